@@ -1,0 +1,63 @@
+"""The ``bearing-lab`` command line.
+
+Each sub-command lives in its own module in this package and exposes
+``register(subparsers)``; that function adds its parser and sets ``func`` to a
+callable taking the parsed ``args`` and returning an exit status.  Errors that
+bearing_lab raises on purpose (:class:`bearing_lab.errors.BearingLabError`) are
+printed as one line on stderr with exit status 2 (contract.md).
+"""
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+from ..errors import BearingLabError
+
+# one line per command module; a module registers one or more sub-commands
+COMMAND_MODULES = [
+    "simulate",   # scenes, simulate
+    "recording",  # import, info, data
+    "analyze",    # analyze
+    "study",      # study
+    "validate",   # validate
+    "bench",      # bench, sweep
+]
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="bearing-lab",
+        description="Rolling-bearing toolkit: import, simulate, analyse, validate.")
+    from .. import __version__
+    parser.add_argument("--version", action="version", version=f"bearing_lab {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    for name in COMMAND_MODULES:
+        try:
+            mod = importlib.import_module(f".{name}", __name__)
+        except ModuleNotFoundError as exc:  # a command module not written yet
+            if exc.name and exc.name.endswith(f"cli.{name}"):
+                continue
+            raise
+        mod.register(sub)
+    return parser
+
+
+def main(argv=None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if not getattr(args, "func", None):
+        parser.print_help()
+        return 2
+    try:
+        return int(args.func(args) or 0)
+    except BearingLabError as exc:
+        print(f"bearing-lab {args.command}: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("bearing-lab: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())
