@@ -1,0 +1,452 @@
+"""numba kernels of the bearing model: contact laws, right-hand side, integrator.
+
+Why numba: the model is a small ODE system (rings, balls, sensor) whose
+right-hand side is evaluated millions of times per simulated second because
+ball-race Hertz contacts ring at 15-25 kHz.  Calling a Python function per
+evaluation (as scipy's ``solve_ivp`` does) costs more than the physics, so the
+right-hand side and the integrator loop are compiled together here.
+
+Conventions the kernels rely on (assembled by :mod:`bearing_lab.sim.assembly`):
+
+- SI units; angles in rad, counter-clockwise positive; the shaft turns
+  counter-clockwise; Y is up.
+- ``p``: float64 parameter vector, indices ``P_*`` below.
+- state ``y``: inner ring (x, y, vx, vy), outer ring (x, y, vx, vy), then for the
+  multibody fidelity each ball's radial coordinate q_j = r_j − d_m/2 and its
+  rate, then the sensor's relative displacements and rates (x, y).
+- ball j sits at angle φ_j = φ_c(t) + 2πj/Z with the cage angle
+  φ_c = φ_c0 + FTF/f_r · θ_s(t) (kinematic cage), θ_s the shaft angle.
+- contact deflections are linearised in the ring displacements (µm against
+  rings of tens of mm: the neglected terms are ~1e-10 m).
+- a defect is a table over ψ (ball-centre angle relative to the defect centre):
+  kind 0: drop h(ψ) (elastic force K·max(δ − h, 0)^e); kind 1: G(ψ, δ) with
+  force K·G (2-D contact-area tables; G = δ^1.5 on intact surface).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+# ---- parameter vector layout
+P_Z, P_RP, P_PD, P_KI, P_KO, P_KEFF, P_CMAX, P_DPEN, P_EXP = 0, 1, 2, 3, 4, 5, 6, 7, 8
+P_MI, P_MO, P_MB = 9, 10, 11
+P_KSX, P_KSY, P_CSX, P_CSY, P_KMX, P_KMY, P_CMX, P_CMY = 12, 13, 14, 15, 16, 17, 18, 19
+P_XIR, P_YIR, P_XOR, P_YOR = 20, 21, 22, 23
+P_FIX, P_FIY, P_FOX, P_FOY = 24, 25, 26, 27
+P_G, P_FTF, P_PHI0 = 28, 29, 30
+P_SENS, P_SW, P_SZ = 31, 32, 33
+P_FID = 34
+P_TSTEP, P_FIX2, P_FIY2, P_FOX2, P_FOY2 = 35, 36, 37, 38, 39
+P_NDEF = 40
+P_SIZE = 41
+
+# ---- defect table layout: dint[k] = race, kind, npsi, ndelta, h_off, g_off
+#                            dflt[k] = psi0, psi_first, dpsi, ddelta, zone_lo, zone_hi
+D_RACE, D_KIND, D_NPSI, D_NDEL, D_HOFF, D_GOFF = 0, 1, 2, 3, 4, 5
+F_PSI0, F_PSIF, F_DPSI, F_DDEL, F_ZLO, F_ZHI = 0, 1, 2, 3, 4, 5
+
+TWO_PI = 2.0 * math.pi
+
+
+@njit(cache=True)
+def shaft_state(t, sp_t, sp_w, sp_th):
+    """Shaft angle (rad) and speed (rad/s) at t for a piecewise-linear speed."""
+    n = sp_t.shape[0]
+    if n == 1 or t <= sp_t[0]:
+        return sp_w[0] * (t - sp_t[0]) + sp_th[0], sp_w[0]
+    if t >= sp_t[n - 1]:
+        return sp_th[n - 1] + sp_w[n - 1] * (t - sp_t[n - 1]), sp_w[n - 1]
+    lo = 0
+    hi = n - 1
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        if sp_t[mid] <= t:
+            lo = mid
+        else:
+            hi = mid
+    dt = t - sp_t[lo]
+    slope = (sp_w[hi] - sp_w[lo]) / (sp_t[hi] - sp_t[lo])
+    return sp_th[lo] + sp_w[lo] * dt + 0.5 * slope * dt * dt, sp_w[lo] + slope * dt
+
+
+@njit(cache=True)
+def wrap(a):
+    """Angle wrapped to [-pi, pi)."""
+    return (a + math.pi) % TWO_PI - math.pi
+
+
+@njit(cache=True)
+def step_fn(x, x0, h0, x1, h1):
+    """Adams STEP: cubic from (x0, h0) to (x1, h1), constant outside."""
+    if x <= x0:
+        return h0
+    if x >= x1:
+        return h1
+    s = (x - x0) / (x1 - x0)
+    return h0 + (h1 - h0) * s * s * (3.0 - 2.0 * s)
+
+
+@njit(cache=True)
+def impact(pen, pen_rate, k, e, cmax, dpen):
+    """Adams IMPACT force for penetration ``pen`` >= 0 (clipped at zero: no pull)."""
+    if pen <= 0.0:
+        return 0.0
+    f = k * pen ** e + step_fn(pen, 0.0, 0.0, dpen, cmax) * pen_rate
+    return f if f > 0.0 else 0.0
+
+
+@njit(cache=True)
+def _interp_h(k, psi, dint, dflt, hbuf):
+    """Drop h (m) and dh/dpsi at relative angle psi for defect k (linear)."""
+    n = dint[k, D_NPSI]
+    off = dint[k, D_HOFF]
+    x = (psi - dflt[k, F_PSIF]) / dflt[k, F_DPSI]
+    if x <= 0.0 or x >= n - 1:
+        return 0.0, 0.0
+    i = int(x)
+    fr = x - i
+    h0 = hbuf[off + i]
+    h1 = hbuf[off + i + 1]
+    return h0 + fr * (h1 - h0), (h1 - h0) / dflt[k, F_DPSI]
+
+
+@njit(cache=True)
+def _interp_g(k, psi, delta, dint, dflt, gbuf):
+    """G(psi, delta) (m^1.5) of defect k, bilinear; linear extrapolation in delta."""
+    npsi = dint[k, D_NPSI]
+    nd = dint[k, D_NDEL]
+    off = dint[k, D_GOFF]
+    dd = dflt[k, F_DDEL]
+    x = (psi - dflt[k, F_PSIF]) / dflt[k, F_DPSI]
+    if x <= 0.0 or x >= npsi - 1:
+        return delta ** 1.5 if delta > 0.0 else 0.0
+    if delta <= 0.0:
+        return 0.0
+    i = int(x)
+    fx = x - i
+    yv = delta / dd
+    if yv >= nd - 1:
+        j = nd - 2
+    else:
+        j = int(yv)
+    fy = yv - j
+    a00 = gbuf[off + i * nd + j]
+    a01 = gbuf[off + i * nd + j + 1]
+    a10 = gbuf[off + (i + 1) * nd + j]
+    a11 = gbuf[off + (i + 1) * nd + j + 1]
+    g0 = a00 + fy * (a01 - a00)
+    g1 = a10 + fy * (a11 - a10)
+    g = g0 + fx * (g1 - g0)
+    return g if g > 0.0 else 0.0
+
+
+@njit(cache=True)
+def race_force(race, phi, phidot, theta_s, omega_s, delta, delta_rate, k, p, dint, dflt, hbuf, gbuf):
+    """Normal force of one ball on ``race`` (0 outer, 1 inner) with defects."""
+    e = p[P_EXP]
+    cmax = p[P_CMAX]
+    dpen = p[P_DPEN]
+    ndef = int(p[P_NDEF])
+    for kk in range(ndef):
+        if dint[kk, D_RACE] != race:
+            continue
+        if race == 0:
+            rel = wrap(phi - dflt[kk, F_PSI0])
+            reld = phidot
+        else:
+            rel = wrap(phi - dflt[kk, F_PSI0] - theta_s)
+            reld = phidot - omega_s
+        if rel < dflt[kk, F_ZLO] or rel > dflt[kk, F_ZHI]:
+            continue
+        h, dh = _interp_h(kk, rel, dint, dflt, hbuf)
+        pen = delta - h
+        pen_rate = delta_rate - dh * reld
+        if pen <= 0.0:
+            return 0.0
+        if dint[kk, D_KIND] == 0:
+            return impact(pen, pen_rate, k, e, cmax, dpen)
+        f = k * _interp_g(kk, rel, delta, dint, dflt, gbuf) + step_fn(pen, 0.0, 0.0, dpen, cmax) * pen_rate
+        return f if f > 0.0 else 0.0
+    return impact(delta, delta_rate, k, e, cmax, dpen)
+
+
+@njit(cache=True)
+def _qs_ball(phi, phidot, theta_s, omega_s, dtot, dtot_rate, p, dint, dflt, hbuf, gbuf):
+    """Quasi-static (massless) ball: load through inner and outer contacts in series."""
+    ki = p[P_KI]
+    ndef = int(p[P_NDEF])
+    e = p[P_EXP]
+    cser = 0.5 * p[P_CMAX]  # two equal dampers in series
+    dpen = p[P_DPEN]
+    for kk in range(ndef):
+        race = dint[kk, D_RACE]
+        if race == 0:
+            rel = wrap(phi - dflt[kk, F_PSI0])
+            reld = phidot
+        else:
+            rel = wrap(phi - dflt[kk, F_PSI0] - theta_s)
+            reld = phidot - omega_s
+        if rel < dflt[kk, F_ZLO] or rel > dflt[kk, F_ZHI]:
+            continue
+        h, dh = _interp_h(kk, rel, dint, dflt, hbuf)
+        pen = dtot - h
+        pen_rate = dtot_rate - dh * reld
+        if pen <= 0.0:
+            return 0.0
+        if dint[kk, D_KIND] == 0:
+            return impact(pen, pen_rate, p[P_KEFF], e, cser, dpen)
+        # 2-D table on one race, Hertz on the other: split the approach by bisection
+        k_def = p[P_KO] if race == 0 else p[P_KI]
+        k_oth = p[P_KI] if race == 0 else p[P_KO]
+        lo = 0.0
+        hi = dtot
+        for _ in range(40):
+            mid = 0.5 * (lo + hi)
+            r = k_def * _interp_g(kk, rel, mid, dint, dflt, gbuf) - k_oth * (dtot - mid) ** 1.5
+            if r > 0.0:
+                hi = mid
+            else:
+                lo = mid
+        q = k_oth * (dtot - 0.5 * (lo + hi)) ** 1.5
+        f = q + step_fn(pen, 0.0, 0.0, dpen, cser) * pen_rate
+        return f if f > 0.0 else 0.0
+    return impact(dtot, dtot_rate, p[P_KEFF], e, cser, dpen)
+
+
+@njit(cache=True)
+def rhs(t, y, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, dy, fi_out, fo_out):
+    """dy/dt of the bearing model; also writes the ball loads into fi_out/fo_out."""
+    z = int(p[P_Z])
+    xi, yi, vxi, vyi = y[0], y[1], y[2], y[3]
+    xo, yo, vxo, vyo = y[4], y[5], y[6], y[7]
+    theta_s, omega_s = shaft_state(t, sp_t, sp_w, sp_th)
+    phic = p[P_PHI0] + p[P_FTF] * theta_s
+    phidot = p[P_FTF] * omega_s
+    pd4 = 0.25 * p[P_PD]
+    fix = 0.0
+    fiy = 0.0
+    fox = 0.0
+    foy = 0.0
+    mb = p[P_MB]
+    qs = p[P_FID] > 0.5
+    base = 8
+    for j in range(z):
+        phi = phic + TWO_PI * j / z
+        c = math.cos(phi)
+        s = math.sin(phi)
+        if qs:
+            dtot = (xi - xo) * c + (yi - yo) * s - 2.0 * pd4
+            drate = (vxi - vxo) * c + (vyi - vyo) * s + ((xi - xo) * (-s) + (yi - yo) * c) * phidot
+            q = _qs_ball(phi, phidot, theta_s, omega_s, dtot, drate, p, dint, dflt, hbuf, gbuf)
+            fi = q
+            fo = q
+        else:
+            qj = y[base + j]
+            qd = y[base + z + j]
+            d_o = qj - (xo * c + yo * s) - pd4
+            d_or = qd - (vxo * c + vyo * s) - (xo * (-s) + yo * c) * phidot
+            d_i = -qj + (xi * c + yi * s) - pd4
+            d_ir = -qd + (vxi * c + vyi * s) + (xi * (-s) + yi * c) * phidot
+            fo = race_force(0, phi, phidot, theta_s, omega_s, d_o, d_or, p[P_KO], p, dint, dflt, hbuf, gbuf)
+            fi = race_force(1, phi, phidot, theta_s, omega_s, d_i, d_ir, p[P_KI], p, dint, dflt, hbuf, gbuf)
+            dy[base + j] = qd
+            dy[base + z + j] = (fi - fo) / mb + (p[P_RP] + qj) * phidot * phidot - p[P_G] * s
+        fix -= fi * c
+        fiy -= fi * s
+        fox += fo * c
+        foy += fo * s
+        fi_out[j] = fi
+        fo_out[j] = fo
+    if t >= p[P_TSTEP]:
+        lix, liy, lox, loy = p[P_FIX2], p[P_FIY2], p[P_FOX2], p[P_FOY2]
+    else:
+        lix, liy, lox, loy = p[P_FIX], p[P_FIY], p[P_FOX], p[P_FOY]
+    axi = (fix - p[P_KSX] * (xi - p[P_XIR]) - p[P_CSX] * vxi + lix) / p[P_MI]
+    ayi = (fiy - p[P_KSY] * (yi - p[P_YIR]) - p[P_CSY] * vyi + liy) / p[P_MI]
+    axo = (fox - p[P_KMX] * (xo - p[P_XOR]) - p[P_CMX] * vxo + lox) / p[P_MO]
+    ayo = (foy - p[P_KMY] * (yo - p[P_YOR]) - p[P_CMY] * vyo + loy) / p[P_MO]
+    dy[0] = vxi
+    dy[1] = vyi
+    dy[2] = axi
+    dy[3] = ayi
+    dy[4] = vxo
+    dy[5] = vyo
+    dy[6] = axo
+    dy[7] = ayo
+    if p[P_SENS] > 0.5:
+        sb = 8 if qs else 8 + 2 * z
+        w = p[P_SW]
+        zt = p[P_SZ]
+        dy[sb] = y[sb + 2]
+        dy[sb + 1] = y[sb + 3]
+        dy[sb + 2] = -2.0 * zt * w * y[sb + 2] - w * w * y[sb] - axo
+        dy[sb + 3] = -2.0 * zt * w * y[sb + 3] - w * w * y[sb + 1] - ayo
+
+
+@njit(cache=True)
+def _step_limit(t, h, p, sp_t, sp_w, sp_th, dint, dflt, nsteps_def, hmax):
+    """Bound the step near defects: land on zone entry, then take >= nsteps_def steps inside."""
+    ndef = int(p[P_NDEF])
+    if ndef == 0:
+        return h
+    z = int(p[P_Z])
+    theta_s, omega_s = shaft_state(t, sp_t, sp_w, sp_th)
+    phic = p[P_PHI0] + p[P_FTF] * theta_s
+    phidot = p[P_FTF] * omega_s
+    hh = h
+    for kk in range(ndef):
+        if dint[kk, D_RACE] == 0:
+            reld = phidot
+            off = dflt[kk, F_PSI0]
+        else:
+            reld = phidot - omega_s
+            off = dflt[kk, F_PSI0] + theta_s
+        if abs(reld) < 1e-12:
+            continue
+        zlo = dflt[kk, F_ZLO]
+        zhi = dflt[kk, F_ZHI]
+        hdef = (zhi - zlo) / abs(reld) / nsteps_def
+        for j in range(z):
+            rel = wrap(phic + TWO_PI * j / z - off)
+            if zlo <= rel <= zhi:
+                if hdef < hh:
+                    hh = hdef
+            elif reld > 0.0 and rel < zlo:
+                tt = (zlo - rel) / reld
+                if tt < hh:
+                    hh = tt * (1.0 + 1e-9) + 1e-15
+            elif reld < 0.0 and rel > zhi:
+                tt = (rel - zhi) / (-reld)
+                if tt < hh:
+                    hh = tt * (1.0 + 1e-9) + 1e-15
+    return hh
+
+
+@njit(cache=True)
+def _hermite(y0, y1, f0, f1, h, th):
+    h00 = (1 + 2 * th) * (1 - th) ** 2
+    h10 = th * (1 - th) ** 2
+    h01 = th * th * (3 - 2 * th)
+    h11 = th * th * (th - 1)
+    return h00 * y0 + h10 * h * f0 + h01 * y1 + h11 * h * f1
+
+
+@njit(cache=True)
+def integrate(y, t, t_stop, h, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf,
+              a_tab, b_tab, e_tab, c_tab, order, fsal, adaptive, rtol, atol, hmax, nsteps_def,
+              vel_idx, vel_sign, fine_t, fine_out, fine_pos, out_t, out_state, out_pos, stats):
+    """Integrate from t to t_stop, writing dense output on two grids.
+
+    fine grid (``fine_t``): the accelerometer velocity channels (sum over
+    ``vel_idx`` rows with ``vel_sign``) for the anti-alias stage; output grid
+    (``out_t``): the whole state.  Returns (t, h, fine_pos, out_pos, status):
+    status 0 ok, 1 non-finite state, 2 step underflow.
+    """
+    n = y.shape[0]
+    s = b_tab.shape[0]
+    k = np.zeros((s, n))
+    ytmp = np.empty(n)
+    ynew = np.empty(n)
+    err = np.empty(n)
+    fi = np.empty(int(p[P_Z]))
+    fo = np.empty(int(p[P_Z]))
+    rhs(t, y, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, k[0], fi, fo)
+    nch = vel_idx.shape[0]
+    while t < t_stop:
+        hstep = h
+        if hstep > hmax:
+            hstep = hmax
+        if t + hstep > t_stop:
+            hstep = t_stop - t
+        hstep = _step_limit(t, hstep, p, sp_t, sp_w, sp_th, dint, dflt, nsteps_def, hstep)
+        if hstep < 1e-14:
+            hstep = 1e-14
+        for i in range(1, s):
+            for m in range(n):
+                acc = 0.0
+                for jj in range(i):
+                    acc += a_tab[i, jj] * k[jj, m]
+                ytmp[m] = y[m] + hstep * acc
+            if fsal and i == s - 1:
+                pass
+            rhs(t + c_tab[i] * hstep, ytmp, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, k[i], fi, fo)
+        for m in range(n):
+            acc = 0.0
+            acce = 0.0
+            for jj in range(s):
+                acc += b_tab[jj] * k[jj, m]
+                acce += e_tab[jj] * k[jj, m]
+            ynew[m] = y[m] + hstep * acc
+            err[m] = hstep * acce
+        accept = True
+        fac = 1.0
+        if adaptive:
+            en = 0.0
+            for m in range(n):
+                sc = atol[m] + rtol * max(abs(y[m]), abs(ynew[m]))
+                en += (err[m] / sc) ** 2
+            en = math.sqrt(en / n)
+            if not math.isfinite(en):
+                en = 1e10
+            if en > 1.0:
+                accept = False
+                fac = max(0.2, 0.9 * en ** (-1.0 / order))
+            else:
+                fac = 5.0 if en < 1e-10 else min(5.0, 0.9 * en ** (-1.0 / order))
+        if not accept:
+            h = hstep * fac
+            stats[1] += 1
+            if h < 1e-13:
+                return t, h, fine_pos, out_pos, 2
+            continue
+        # f at the new point: the FSAL stage, or one more evaluation
+        if fsal:
+            for m in range(n):
+                ytmp[m] = k[s - 1, m]
+        else:
+            rhs(t + hstep, ynew, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, ytmp, fi, fo)
+            stats[2] += 1
+        tn = t + hstep
+        # dense output: fine grid (accelerometer velocity), output grid (state)
+        while fine_pos < fine_t.shape[0] and fine_t[fine_pos] <= tn:
+            th = (fine_t[fine_pos] - t) / hstep
+            for ch in range(nch):
+                v = 0.0
+                for r in range(vel_idx.shape[1]):
+                    idx = vel_idx[ch, r]
+                    if idx >= 0:
+                        v += vel_sign[ch, r] * _hermite(y[idx], ynew[idx], k[0, idx], ytmp[idx], hstep, th)
+                fine_out[fine_pos, ch] = v
+            fine_pos += 1
+        while out_pos < out_t.shape[0] and out_t[out_pos] <= tn:
+            th = (out_t[out_pos] - t) / hstep
+            for m in range(n):
+                out_state[out_pos, m] = _hermite(y[m], ynew[m], k[0, m], ytmp[m], hstep, th)
+            out_pos += 1
+        for m in range(n):
+            y[m] = ynew[m]
+            k[0, m] = ytmp[m]
+            if not math.isfinite(y[m]):
+                return tn, h, fine_pos, out_pos, 1
+        t = tn
+        stats[0] += 1
+        if adaptive:
+            h = hstep * fac
+    return t, h, fine_pos, out_pos, 0
+
+
+@njit(cache=True)
+def loads_at(out_t, out_state, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, fi_all, fo_all):
+    """Ball loads (N) at the output samples from the interpolated states."""
+    n = out_state.shape[1]
+    dy = np.empty(n)
+    z = int(p[P_Z])
+    fi = np.empty(z)
+    fo = np.empty(z)
+    for i in range(out_t.shape[0]):
+        rhs(out_t[i], out_state[i], p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, dy, fi, fo)
+        for j in range(z):
+            fi_all[j, i] = fi[j]
+            fo_all[j, i] = fo[j]

@@ -1,0 +1,263 @@
+"""simulate(scene) -> xarray.Dataset: validate, assemble, integrate, label.
+
+How the output is sampled (as a data-acquisition system would):
+
+1. The integrator steps adaptively (embedded Runge-Kutta, error-controlled) or
+   with a fixed step, never stepping over a defect: a step that would carry a
+   ball into a defect zone is cut to end at the zone's edge, and inside the zone
+   at least ``solver.defect_steps`` steps are taken per crossing.
+2. Between steps the solution is interpolated (cubic Hermite, using the
+   derivatives at both ends) onto a fine grid at ``oversample × sample_rate``.
+3. The accelerometer signal is the mean acceleration over each fine interval,
+   computed exactly as the velocity difference across it, then low-pass
+   filtered by a linear-phase (zero-delay) Kaiser FIR with −6 dB at the output
+   Nyquist frequency, flat (±0.01 dB) to 0.45·fs and ≥ 80 dB down from 0.55·fs,
+   and decimated to ``sample_rate``.  So the ball-race resonances at 15–25 kHz
+   do not alias into the record.  The fine-interval mean attenuates 0.45·fs by
+   under 0.5 % at the default oversampling.
+4. Displacements and ball loads are instantaneous samples at the output times
+   (they carry no content near the Nyquist frequency worth filtering).
+"""
+from __future__ import annotations
+
+import math
+import time as _time
+
+import numpy as np
+import xarray as xr
+from scipy import signal
+
+from .. import __version__
+from ..errors import SceneError, SolverError
+from . import _kernels as K
+from .assembly import assemble
+from .scene import Scene, load_scene
+
+# Butcher tableaus: (A, b, b - b_hat, c, order used for step control, FSAL)
+_DP54 = (
+    np.array([[0, 0, 0, 0, 0, 0, 0],
+              [1 / 5, 0, 0, 0, 0, 0, 0],
+              [3 / 40, 9 / 40, 0, 0, 0, 0, 0],
+              [44 / 45, -56 / 15, 32 / 9, 0, 0, 0, 0],
+              [19372 / 6561, -25360 / 2187, 64448 / 6561, -212 / 729, 0, 0, 0],
+              [9017 / 3168, -355 / 33, 46732 / 5247, 49 / 176, -5103 / 18656, 0, 0],
+              [35 / 384, 0, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84, 0]]),
+    np.array([35 / 384, 0, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84, 0]),
+    np.array([35 / 384 - 5179 / 57600, 0, 500 / 1113 - 7571 / 16695, 125 / 192 - 393 / 640,
+              -2187 / 6784 + 92097 / 339200, 11 / 84 - 187 / 2100, -1 / 40]),
+    np.array([0, 1 / 5, 3 / 10, 4 / 5, 8 / 9, 1, 1]), 5, True)
+_BS32 = (
+    np.array([[0, 0, 0, 0], [1 / 2, 0, 0, 0], [0, 3 / 4, 0, 0], [2 / 9, 1 / 3, 4 / 9, 0]]),
+    np.array([2 / 9, 1 / 3, 4 / 9, 0]),
+    np.array([2 / 9 - 7 / 24, 1 / 3 - 1 / 4, 4 / 9 - 1 / 3, -1 / 8]),
+    np.array([0, 1 / 2, 3 / 4, 1]), 3, True)
+_RK4 = (
+    np.array([[0, 0, 0, 0], [0.5, 0, 0, 0], [0, 0.5, 0, 0], [0, 0, 1, 0]], dtype=float),
+    np.array([1 / 6, 1 / 3, 1 / 3, 1 / 6]), np.zeros(4), np.array([0, 0.5, 0.5, 1.0]), 4, False)
+METHODS = {"dp54": _DP54, "bs32": _BS32, "rk4": _RK4}
+
+_COMPILED = {"done": False, "seconds": 0.0}
+
+
+def anti_alias_taps(fs_out: float, oversample: int) -> np.ndarray:
+    """Kaiser low-pass FIR at fs_out·oversample: −6 dB at fs_out/2, 80 dB stop band from 0.55·fs_out."""
+    fs_fine = fs_out * oversample
+    width = 0.1 * fs_out / (fs_fine / 2)
+    numtaps, beta = signal.kaiserord(80.0, width)
+    numtaps |= 1
+    return signal.firwin(numtaps, fs_out / 2, window=("kaiser", beta), fs=fs_fine)
+
+
+def _warm_up():
+    """Compile (or load from the numba cache) once; report the time apart from run time."""
+    if _COMPILED["done"]:
+        return 0.0
+    t0 = _time.perf_counter()
+    scene = load_scene({"output": {"duration_s": 1e-3, "settle_s": 0.0}})
+    for fid in ("multibody",):
+        asm = assemble(scene, fidelity=fid)
+        _run(asm, METHODS["dp54"], 1e-3, progress=False, t_end_override=2e-5)
+    _COMPILED["done"] = True
+    _COMPILED["seconds"] = _time.perf_counter() - t0
+    return _COMPILED["seconds"]
+
+
+def _run(asm, method, rtol, *, progress, t_end_override=None, step=None, max_step=None,
+         defect_steps=40, chunk_s=0.01):
+    scene = asm.scene
+    d = scene.data
+    fs = scene.fs_out
+    R = int(d["output"]["oversample"])
+    taps = anti_alias_taps(fs, R)
+    half = len(taps) // 2
+    dt_f = 1.0 / (fs * R)
+    n_out = int(round(scene.duration * fs)) if t_end_override is None else 1
+    t0 = scene.settle if t_end_override is None else 0.0
+    pad = (half + 2) * dt_f
+    t_end = t0 + (n_out - 1) / fs + pad if t_end_override is None else t_end_override
+    # fine velocity grid at half-offsets; fine acceleration sample m sits at t0 - pad + m dt_f
+    m_pad = half + 2
+    n_fine = m_pad + (n_out - 1) * R + m_pad + 1
+    fine_t = t0 - m_pad * dt_f + (np.arange(n_fine + 1) - 0.5) * dt_f
+    out_t = t0 + np.arange(n_out) / fs
+    n = asm.y0.size
+    # accelerometer velocity channels: outer ring (+ sensor relative) velocity, x and y
+    vel_idx = np.full((2, 2), -1, dtype=np.int64)
+    vel_sign = np.ones((2, 2))
+    vel_idx[0, 0], vel_idx[1, 0] = 6, 7
+    if d["sensor"]["enabled"]:
+        sb = asm.sensor_index
+        vel_idx[0, 1], vel_idx[1, 1] = sb + 2, sb + 3
+    fine_out = np.zeros((fine_t.size, 2))
+    out_state = np.zeros((n_out, n))
+    A, b, e, c, order, fsal = method
+    adaptive = bool(np.any(e != 0))
+    hmax = max_step if max_step is not None else d["solver"]["max_step_s"]
+    if not adaptive:
+        h = step if step is not None else d["solver"]["step_s"]
+        hmax = h
+    else:
+        h = min(1e-6, hmax)
+    atol = asm.atol_scale * rtol
+    y = asm.y0.copy()
+    t = 0.0
+    fpos = opos = 0
+    stats = np.zeros(3, dtype=np.int64)
+    bar = None
+    if progress:
+        from tqdm.auto import tqdm
+        bar = tqdm(total=round(t_end, 6), unit="s sim", delay=2.0, leave=False,
+                   desc=f"simulate {scene.name}", bar_format="{l_bar}{bar}| {n:.3f}/{total:.3f} s sim [{elapsed}<{remaining}]")
+    try:
+        while t < t_end:
+            t_stop = min(t + chunk_s, t_end)
+            t_new, h, fpos, opos, status = K.integrate(
+                y, t, t_stop, h, asm.p, asm.sp_t, asm.sp_w, asm.sp_th, asm.dint, asm.dflt,
+                asm.hbuf, asm.gbuf, A, b, e, c, order, fsal, adaptive, rtol, atol, hmax,
+                float(defect_steps), vel_idx, vel_sign, fine_t, fine_out, fpos, out_t, out_state,
+                opos, stats)
+            if status != 0:
+                what = "the state became NaN/Inf" if status == 1 else "the step size underflowed"
+                raise SolverError(f"scene {scene.name!r}: integration failed at t = {t_new:.6g} s: {what} "
+                                  f"(method {d['solver']['method']}, rtol {rtol:g}); the scene may be "
+                                  "unphysical, or try solver.method='dp54' with a smaller solver.max_step_s")
+            if bar is not None:
+                bar.update(round(t_new - t, 6))
+            t = t_new
+    finally:
+        if bar is not None:
+            bar.close()
+    return dict(fine_t=fine_t, fine_out=fine_out, out_t=out_t, out_state=out_state, taps=taps,
+                R=R, m_pad=m_pad, n_out=n_out, stats=stats, dt_f=dt_f, t0=t0)
+
+
+def _decimate_acc(res):
+    """Fine velocity -> fine-interval mean acceleration -> FIR -> output rate."""
+    v = res["fine_out"]
+    a_fine = np.diff(v, axis=0) / res["dt_f"]           # sample m at t0 - m_pad dt_f + m dt_f
+    taps = res["taps"]
+    half = len(taps) // 2
+    centres = res["m_pad"] + res["R"] * np.arange(res["n_out"])
+    win = np.lib.stride_tricks.sliding_window_view(a_fine, len(taps), axis=0)  # (M', ch, taps)
+    return win[centres - half] @ taps[::-1]
+
+
+def simulate(scene, *, fidelity: str | None = None, duration: float | None = None,
+             fs: float | None = None, rtol: float | None = None, method: str | None = None,
+             step: float | None = None, progress: bool = True, **overrides) -> xr.Dataset:
+    """Simulate a scene and return the contract Dataset (SI units).
+
+    Parameters
+    ----------
+    scene : built-in name, TOML path, dict or :class:`Scene`.
+    fidelity : "multibody" or "quasi-static" (default: the scene's).
+    duration, fs : override ``output.duration_s`` and ``output.sample_rate_hz``.
+    rtol, method, step : override the solver settings.
+    progress : show a progress bar when a run takes more than 2 s.
+    **overrides : ``--set``-style keys, e.g. ``**{"load.radial_n": 480}``.
+
+    Returns
+    -------
+    xarray.Dataset with ``outer_ring_acc_{x,y}`` (m s-2), ``outer_ring_disp_{x,y}``,
+    ``inner_ring_disp_{x,y}`` (m), ``ball_load_{outer,inner}`` (N, dims ball × time)
+    and attributes ``bearing``, ``fidelity``, ``scene_toml``, ``wall_time_s``,
+    ``compile_time_s``, ``sampling_rate_hz``, ``shaft_speed_rpm``.
+    """
+    ov = dict(overrides)
+    if duration is not None:
+        ov["output.duration_s"] = duration
+    if fs is not None:
+        ov["output.sample_rate_hz"] = fs
+    if rtol is not None:
+        ov["solver.rtol"] = rtol
+    if method is not None:
+        ov["solver.method"] = method
+    if step is not None:
+        ov["solver.step_s"] = step
+    if fidelity is not None:
+        ov["fidelity"] = fidelity
+    sc = load_scene(scene, **ov)
+    compile_s = _warm_up()
+    t_start = _time.perf_counter()
+    asm = assemble(sc)
+    d = sc.data
+    res = _run(asm, METHODS[d["solver"]["method"]], d["solver"]["rtol"], progress=progress,
+               defect_steps=d["solver"]["defect_steps"])
+    acc = _decimate_acc(res)
+    if d["sensor"]["enabled"]:
+        acc = acc * d["sensor"]["gain"]
+    st = res["out_state"]
+    z = asm.n_balls
+    fi = np.zeros((z, res["n_out"]))
+    fo = np.zeros((z, res["n_out"]))
+    K.loads_at(res["out_t"], st, asm.p, asm.sp_t, asm.sp_w, asm.sp_th, asm.dint, asm.dflt,
+               asm.hbuf, asm.gbuf, fi, fo)
+    wall = _time.perf_counter() - t_start
+    for name, arr in (("acceleration", acc), ("state", st), ("ball loads", fi), ("ball loads", fo)):
+        if not np.all(np.isfinite(arr)):
+            raise SolverError(f"scene {sc.name!r}: the {name} hold NaN/Inf; the solve diverged")
+    time = res["out_t"] - res["t0"]
+    coords = {"time": ("time", time, {"units": "s", "long_name": "time from the record start"}),
+              "ball": ("ball", np.arange(z), {"long_name": "ball index (cage order)"})}
+    def v(data, units, long):
+        return (("time",), data, {"units": units, "long_name": long})
+    ds = xr.Dataset(
+        {
+            "outer_ring_acc_y": v(acc[:, 1], "m s-2", "outer-ring acceleration Y (accelerometer signal)"),
+            "outer_ring_acc_x": v(acc[:, 0], "m s-2", "outer-ring acceleration X (accelerometer signal)"),
+            "outer_ring_disp_y": v(st[:, 5], "m", "outer-ring displacement Y"),
+            "outer_ring_disp_x": v(st[:, 4], "m", "outer-ring displacement X"),
+            "inner_ring_disp_y": v(st[:, 1], "m", "inner-ring displacement Y"),
+            "inner_ring_disp_x": v(st[:, 0], "m", "inner-ring displacement X"),
+            "ball_load_outer": (("ball", "time"), fo, {"units": "N", "long_name": "ball-outer race normal load"}),
+            "ball_load_inner": (("ball", "time"), fi, {"units": "N", "long_name": "ball-inner race normal load"}),
+        },
+        coords=coords,
+    )
+    if not d["output"]["ball_loads"]:
+        ds = ds.drop_vars(["ball_load_outer", "ball_load_inner"])
+    stats = res["stats"]
+    ds.attrs.update({
+        "title": f"bearing_lab simulation of scene {sc.name!r}",
+        "sampling_rate_hz": float(sc.fs_out),
+        "bearing_lab_version": __version__,
+        "shaft_speed_rpm": float(sc.nominal_rpm),
+        "bearing": sc.bearing.name,
+        "fidelity": asm.fidelity,
+        "scene_name": sc.name,
+        "scene_toml": sc.to_toml(),
+        "defect_contact_models": ",".join(asm.contact_models) if asm.contact_models else "none",
+        "wall_time_s": float(wall),
+        "compile_time_s": float(compile_s),
+        "solver_method": d["solver"]["method"],
+        "solver_rtol": float(d["solver"]["rtol"]),
+        "solver_steps": int(stats[0]),
+        "solver_rejected_steps": int(stats[1]),
+        "settle_time_s": float(sc.settle),
+        "load_zone_angle_deg": float(math.degrees(asm.load_zone_angle) % 360),
+        "load_path": d["load"]["path"],
+        "anti_alias": f"Kaiser FIR {len(res['taps'])} taps at {d['output']['oversample']}x, -6 dB at fs/2",
+        "sensor_resonator": "on" if d["sensor"]["enabled"] else "off",
+        "Conventions": "CF-1.8",
+    })
+    return ds

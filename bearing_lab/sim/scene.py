@@ -1,0 +1,570 @@
+"""Declarative scenes: what to simulate, in physical units, validated on entry.
+
+A scene is a TOML file (or a dict, or a built-in name) whose keys carry their
+unit in the name (``radial_n``, ``length_mm``, ``stiffness_y_n_m``).  A value may
+also be a string with a unit (``"1 mm"``, ``"1800 rpm"``, ``"150 N"``); it is
+converted, and a unit of the wrong kind is refused.  Unknown keys, wrong types
+and impossible values raise :class:`~bearing_lab.errors.SceneError` naming the
+key and the reason.
+
+Defaults where the paper is silent (each settable; see ``docs`` in
+:data:`SCHEMA`):
+
+- steel balls and rings: E = 208 GPa, ν = 0.3, ρ = 7850 kg/m³ (reference.md's
+  assumptions, AISI 52100 handbook values);
+- groove conformities f_i = 0.52, f_o = 0.53 (reference.md; Harris & Kotzalas's
+  typical deep-groove values);
+- radial internal clearance 0 (mounted: an interference fit takes most of a C0
+  6308's 6–20 µm, ISO 5753-1);
+- ring masses from the ring envelope (steel annuli between bore / outer
+  diameter and the raceway shoulders), ball mass from D_b and ρ;
+- shaft (inner ring to ground) and mount (outer-ring bushing) stiffness
+  1e8 N/m: the order of the bearing's own linearised radial stiffness
+  (≈1.2e8 N/m near 1 kN, reference.md), as in lumped rotor–bearing–pedestal
+  models (e.g. Sawalhi & Randall, MSSP 22 (2008) 1924–1951);
+- their damping 1000 N·s/m: ~1e-5 × stiffness, inside the paper's
+  0.25–2.5e-5 rule (its section 2.1, citing Liu & Shao);
+- contact damping c_max = 350 N·s/m (paper) reached at penetration d = 1 µm
+  (not given by the paper; 1 µm is ~10 % of the static deflection, so damping
+  is fully on in a loaded contact and fades smoothly at touch-down);
+- load path "bearing": the support spring of the ring that takes the external
+  load is preloaded (its rest position is the ring's static equilibrium), so the
+  whole load goes through the balls, as in the paper's experiment where the
+  load is applied through the bearing.  ``load.path = "springs"`` leaves both
+  supports unstressed at the nominal centre (most load then bypasses the
+  bearing and amplitudes drop three- to five-fold, paper.md).
+"""
+from __future__ import annotations
+
+import copy
+from dataclasses import dataclass, field
+import math
+from pathlib import Path
+import re
+import tomllib
+
+import numpy as np
+
+from ..bearings import BearingGeometry, CATALOG, get_bearing
+from ..errors import SceneError
+
+STEEL_DENSITY = 7850.0
+G0 = 9.80665
+
+# ---------------------------------------------------------------- units
+_UNITS = {
+    "length": {"m": 1.0, "mm": 1e-3, "um": 1e-6, "µm": 1e-6, "in": 0.0254, "mil": 2.54e-5},
+    "force": {"n": 1.0, "kn": 1e3, "lbf": 4.4482216152605},
+    "speed": {"rpm": 1.0, "r/min": 1.0, "hz": 60.0},
+    "time": {"s": 1.0, "ms": 1e-3},
+    "frequency": {"hz": 1.0, "khz": 1e3},
+    "angle": {"deg": 1.0, "rad": 180 / math.pi},
+    "stiffness": {"n/m": 1.0, "n/mm": 1e3, "n/um": 1e6},
+    "damping": {"n s/m": 1.0, "ns/m": 1.0, "n*s/m": 1.0},
+    "mass": {"kg": 1.0, "g": 1e-3},
+    "pressure": {"gpa": 1.0, "pa": 1e-9, "mpa": 1e-3},
+    "density": {"kg/m3": 1.0, "kg/m^3": 1.0},
+    "acceleration": {"m/s2": 1.0, "m/s^2": 1.0, "g": G0},
+}
+# unit kind and the scale of the key's own unit in that kind's base unit
+_SUFFIX = {
+    "_mm": ("length", 1e-3), "_um": ("length", 1e-6), "_m": ("length", 1.0),
+    "_n": ("force", 1.0), "_rpm": ("speed", 1.0), "_s": ("time", 1.0),
+    "_hz": ("frequency", 1.0), "_deg": ("angle", 1.0), "_n_m": ("stiffness", 1.0),
+    "_n_s_m": ("damping", 1.0), "_kg": ("mass", 1.0), "_gpa": ("pressure", 1.0),
+    "_kg_m3": ("density", 1.0), "_m_s2": ("acceleration", 1.0),
+}
+
+
+def _suffix(key: str):
+    for suf in sorted(_SUFFIX, key=len, reverse=True):
+        if key.endswith(suf):
+            return _SUFFIX[suf]
+    return None
+
+
+def _convert(value, key: str, where: str):
+    """Convert a "1 mm"-style string to the unit the key names."""
+    if not isinstance(value, str):
+        return value
+    spec = _suffix(key)
+    m = re.fullmatch(r"\s*([-+0-9.eE]+)\s*(\S.*?)?\s*", value)
+    if spec is None or m is None:
+        return value
+    try:
+        number = float(m.group(1))
+    except ValueError:
+        raise SceneError(f"{where}: {value!r} is not a number with a unit") from None
+    unit = (m.group(2) or "").lower().replace("·", " ").strip()
+    kind, own_scale = spec
+    table = _UNITS[kind]
+    if unit not in table:
+        other = [k for k, t in _UNITS.items() if unit in t]
+        hint = f" (that is a {other[0]} unit)" if other else ""
+        raise SceneError(f"{where}: unit {m.group(2)!r} is not a {kind} unit{hint}; "
+                         f"use one of {', '.join(table)}")
+    return number * table[unit] / own_scale
+
+
+# ---------------------------------------------------------------- schema
+# section -> key -> (default, type, check, doc).  check: "pos", "nonneg", "any", "frac",
+# a tuple of allowed strings, or None.
+_NUM = (int, float)
+SCHEMA: dict[str, dict[str, tuple]] = {
+    "": {
+        "name": ("custom", str, None, "scene name"),
+        "description": ("", str, None, "one line shown by `bearing-lab scenes`"),
+        "bearing": ("6308", str, None, "catalog bearing (6308, 6205, 6203) or see [bearing_geometry]"),
+        "fidelity": ("multibody", str, ("multibody", "quasi-static", "auto"),
+                     "multibody: each ball a body with radial inertia; quasi-static: massless balls"),
+    },
+    "bearing_geometry": {
+        "n_balls": (None, int, "pos", "override Z"),
+        "ball_diameter_mm": (None, _NUM, "pos", "override D_b"),
+        "pitch_diameter_mm": (None, _NUM, "pos", "override d_m"),
+        "bore_mm": (None, _NUM, "pos", "override bore"),
+        "outer_diameter_mm": (None, _NUM, "pos", "override outer diameter"),
+        "width_mm": (None, _NUM, "pos", "override ring width"),
+        "inner_conformity": (None, _NUM, "pos", "groove radius / D_b, inner (default 0.52)"),
+        "outer_conformity": (None, _NUM, "pos", "groove radius / D_b, outer (default 0.53)"),
+    },
+    "material": {
+        "youngs_modulus_gpa": (208.0, _NUM, "pos", "E of balls and rings (52100 steel)"),
+        "poisson_ratio": (0.3, _NUM, "frac", "nu"),
+        "density_kg_m3": (STEEL_DENSITY, _NUM, "pos", "steel density"),
+    },
+    "clearance": {
+        "radial_um": (0.0, _NUM, "any", "radial internal clearance P_d (total radial play); negative = preload"),
+    },
+    "mass": {
+        "inner_ring_kg": (None, _NUM, "pos", "default: steel ring from bore to inner raceway shoulder"),
+        "outer_ring_kg": (None, _NUM, "pos", "default: steel ring from outer raceway shoulder to OD"),
+        "ball_kg": (None, _NUM, "pos", "default: steel sphere of D_b"),
+    },
+    "shaft": {
+        "stiffness_x_n_m": (1e8, _NUM, "pos", "inner ring to ground, X"),
+        "stiffness_y_n_m": (1e8, _NUM, "pos", "inner ring to ground, Y"),
+        "damping_x_n_s_m": (1e3, _NUM, "nonneg", "inner ring to ground, X"),
+        "damping_y_n_s_m": (1e3, _NUM, "nonneg", "inner ring to ground, Y"),
+    },
+    "mount": {
+        "stiffness_x_n_m": (1e8, _NUM, "pos", "outer-ring bushing to ground, X"),
+        "stiffness_y_n_m": (1e8, _NUM, "pos", "outer-ring bushing to ground, Y"),
+        "damping_x_n_s_m": (1e3, _NUM, "nonneg", "outer-ring bushing, X"),
+        "damping_y_n_s_m": (1e3, _NUM, "nonneg", "outer-ring bushing, Y"),
+    },
+    "speed": {
+        "rpm": (1800.0, _NUM, "nonneg", "constant shaft (inner ring) speed"),
+        "profile": (None, list, None, "[[t_s, rpm], ...] piecewise-linear speed; overrides rpm"),
+    },
+    "load": {
+        "radial_n": (150.0, _NUM, "nonneg", "radial load magnitude"),
+        "direction_deg": (270.0, _NUM, "any", "direction of the force on the ring (270 = -Y, downward)"),
+        "on": ("outer", str, ("inner", "outer"), "ring the load is applied to"),
+        "path": ("bearing", str, ("bearing", "springs"), "see module docs: who carries the static load"),
+        "step_time_s": (None, _NUM, "nonneg", "optional load step: time (from the record start)"),
+        "step_radial_n": (None, _NUM, "nonneg", "optional load step: new magnitude"),
+    },
+    "gravity": {
+        "enabled": (True, bool, None, "ring and ball weights along -Y"),
+        "g_m_s2": (G0, _NUM, "nonneg", "standard gravity"),
+    },
+    "contact": {
+        "damping_n_s_m": (350.0, _NUM, "nonneg", "IMPACT c_max (paper: 350 N s/m)"),
+        "penetration_um": (1.0, _NUM, "pos", "IMPACT d: penetration at which full damping applies"),
+        "exponent": (1.5, _NUM, "pos", "IMPACT exponent e (Hertz point contact: 1.5)"),
+    },
+    "cage": {
+        "model": ("kinematic", str, ("kinematic",), "kinematic: balls spaced at the cage speed (FTF)"),
+    },
+    "sensor": {
+        "enabled": (False, bool, None, "accelerometer/housing resonator between outer ring and sensor"),
+        "frequency_hz": (5000.0, _NUM, "pos", "resonance frequency"),
+        "damping_ratio": (0.05, _NUM, "pos", "resonance damping ratio"),
+        "gain": (1.0, _NUM, "pos", "sensor gain"),
+    },
+    "output": {
+        "duration_s": (1.0, _NUM, "pos", "recorded duration"),
+        "sample_rate_hz": (20000.0, _NUM, "pos", "output rate (as the DAQ: anti-alias filtered)"),
+        "settle_s": (0.02, _NUM, "nonneg", "simulated and discarded before the record starts"),
+        "oversample": (8, int, "pos", "internal fine grid = oversample x sample_rate before the anti-alias FIR"),
+        "ball_loads": (True, bool, None, "store per-ball contact loads"),
+    },
+    "solver": {
+        "method": ("dp54", str, ("dp54", "bs32", "rk4"), "dp54/bs32: adaptive embedded RK; rk4: fixed step"),
+        "rtol": (1e-5, _NUM, "pos", "relative tolerance of the adaptive methods"),
+        "step_s": (2e-6, _NUM, "pos", "fixed step (rk4)"),
+        "max_step_s": (2.5e-5, _NUM, "pos", "largest step of the adaptive methods"),
+        "defect_steps": (40, int, "pos", "at least this many steps while a ball crosses a defect"),
+    },
+}
+DEFECT_KEYS = {"race", "shape", "length_mm", "width_mm", "depth_mm", "offset_mm", "skew_deg",
+               "angle_deg", "vertices_mm", "contact_model"}
+
+
+def _check(value, key, spec, where):
+    default, typ, check, _ = spec
+    value = _convert(value, key, where)
+    if typ is bool:
+        if not isinstance(value, bool):
+            raise SceneError(f"{where}: {value!r} must be true or false")
+        return value
+    if typ is int and isinstance(value, float) and value.is_integer():
+        value = int(value)
+    if typ in (_NUM, int):
+        if isinstance(value, bool) or not isinstance(value, typ if typ is int else _NUM):
+            raise SceneError(f"{where}: {value!r} must be a number"
+                             + (" (an integer)" if typ is int else "")
+                             + (f" in the key's unit ({key.rsplit('_', 1)[-1]})" if _suffix(key) else ""))
+        value = float(value) if typ is _NUM else int(value)
+        if not math.isfinite(value):
+            raise SceneError(f"{where}: {value!r} must be finite")
+        if check == "pos" and not value > 0:
+            raise SceneError(f"{where}: {value!r} must be positive")
+        if check == "nonneg" and value < 0:
+            raise SceneError(f"{where}: {value!r} must not be negative")
+        if check == "frac" and not 0 <= value < 0.5:
+            raise SceneError(f"{where}: {value!r} must lie in [0, 0.5)")
+        return value
+    if typ is str:
+        if not isinstance(value, str):
+            raise SceneError(f"{where}: {value!r} must be a string")
+        if isinstance(check, tuple) and value not in check:
+            raise SceneError(f"{where}: invalid value {value!r}; allowed values are "
+                             + ", ".join(repr(c) for c in check))
+        return value
+    if typ is list:
+        if not isinstance(value, list):
+            raise SceneError(f"{where}: {value!r} must be a list")
+        return value
+    return value
+
+
+def _validate_mapping(raw: dict) -> dict:
+    """Return a complete nested dict (defaults filled in) or raise SceneError."""
+    if not isinstance(raw, dict):
+        raise SceneError(f"a scene must be a table of keys, got {type(raw).__name__}")
+    out = {}
+    for sec, keys in SCHEMA.items():
+        if sec == "":
+            continue
+        out[sec] = {k: spec[0] for k, spec in keys.items()}
+    for k, spec in SCHEMA[""].items():
+        out[k] = spec[0]
+    defects = []
+    for key, value in raw.items():
+        if key in ("defect", "defects"):
+            items = value if isinstance(value, list) else [value]
+            for i, d in enumerate(items):
+                if not isinstance(d, dict):
+                    raise SceneError(f"{key}[{i}]: must be a table of defect keys")
+                bad = set(d) - DEFECT_KEYS
+                if bad:
+                    raise SceneError(f"unknown key {key}.{sorted(bad)[0]!s}; defect keys are "
+                                     + ", ".join(sorted(DEFECT_KEYS)))
+                defects.append(dict(d))
+            continue
+        if key in SCHEMA[""]:
+            out[key] = _check(value, key, SCHEMA[""][key], key)
+            continue
+        if key not in SCHEMA:
+            raise SceneError(f"unknown key {key!r}; top-level keys are "
+                             + ", ".join(sorted([*SCHEMA[""], *[s for s in SCHEMA if s], "defect"])))
+        if not isinstance(value, dict):
+            raise SceneError(f"{key}: must be a table, got {value!r}")
+        for sub, v in value.items():
+            where = f"{key}.{sub}"
+            if sub not in SCHEMA[key]:
+                raise SceneError(f"unknown key {where!r}; [{key}] keys are " + ", ".join(SCHEMA[key]))
+            out[key][sub] = _check(v, sub, SCHEMA[key][sub], where)
+    out["defect"] = defects
+    return out
+
+
+# ---------------------------------------------------------------- the Scene
+@dataclass(frozen=True)
+class Scene:
+    """A validated scene.  ``data`` holds the user-unit mapping (what TOML shows);
+    the properties give SI values."""
+
+    data: dict
+    bearing: BearingGeometry
+    defects: tuple = field(default_factory=tuple)
+
+    # ---- construction
+    @classmethod
+    def from_mapping(cls, raw: dict) -> "Scene":
+        d = _validate_mapping(copy.deepcopy(raw))
+        bearing = _bearing_from(d)
+        from .defects import Defect  # the 2-D defect description
+        defects = []
+        for i, m in enumerate(d["defect"]):
+            where = "defect" if len(d["defect"]) == 1 else f"defect[{i}]"
+            m = dict(m)
+            m.pop("contact_model", None)
+            defect = Defect.from_mapping(m, where=where)
+            defect.validate(bearing)
+            defects.append(defect)
+        scene = cls(d, bearing, tuple(defects))
+        scene._check_physics()
+        return scene
+
+    def replace(self, **overrides) -> "Scene":
+        """Return a new scene with ``--set``-style overrides (``{"load.radial_n": 480}``)."""
+        raw = copy.deepcopy(self.data)
+        for key, value in overrides.items():
+            _apply_override(raw, key, value)
+        return Scene.from_mapping(raw)
+
+    # ---- physics checks that need several keys
+    def _check_physics(self):
+        d = self.data
+        prof = d["speed"]["profile"]
+        if prof is not None:
+            try:
+                arr = np.asarray(prof, dtype=float)
+            except (TypeError, ValueError):
+                raise SceneError("speed.profile: must be a list of [t_s, rpm] pairs") from None
+            if arr.ndim != 2 or arr.shape[1] != 2 or arr.shape[0] < 1:
+                raise SceneError("speed.profile: must be a list of [t_s, rpm] pairs")
+            if np.any(np.diff(arr[:, 0]) <= 0):
+                raise SceneError("speed.profile: times must increase strictly")
+            if np.any(arr[:, 1] < 0) or not np.all(np.isfinite(arr)):
+                raise SceneError("speed.profile: speeds must be finite and not negative")
+        pd = self.clearance
+        b = self.bearing
+        if pd < -0.05 * b.ball_diameter * 1e-1:
+            raise SceneError(f"clearance.radial_um={pd*1e6:g}: a preload this large "
+                             f"(> {0.005*b.ball_diameter*1e6:.0f} µm) crushes the balls")
+        if pd > 0.02 * b.ball_diameter:
+            raise SceneError(f"clearance.radial_um={pd*1e6:g} is larger than 2 % of the ball diameter: "
+                             "not a bearing")
+        if self.fs_out < 1000:
+            raise SceneError(f"output.sample_rate_hz={self.fs_out:g} is below 1 kHz: too coarse for bearing vibration")
+        if d["output"]["duration_s"] > 600:
+            raise SceneError(f"output.duration_s={d['output']['duration_s']:g} s exceeds 600 s; split the run")
+
+    # ---- SI accessors
+    @property
+    def name(self) -> str:
+        return self.data["name"]
+
+    @property
+    def fidelity(self) -> str:
+        return self.data["fidelity"]
+
+    @property
+    def clearance(self) -> float:
+        return self.data["clearance"]["radial_um"] * 1e-6
+
+    @property
+    def fs_out(self) -> float:
+        return self.data["output"]["sample_rate_hz"]
+
+    @property
+    def duration(self) -> float:
+        return self.data["output"]["duration_s"]
+
+    @property
+    def settle(self) -> float:
+        return self.data["output"]["settle_s"]
+
+    def speed_profile(self):
+        """(t, rpm) arrays of the piecewise-linear speed, t from the start of settling."""
+        prof = self.data["speed"]["profile"]
+        if prof is None:
+            return np.array([0.0]), np.array([self.data["speed"]["rpm"]], dtype=float)
+        arr = np.asarray(prof, dtype=float)
+        return arr[:, 0] + self.settle, arr[:, 1]
+
+    @property
+    def nominal_rpm(self) -> float:
+        t, rpm = self.speed_profile()
+        return float(rpm[-1]) if len(rpm) == 1 else float(np.max(rpm))
+
+    def masses(self) -> tuple[float, float, float]:
+        """(inner ring, outer ring, ball) masses, kg."""
+        b = self.bearing
+        rho = self.data["material"]["density_kg_m3"]
+        m = self.data["mass"]
+        ball = m["ball_kg"] or rho * math.pi / 6 * b.ball_diameter ** 3
+        width = b.width or 0.4 * b.ball_diameter / 0.4 * 1.5
+        bore = b.bore or (b.pitch_diameter - 2.2 * b.ball_diameter)
+        od = b.outer_diameter or (b.pitch_diameter + 2.2 * b.ball_diameter)
+        # shoulders at 60 % of the ball radius beyond the raceway bottoms (typical 6xxx)
+        shoulder_i = b.pitch_diameter - 0.6 * b.ball_diameter
+        shoulder_o = b.pitch_diameter + 0.6 * b.ball_diameter
+        inner = m["inner_ring_kg"] or rho * math.pi / 4 * (shoulder_i ** 2 - bore ** 2) * width
+        outer = m["outer_ring_kg"] or rho * math.pi / 4 * (od ** 2 - shoulder_o ** 2) * width
+        return float(inner), float(outer), float(ball)
+
+    def to_toml(self) -> str:
+        return dumps_toml(self.data)
+
+
+def _bearing_from(d: dict) -> BearingGeometry:
+    name = d["bearing"]
+    if name in CATALOG:
+        base = get_bearing(name)
+    elif d["bearing_geometry"]["n_balls"] is not None:
+        base = None
+    else:
+        raise SceneError(f"bearing: unknown bearing {name!r}; the catalog has "
+                         + ", ".join(sorted(CATALOG)) + " (or give [bearing_geometry] n_balls, "
+                         "ball_diameter_mm, pitch_diameter_mm, ...)")
+    g = d["bearing_geometry"]
+    mm = 1e-3
+    kw = {}
+    for key, attr, scale in (("n_balls", "n_balls", 1), ("ball_diameter_mm", "ball_diameter", mm),
+                             ("pitch_diameter_mm", "pitch_diameter", mm), ("bore_mm", "bore", mm),
+                             ("outer_diameter_mm", "outer_diameter", mm), ("width_mm", "width", mm),
+                             ("inner_conformity", "inner_conformity", 1),
+                             ("outer_conformity", "outer_conformity", 1)):
+        if g[key] is not None:
+            kw[attr] = g[key] * scale
+    try:
+        if base is None:
+            missing = [k for k in ("ball_diameter", "pitch_diameter") if k not in kw]
+            if missing:
+                raise SceneError("bearing_geometry: a user-defined bearing needs "
+                                 + " and ".join(m + "_mm" for m in missing))
+            return BearingGeometry(name, **kw)
+        return base.with_(**kw) if kw else base
+    except SceneError as exc:
+        raise SceneError(f"bearing_geometry: {exc}") from None
+
+
+# ---------------------------------------------------------------- overrides
+_ALIASES = {"speed_rpm": "speed.rpm", "rpm": "speed.rpm", "duration": "output.duration_s",
+            "fs": "output.sample_rate_hz"}
+
+
+def _parse_value(text):
+    if not isinstance(text, str):
+        return text
+    low = text.strip().lower()
+    if low in ("true", "false"):
+        return low == "true"
+    try:
+        return int(text)
+    except ValueError:
+        pass
+    try:
+        return float(text)
+    except ValueError:
+        return text.strip()
+
+
+def _apply_override(raw: dict, key: str, value):
+    key = _ALIASES.get(key, key)
+    value = _parse_value(value)
+    parts = key.split(".")
+    if parts[0] in ("defect", "defects"):
+        if len(parts) != 2:
+            raise SceneError(f"--set {key}: use defect.<key>, e.g. defect.length_mm=1")
+        items = raw.get("defect") or raw.get("defects") or []
+        if isinstance(items, dict):
+            items = [items]
+        if not items:
+            items = [{"race": "outer", "shape": "rectangle"}]
+        raw.pop("defects", None)
+        items[0][parts[1]] = value
+        raw["defect"] = items
+        return
+    if len(parts) == 1:
+        raw[parts[0]] = value
+    elif len(parts) == 2:
+        sec = raw.setdefault(parts[0], {})
+        if not isinstance(sec, dict):
+            raise SceneError(f"--set {key}: {parts[0]!r} is not a table")
+        sec[parts[1]] = value
+    else:
+        raise SceneError(f"--set {key}: keys have at most one dot (section.key)")
+
+
+def parse_set(items) -> dict:
+    """Turn ``["load.radial_n=480", ...]`` into a dict, refusing malformed items."""
+    out = {}
+    for item in items or []:
+        if "=" not in item:
+            raise SceneError(f"--set {item!r}: expected KEY=VALUE")
+        k, v = item.split("=", 1)
+        out[k.strip()] = v
+    return out
+
+
+# ---------------------------------------------------------------- TOML
+def _toml_value(v):
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, (int, np.integer)):
+        return str(int(v))
+    if isinstance(v, (float, np.floating)):
+        return repr(float(v))
+    if isinstance(v, str):
+        return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    if isinstance(v, (list, tuple)):
+        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
+    raise TypeError(f"cannot write {v!r} to TOML")
+
+
+def dumps_toml(d: dict) -> str:
+    """Write a scene mapping as TOML (None values are omitted)."""
+    lines = []
+    for k, v in d.items():
+        if not isinstance(v, (dict, list)) or (isinstance(v, list) and k != "defect"):
+            if v is not None:
+                lines.append(f"{k} = {_toml_value(v)}")
+    for k, v in d.items():
+        if isinstance(v, dict):
+            body = [f"{kk} = {_toml_value(vv)}" for kk, vv in v.items() if vv is not None]
+            if body:
+                lines += ["", f"[{k}]", *body]
+    for item in d.get("defect", []) or []:
+        lines += ["", "[[defect]]", *[f"{kk} = {_toml_value(vv)}" for kk, vv in item.items()]]
+    return "\n".join(lines) + "\n"
+
+
+# ---------------------------------------------------------------- loading
+_SCENE_DIR = Path(__file__).with_name("scenes")
+
+
+def list_scenes() -> dict[str, str]:
+    """Built-in scene names with their one-line descriptions."""
+    out = {}
+    for p in sorted(_SCENE_DIR.glob("*.toml")):
+        with open(p, "rb") as fh:
+            out[p.stem] = tomllib.load(fh).get("description", "")
+    return out
+
+
+def load_scene(scene, **overrides) -> Scene:
+    """Return a :class:`Scene` from a built-in name, a TOML path, a dict or a Scene.
+
+    ``overrides`` use the ``--set`` keys (``speed_rpm``, ``load.radial_n``,
+    ``defect.offset_mm``, ``fidelity`` ...).
+    """
+    if isinstance(scene, Scene):
+        return scene.replace(**overrides) if overrides else scene
+    if isinstance(scene, dict):
+        raw = copy.deepcopy(scene)
+    else:
+        name = str(scene)
+        path = Path(name)
+        if path.suffix == ".toml" or path.exists():
+            if not path.is_file():
+                raise SceneError(f"scene file {name!r} does not exist")
+            try:
+                with open(path, "rb") as fh:
+                    raw = tomllib.load(fh)
+            except tomllib.TOMLDecodeError as exc:
+                raise SceneError(f"scene file {name!r} is not valid TOML: {exc}") from None
+        elif (_SCENE_DIR / f"{name}.toml").is_file():
+            with open(_SCENE_DIR / f"{name}.toml", "rb") as fh:
+                raw = tomllib.load(fh)
+        else:
+            raise SceneError(f"unknown scene {name!r}: not a file, and the built-in scenes are "
+                             + ", ".join(list_scenes()))
+    for key, value in overrides.items():
+        _apply_override(raw, key, value)
+    return Scene.from_mapping(raw)
