@@ -1,0 +1,132 @@
+"""Defect description and exact rigid-drop geometry (bearing_lab.sim.defects)."""
+import math
+
+import numpy as np
+import pytest
+
+from bearing_lab.bearings import get_bearing
+from bearing_lab.errors import SceneError
+from bearing_lab.sim.defects import Defect, RaceGeometry, rigid_drop
+from bearing_lab.sim.defects.geometry import drop_profile_1d, drop_profile_2d
+
+B6308 = get_bearing("6308")
+
+
+# reference.md, "How far a rigid ball can move into an outer-race defect": 6308, r_o = 0.53 D_b,
+# rectangle removed to 0.5 mm depth, ball centred over the defect.  (L, B, H/B, theta_deg, µm)
+REFERENCE_DROPS = [
+    (1, 1, 0, 0, 0.9413),
+    (1, 1, 1 / 3, 0, 0.1043),
+    (1, 1, 1 / 2, 0, 0.0),
+    (3, 1, 0, 0, 0.9413),
+    (6, 1, 0, 0, 0.9413),
+    (3, 1, 0, 30, 1.2275),
+    (3, 1, 0, 60, 3.1287),
+    (1, 23, 0, 0, 13.473),
+]
+
+
+@pytest.mark.parametrize("L,B,h_frac,theta,expected_um", REFERENCE_DROPS)
+def test_rigid_drop_matches_reference(L, B, h_frac, theta, expected_um):
+    d = Defect(race="outer", shape="rectangle", length=L * 1e-3, width=B * 1e-3, depth=0.5e-3,
+               offset=h_frac * B * 1e-3, skew=math.radians(theta))
+    got = rigid_drop(d, B6308) * 1e6
+    assert got == pytest.approx(expected_um, rel=0.01, abs=0.01)
+
+
+def test_rigid_drop_closed_form_bounds():
+    """Along the track (L^2/8)(1/r_b - 1/R_o); across (B^2/8)(1/r_b - 1/r_o) (reference.md)."""
+    g = RaceGeometry.from_bearing(B6308, "outer")
+    slot = Defect(length=1e-3, width=23e-3)
+    assert rigid_drop(slot, B6308) == pytest.approx(1e-6 / 8 / g.rx, rel=0.005)
+    narrow = Defect(length=20e-3, width=1e-3)
+    assert rigid_drop(narrow, B6308) == pytest.approx(1e-6 / 8 / g.ry, rel=0.005)
+    # inner race: convex along the track, 1/R_x = 1/r_b + 1/R_i
+    gi = RaceGeometry.from_bearing(B6308, "inner")
+    slot_i = Defect(race="inner", length=1e-3, width=23e-3)
+    assert rigid_drop(slot_i, B6308) == pytest.approx(1e-6 / 8 / gi.rx, rel=0.005)
+
+
+def test_drop_capped_by_depth_and_clearance_shifts_nothing():
+    shallow = Defect(length=1e-3, width=23e-3, depth=5e-6)
+    assert rigid_drop(shallow, B6308) == pytest.approx(5e-6)
+    d = Defect(length=1e-3, width=1e-3)
+    assert rigid_drop(d, B6308, clearance=20e-6) == pytest.approx(rigid_drop(d, B6308), rel=1e-3)
+
+
+def test_race_geometry_intact_gap():
+    for race in ("outer", "inner"):
+        g = RaceGeometry.from_bearing(B6308, race, clearance=10e-6)
+        assert float(g.approach(0.0, 0.0)) == pytest.approx(0.0, abs=1e-15)
+        s, z = 0.05e-3, 0.2e-3
+        h = float(g.approach(s / g.track_radius, z))
+        assert h == pytest.approx(s * s / (2 * g.rx) + z * z / (2 * g.ry), rel=1e-3)
+        assert float(g.approach(0.0, 0.0, depth=1e-4)) == pytest.approx(1e-4, rel=1e-9)
+
+
+def test_drop_profiles_symmetric_and_zero_off_defect():
+    g = RaceGeometry.from_bearing(B6308, "outer")
+    d = Defect(length=3e-3, width=1e-3, skew=math.radians(30))
+    psi = np.linspace(-3e-3, 3e-3, 41) / g.track_radius
+    h = drop_profile_2d(d, g, psi)
+    np.testing.assert_allclose(h, h[::-1], atol=1e-12)
+    assert h[0] == 0 and h[-1] == 0
+    h1 = drop_profile_1d(d, g, psi)
+    assert np.all(h1 >= h - 1e-12)  # the 1-D reduction ignores the flanks
+
+
+def test_from_mapping_units_and_defaults():
+    d = Defect.from_mapping({"length_mm": 3, "width_mm": 1, "offset_mm": 0.2, "skew_deg": 30,
+                             "angle_deg": 90})
+    assert d.race == "outer" and d.shape == "rectangle"
+    assert d.length == pytest.approx(3e-3) and d.width == pytest.approx(1e-3)
+    assert d.depth == pytest.approx(0.5e-3) and d.offset == pytest.approx(0.2e-3)
+    assert d.skew == pytest.approx(math.pi / 6) and d.angle == pytest.approx(math.pi / 2)
+    c = Defect.from_mapping({"shape": "ellipse", "diameter_mm": 0.1778, "depth_mm": 0.2794})
+    assert c.length == c.width == pytest.approx(0.1778e-3)
+    p = Defect.from_mapping({"shape": "polygon", "vertices_mm": [[-1, -0.5], [1, -0.5], [0, 0.5]]})
+    assert p.length == pytest.approx(2e-3) and p.width == pytest.approx(1e-3)
+    assert p.contains(0.0, 0.0) and not p.contains(0.9e-3, 0.4e-3)
+
+
+@pytest.mark.parametrize("mapping,key", [
+    ({"length_mm": -1, "width_mm": 1}, "defect.length_mm"),
+    ({"length_mm": 1, "width_mm": float("nan")}, "defect.width_mm"),
+    ({"length_mm": 1, "width_mm": 1, "depth_mm": 0}, "defect.depth_mm"),
+    ({"length_mm": 1, "width_mm": 1, "skew_deg": float("inf")}, "defect.skew_deg"),
+    ({"length_mm": 1, "width_mm": 1, "colour": "red"}, "colour"),
+    ({"length_mm": 1}, "defect.width_mm"),
+    ({"length_mm": 1, "width_mm": 1, "race": "cage"}, "defect.race"),
+    ({"shape": "polygon"}, "defect.vertices_mm"),
+    ({"shape": "polygon", "vertices_mm": [[0, 0], [1, 1], [1, 0], [0, 1]]}, "defect.vertices"),
+])
+def test_from_mapping_refuses(mapping, key):
+    with pytest.raises(SceneError, match=key.replace(".", r"\.")):
+        Defect.from_mapping(mapping)
+
+
+def test_from_mapping_where_prefix():
+    with pytest.raises(SceneError, match=r"defects\[1\]\.length_mm"):
+        Defect.from_mapping({"length_mm": -1, "width_mm": 1}, where="defects[1]")
+
+
+def test_validate_against_bearing():
+    Defect(length=1e-3, width=23e-3).validate(B6308)           # the paper's slot fits exactly
+    with pytest.raises(SceneError, match="leaves the ring"):
+        Defect(length=4e-3, width=23e-3, skew=math.radians(10)).validate(B6308)
+    with pytest.raises(SceneError, match="leaves the ring"):
+        Defect(length=1e-3, width=1e-3, offset=11.2e-3).validate(B6308)
+    with pytest.raises(SceneError, match="depth_mm"):
+        Defect(length=1e-3, width=1e-3, depth=5e-3).validate(B6308)   # section 4.96 mm
+    with pytest.raises(SceneError, match="depth_mm"):
+        Defect(race="inner", length=1e-3, width=1e-3, depth=5e-3).validate(B6308)
+    Defect(length=1e-3, width=1e-3, depth=4.9e-3).validate(B6308)
+
+
+def test_misses_track():
+    far = Defect(length=1e-3, width=1e-3, offset=4e-3)
+    near = Defect(length=1e-3, width=1e-3, offset=1.5e-3)
+    assert far.misses_track(B6308, 20e-6)
+    assert not near.misses_track(B6308, 20e-6)       # reach across at 20 µm is ~2.3 mm
+    assert near.misses_track(B6308, 2e-6)
+    assert rigid_drop(far, B6308) == 0.0
