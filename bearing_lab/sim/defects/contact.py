@@ -116,6 +116,8 @@ class ContactTable:
         psi = np.asarray(psi, dtype=float)
         delta = np.asarray(delta, dtype=float)
         psi, delta = np.broadcast_arrays(psi, delta)
+        shape = psi.shape
+        psi, delta = psi.ravel(), delta.ravel()
         out = np.maximum(delta, 0.0) ** 1.5
         n_psi, n_d = self.G.shape
         dpsi = (self.psi_max - self.psi_min) / (n_psi - 1)
@@ -135,9 +137,8 @@ class ContactTable:
             above = dl > self.delta[-1]
             if np.any(above):
                 g = g + np.where(above, 1.5 * math.sqrt(self.delta[-1]) * (dl - self.delta[-1]), 0.0)
-            out = out.copy()
             out[inside] = g
-        return out
+        return out.reshape(shape)
 
     def kernel_arrays(self):
         """(psi_min, dpsi, ddelta, G) with G C-contiguous float64, for a jitted lookup."""
