@@ -1,0 +1,241 @@
+"""Registry of the public recordings used by tests and validation.
+
+Why: recordings are never committed (their publishers' terms, and their size);
+the project keeps only their names, sha256, publisher addresses and test
+conditions in ``data/recordings.csv`` (one row per file, path relative to a
+mirror root such as ``../shared/data``).  A file is brought in from a local
+mirror (``--mirror DIR`` or ``BEARING_LAB_MIRROR``) with a hash check, or
+downloaded with pooch where a network allows.  The CWRU reader asks this module
+for a record's sampling rate, because CWRU files do not store it (record 97 is
+48 kHz, the 12k drive-end set 12 kHz).
+
+Public API
+----------
+load_registry()                     -- {name: Recording} from data/recordings.csv
+get(name)                           -- one Recording (name, or a unique suffix such as "130_OR007@6_0.mat")
+cwru_record(number)                 -- the Recording of a CWRU record number, or None
+cwru_sampling_rate(number)          -- its rate in Hz, or None if unknown
+fetch(name, mirror=None, dest=None) -- Path of a hash-checked local copy
+locate(name, mirror=None)           -- Path in a mirror or the cache, without copying, or None
+pooch_registry()                    -- {name: "sha256:..."} for pooch.create
+data_dir()                          -- where fetch puts files by default
+"""
+from __future__ import annotations
+
+import csv
+import functools
+import hashlib
+import os
+import shutil
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from .errors import RecordingError
+
+REGISTRY_FILE = Path(__file__).resolve().parents[1] / "data" / "recordings.csv"
+
+
+@dataclass(frozen=True)
+class Recording:
+    """One registered public recording (a row of data/recordings.csv)."""
+
+    name: str
+    sha256: str
+    url: str
+    page: str
+    publisher: str
+    dataset: str
+    record: int | None
+    fs_hz: float | None
+    rpm: float | None
+    load_hp: float | None
+    defect: str
+    defect_size_in: float | None
+    defect_position: str
+    bearing: str
+    channels: tuple[str, ...] = field(default_factory=tuple)
+    note: str = ""
+
+
+def _num(text, kind=float):
+    text = (text or "").strip()
+    return kind(text) if text else None
+
+
+@functools.lru_cache(maxsize=4)
+def _load(path: str) -> dict:
+    out = {}
+    with open(path, newline="", encoding="utf-8") as fh:
+        for row in csv.DictReader(fh):
+            rec = Recording(
+                name=row["name"], sha256=row["sha256"].strip().lower(), url=row["url"].strip(),
+                page=row.get("page", ""), publisher=row["publisher"], dataset=row["dataset"],
+                record=_num(row["record"], int), fs_hz=_num(row["fs_hz"]), rpm=_num(row["rpm"]),
+                load_hp=_num(row["load_hp"]), defect=row["defect"],
+                defect_size_in=_num(row["defect_size_in"]), defect_position=row["defect_position"],
+                bearing=row["bearing"], channels=tuple(row["channels"].split()), note=row["note"])
+            out[rec.name] = rec
+    return out
+
+
+def load_registry(path=None) -> dict[str, Recording]:
+    """Return ``{name: Recording}`` from ``data/recordings.csv`` (or ``path``).
+
+    Raises
+    ------
+    RecordingError
+        If the registry file is missing (a non-editable install without ``data/``).
+    """
+    p = Path(path) if path else REGISTRY_FILE
+    if not p.is_file():
+        msg = (f"data registry {p} not found; bearing_lab reads it from the project's data/ "
+               "directory: install the project in editable mode (make install)")
+        raise RecordingError(msg)
+    return dict(_load(str(p)))
+
+
+def get(name: str) -> Recording:
+    """Return the registered recording ``name`` (full name or a unique file-name suffix)."""
+    reg = load_registry()
+    if name in reg:
+        return reg[name]
+    hits = [r for n, r in reg.items() if n.endswith("/" + name) or Path(n).name == name]
+    if len(hits) == 1:
+        return hits[0]
+    if len(hits) > 1:
+        raise RecordingError(f"recording name {name!r} is ambiguous: {', '.join(h.name for h in hits)}")
+    close = [n for n in reg if name.split("/")[-1].split("_")[0] in n][:5]
+    hint = f"; similar: {', '.join(close)}" if close else ""
+    raise RecordingError(f"no registered recording {name!r} (see `bearing-lab data list`){hint}")
+
+
+def cwru_record(number: int) -> Recording | None:
+    """Return the registered CWRU recording with this record number, or None."""
+    for r in load_registry().values():
+        if r.dataset.startswith("cwru") and r.record == int(number):
+            return r
+    return None
+
+
+def cwru_sampling_rate(number: int) -> float | None:
+    """Return the sampling rate (Hz) of CWRU record ``number``, or None if not registered."""
+    r = cwru_record(number)
+    return r.fs_hz if r else None
+
+
+def pooch_registry() -> dict[str, str | None]:
+    """Return ``{name: "sha256:<hex>" or None}`` for ``pooch.create(registry=...)``."""
+    return {n: (f"sha256:{r.sha256}" if r.sha256 else None) for n, r in load_registry().items()}
+
+
+def data_dir() -> Path:
+    """Return where fetched recordings go: ``BEARING_LAB_DATA``, else ``data/cache`` of the
+    project (git-ignored), else pooch's user cache."""
+    env = os.environ.get("BEARING_LAB_DATA")
+    if env:
+        return Path(env)
+    proj = REGISTRY_FILE.parent
+    if proj.is_dir() and os.access(proj, os.W_OK):
+        return proj / "cache"
+    import pooch
+    return Path(pooch.os_cache("bearing_lab"))
+
+
+def _sha256(path: Path) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for chunk in iter(lambda: fh.read(1 << 22), b""):
+            h.update(chunk)
+    return h.hexdigest()
+
+
+def _mirror_dir(mirror) -> Path | None:
+    m = mirror if mirror is not None else os.environ.get("BEARING_LAB_MIRROR")
+    return Path(m) if m else None
+
+
+def _check(rec: Recording, path: Path, where: str) -> None:
+    if not rec.sha256:
+        return
+    got = _sha256(path)
+    if got != rec.sha256:
+        msg = (f"{path}: sha256 {got} does not match the registry's {rec.sha256} for "
+               f"{rec.name!r} ({where}); the copy is corrupt or a different file: replace it")
+        raise RecordingError(msg)
+
+
+def locate(name: str, mirror=None) -> Path | None:
+    """Return the path of ``name`` in the mirror or the data directory (no copy), or None."""
+    rec = get(name)
+    m = _mirror_dir(mirror)
+    for root in ([m] if m else []) + [data_dir()]:
+        p = root / rec.name
+        if p.is_file():
+            return p
+    return None
+
+
+def fetch(name: str, mirror=None, dest=None, *, download: bool = True, verify: bool = True) -> Path:
+    """Bring a registered recording into ``dest`` (default :func:`data_dir`), hash-checked.
+
+    Parameters
+    ----------
+    name : str
+        Registry name (``cwru/130_OR007@6_0.mat``) or a unique file name (``130_OR007@6_0.mat``).
+    mirror : str or Path, optional
+        A local directory laid out like the registry (default: ``BEARING_LAB_MIRROR``).
+    dest : str or Path, optional
+        Target directory; the file goes to ``dest/<name>``.
+    download : bool
+        Try the publisher's URL (pooch) when no mirror holds the file.
+    verify : bool
+        Check the sha256 (files without a registered checksum are copied with a note
+        in the return value's log only).
+
+    Returns
+    -------
+    Path
+        The local, verified copy.
+
+    Raises
+    ------
+    RecordingError
+        Unknown name, checksum mismatch, or the file is neither in a mirror nor downloadable.
+    """
+    rec = get(name)
+    dest = Path(dest) if dest else data_dir()
+    target = dest / rec.name
+    if target.is_file():
+        try:
+            if verify:
+                _check(rec, target, "existing copy")
+            return target
+        except RecordingError:
+            target.unlink()
+    m = _mirror_dir(mirror)
+    if m is not None:
+        src = m / rec.name
+        if src.is_file():
+            if verify:
+                _check(rec, src, f"mirror {m}")
+            if src.resolve() == target.resolve():
+                return target
+            target.parent.mkdir(parents=True, exist_ok=True)
+            shutil.copyfile(src, target)
+            return target
+    if not download or not rec.url:
+        where = f"mirror {m}" if m else "no mirror (pass --mirror DIR or set BEARING_LAB_MIRROR)"
+        how = f"download it from {rec.page or rec.url}" if (rec.page or rec.url) else "get it"
+        msg = (f"recording {rec.name!r} is not in {where}"
+               + ("" if rec.url else " and has no direct download URL")
+               + f"; {how} and place it under <mirror>/{rec.name}")
+        raise RecordingError(msg)
+    import pooch
+    try:
+        got = pooch.retrieve(rec.url, known_hash=f"sha256:{rec.sha256}" if rec.sha256 else None,
+                             fname=Path(rec.name).name, path=target.parent, progressbar=False)
+    except Exception as exc:  # network down, 404, hash mismatch
+        msg = (f"recording {rec.name!r}: download from {rec.url} failed ({type(exc).__name__}: "
+               f"{exc}); without network, copy it from a mirror with --mirror DIR")
+        raise RecordingError(msg) from exc
+    return Path(got)

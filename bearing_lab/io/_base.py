@@ -1,0 +1,418 @@
+"""Reader base class, engine registry and the shared Dataset builder.
+
+Why: every format ends in the same Dataset contract (``schema.check_dataset(...,
+kind="recording")``), with the same checks (non-finite values, unknown units,
+voltage without sensitivity, clipping, flat lines) and the same provenance.  A
+format module only finds its channels in the file and hands them to
+:class:`RecordingBuilder`; the builder converts to SI, records warnings and
+assembles the Dataset.  So a new format is one module that ends with
+``ENGINES["name"] = NameReader``.
+
+Warnings convention: non-fatal findings (clipping, flat line, rate snapped,
+dropped sets, truncated data kept on request) are issued with
+:func:`warnings.warn` (category :class:`RecordingWarning`) *and* stored in the
+global attribute ``warnings`` as one string, the messages joined by ``"; "``
+(empty string when there are none).  :func:`get_warnings` splits it again.
+
+Channel naming rule (all readers):
+
+1. a channel is named after the file's own channel identity (UFF: response
+   entity name, else node+direction such as ``1+Z``; Testlab: the point name;
+   CSV: the column header), cleaned to letters, digits and ``_ + - .``;
+2. the public sets use fixed names: CWRU ``DE``, ``FE``, ``BA``; IMS ``b1`` ..
+   ``b4`` (8-channel set 1: ``b1x``, ``b1y`` ... ``b4y``); MFPT ``acc``;
+   WAV/unnamed columns ``ch1``, ``ch2`` ...;
+3. a name that repeats gets ``_2``, ``_3`` ... in file order (``1+Z``, ``1+Z_2``);
+4. the global attribute ``default_channel`` names the channel analysis should use
+   when none is given: the first acceleration channel in file order (CWRU ``DE``,
+   IMS ``b1``), else the first channel.
+"""
+from __future__ import annotations
+
+import hashlib
+import importlib
+import inspect
+import json
+import mmap
+import re
+import warnings
+from abc import ABC, abstractmethod
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import BearingLabError, RecordingError
+from .. import units as _units
+
+ENGINES: dict[str, type["RecordingReader"]] = {}
+"""Format name -> reader class, in sniffing order (registered by each format module)."""
+
+
+class RecordingWarning(UserWarning):
+    """A non-fatal problem found in a recording (also stored in ``ds.attrs['warnings']``)."""
+
+
+def get_warnings(ds) -> list[str]:
+    """Return the recording's warnings as a list (the attribute is ``"; "``-joined)."""
+    text = ds.attrs.get("warnings", "")
+    return [w for w in str(text).split("; ") if w]
+
+
+class RecordingReader(ABC):
+    """One file format.
+
+    Subclasses set :attr:`description`, :attr:`extensions` and :attr:`libraries`,
+    implement :meth:`guess_can_open` (from the content, not only the name) and
+    :meth:`open_dataset` with explicit keyword arguments, and register themselves
+    with ``ENGINES["name"] = TheReader`` on the module's last line.
+    """
+
+    name: str = ""
+    description: str = ""
+    extensions: tuple[str, ...] = ()
+    libraries: tuple[str, ...] = ("numpy",)
+    """Modules the reader needs; their versions go into the provenance."""
+
+    def available(self) -> str | None:
+        """Return None when the reader can run, else what to install."""
+        for lib in self.libraries:
+            try:
+                importlib.import_module(lib)
+            except ImportError:
+                return f"needs the optional package {lib!r}: pip install bearing_lab[formats]"
+        return None
+
+    @abstractmethod
+    def guess_can_open(self, path: Path, head: bytes) -> bool:
+        """Return True if ``path`` looks like this format (``head``: its first 8 KiB)."""
+
+    @abstractmethod
+    def open_dataset(self, path, **options):
+        """Read ``path`` into a recording Dataset (explicit keyword arguments in subclasses)."""
+
+    def option_names(self) -> list[str]:
+        sig = inspect.signature(self.open_dataset)
+        return [p.name for p in sig.parameters.values()
+                if p.kind in (p.KEYWORD_ONLY, p.POSITIONAL_OR_KEYWORD) and p.name != "path"]
+
+
+def library_versions(libraries) -> str:
+    """Return ``"numpy 2.1.0, pyuff 2.5.8"`` for the given module names."""
+    out = []
+    for lib in libraries:
+        try:
+            mod = importlib.import_module(lib)
+            out.append(f"{lib} {getattr(mod, '__version__', '?')}")
+        except ImportError:
+            out.append(f"{lib} missing")
+    return ", ".join(out)
+
+
+def file_sha256(path, data=None) -> str:
+    """Return the hex sha256 of a file (or of an already mapped buffer ``data``)."""
+    h = hashlib.sha256()
+    if data is not None:
+        mv = memoryview(data)
+        for i in range(0, len(mv), 1 << 24):
+            h.update(mv[i:i + (1 << 24)])
+        return h.hexdigest()
+    with open(path, "rb") as fh:
+        for chunk in iter(lambda: fh.read(1 << 22), b""):
+            h.update(chunk)
+    return h.hexdigest()
+
+
+def map_file(path):
+    """Return a read-only mmap of a non-empty file (the caller closes it)."""
+    with open(path, "rb") as fh:
+        return mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ)
+
+
+_NAME_BAD = re.compile(r"[^A-Za-z0-9_+\-.]+")
+
+
+def clean_name(name, fallback: str) -> str:
+    """Clean a channel name to letters, digits and ``_ + - .``; ``fallback`` if empty."""
+    s = _NAME_BAD.sub("_", str(name).strip()).strip("_")
+    if not s or s.upper() == "NONE":
+        return fallback
+    return s
+
+
+def _attr_value(v):
+    """Make an attribute value netCDF-safe (str, int, float or 1-D numeric array)."""
+    if isinstance(v, (bool, np.bool_)):
+        return int(v)
+    if isinstance(v, (int, float, str, np.integer, np.floating)):
+        return v
+    if isinstance(v, bytes):
+        return v.decode("utf-8", errors="replace")
+    if isinstance(v, np.ndarray) and v.ndim == 1 and v.dtype.kind in "if":
+        return v
+    if isinstance(v, (dict, list, tuple)):
+        return json.dumps(v, default=str)
+    return str(v)
+
+
+def _runs(mask):
+    """Return (starts, lengths) of runs of True in a boolean array."""
+    if not mask.any():
+        return np.empty(0, int), np.empty(0, int)
+    d = np.diff(np.concatenate(([0], mask.view(np.int8), [0])))
+    starts = np.flatnonzero(d == 1)
+    ends = np.flatnonzero(d == -1)
+    return starts, ends - starts
+
+
+class RecordingBuilder:
+    """Collect channels of one file, convert them to SI and build the Dataset.
+
+    Parameters
+    ----------
+    path : path of the file (named in every message).
+    reader : the reader instance (its ``name`` and ``libraries`` go into the attrs).
+    units : None, a unit label for every channel, or a dict channel -> label that
+        overrides (or supplies) the file's unit labels.
+    sensitivity : None, ``"9.91mV/g"`` for every voltage channel, a dict
+        channel -> sensitivity, or False to keep voltage channels in V.
+    checksum : compute the file's sha256 (``source_sha256``); ``False`` stores "".
+    """
+
+    def __init__(self, path, reader, *, units=None, sensitivity=None, checksum=True,
+                 clip_volts=5.0):
+        self.path = Path(path)
+        self.reader = reader
+        self.units = units
+        self.sensitivity = sensitivity
+        self.checksum = checksum
+        self.clip_volts = clip_volts
+        self.warnings: list[str] = []
+        self.channels: dict[str, tuple[np.ndarray, dict]] = {}
+        self.attrs: dict = {}
+        self.sha256: str | None = None
+        self._used_units = set()
+
+    # -- messages -------------------------------------------------------------------
+    def fail(self, msg: str):
+        """Raise :class:`RecordingError` naming the file."""
+        raise RecordingError(f"{self.path}: {msg}")
+
+    def warn(self, msg: str):
+        """Record a non-fatal finding (attribute ``warnings`` and warnings.warn)."""
+        msg = str(msg).replace("; ", ", ")
+        self.warnings.append(msg)
+        warnings.warn(f"{self.path.name}: {msg}", RecordingWarning, stacklevel=4)
+
+    # -- channels -------------------------------------------------------------------
+    def unique_name(self, name: str) -> str:
+        if name not in self.channels and name != "time":
+            return name
+        k = 2
+        while f"{name}_{k}" in self.channels:
+            k += 1
+        return f"{name}_{k}"
+
+    def _per_channel(self, option, name, original):
+        if isinstance(option, dict):
+            if name in option:
+                self._used_units.add(name)
+                return option[name]
+            if original in option:
+                self._used_units.add(original)
+                return option[original]
+            return None
+        return option
+
+    def add_channel(self, name, values, label, *, already_si=False, quantity=None,
+                    attrs=None, file_name=None):
+        """Add one channel.
+
+        Parameters
+        ----------
+        name : cleaned channel name (made unique here).
+        values : 1-D numeric array as stored in the file.
+        label : the file's unit label for the channel (None or "" if it has none).
+        already_si : the stored values are already SI (Testlab MAT stores MKS and
+            labels the display unit): ``label`` is only recorded.
+        quantity : physical quantity when the file says it and the label does not.
+        attrs : extra variable attributes (file metadata).
+        file_name : the channel's name in the file, for ``units``/``sensitivity`` dicts.
+        """
+        name = self.unique_name(name)
+        original = file_name if file_name is not None else name
+        x = np.asarray(values)
+        if x.ndim != 1:
+            self.fail(f"channel {name!r} has shape {x.shape}; expected one dimension")
+        if x.dtype.kind not in "iuf":
+            self.fail(f"channel {name!r} holds {x.dtype} values, not numbers")
+        x = x.astype(np.float64, copy=False)
+        bad = ~np.isfinite(x)
+        if bad.any():
+            first = int(np.flatnonzero(bad)[0])
+            self.fail(f"channel {name!r} holds {int(bad.sum())} NaN/Inf values (first at sample "
+                      f"{first}); the file is corrupt or has gaps: repair or cut it")
+        override = self._per_channel(self.units, name, original)
+        raw_label = "" if label is None else str(label).strip()
+        use_label = override if override is not None else raw_label
+        try:
+            unit = _units.lookup_unit(use_label, what=f"channel {name!r}")
+        except RecordingError as exc:
+            self.fail(str(exc))
+        vattrs = {}
+        sens = self._per_channel(self.sensitivity, name, original)
+        if unit.quantity == "voltage" and not already_si:
+            volts = x * unit.factor if unit.factor != 1.0 else x
+            vmax = float(np.max(np.abs(volts))) if volts.size else 0.0
+            if self.clip_volts and vmax >= 0.99 * self.clip_volts:
+                self.warn(f"channel {name!r} reaches {vmax:.3g} V, at the ±{self.clip_volts:g} V "
+                          "swing of an IEPE input: probable clipping")
+            if sens is False or (isinstance(sens, str) and sens.lower() in ("none", "off", "v")):
+                si, si_unit, q = volts, "V", "voltage"
+            elif sens is None or sens is True:
+                self.fail(f"channel {name!r} is in {use_label or 'V'}; a voltage channel needs a "
+                          "sensor sensitivity: pass sensitivity='9.91mV/g' (CLI --sensitivity), "
+                          "or sensitivity=False to keep volts")
+            else:
+                try:
+                    s = _units.parse_sensitivity(sens)
+                except RecordingError as exc:
+                    self.fail(str(exc))
+                si, si_unit, q = s.to_si(volts), s.unit.si, s.unit.quantity
+                vattrs["sensitivity"] = s.text
+        else:
+            if sens not in (None, False, True) and not isinstance(self.sensitivity, dict) \
+                    and "sensitivity ignored" not in " ".join(self.warnings):
+                self.warn(f"sensitivity {sens!r} ignored: channel {name!r} is already in "
+                          f"{use_label} (not volts)")
+            elif isinstance(self.sensitivity, dict) and sens is not None:
+                self.warn(f"sensitivity {sens!r} ignored: channel {name!r} is in {use_label}")
+            if already_si or (unit.factor == 1.0 and unit.offset == 0.0):
+                si = x
+            else:
+                si = x * unit.factor + unit.offset
+            si_unit = unit.si
+            q = quantity or unit.quantity
+        self._flag_shape(name, si)
+        vattrs.update({"units": si_unit, "original_units": raw_label if override is None
+                       else str(override), "quantity": q})
+        if override is not None:
+            vattrs["file_units"] = raw_label or "none"
+        if file_name is not None and file_name != name:
+            vattrs["file_channel"] = str(file_name)
+        for k, v in (attrs or {}).items():
+            if v is not None and k not in vattrs:
+                vattrs[k] = _attr_value(v)
+        self.channels[name] = (si, vattrs)
+        return name
+
+    def _flag_shape(self, name, x):
+        n = x.size
+        if n < 2:
+            return
+        lo, hi = float(x.min()), float(x.max())
+        if lo == hi:
+            self.warn(f"channel {name!r} is a flat line (all {n} samples equal {lo:g})")
+            return
+        for ext, word in ((hi, "maximum"), (lo, "minimum")):
+            starts, lengths = _runs(x == ext)
+            long = lengths >= 3
+            if long.any():
+                self.warn(f"channel {name!r}: {int(lengths[long].sum())} samples in "
+                          f"{int(long.sum())} runs stuck at the {word} {ext:.6g}: probable clipping")
+        same = np.diff(x) == 0
+        starts, lengths = _runs(same)
+        if lengths.size:
+            longest = int(lengths.max()) + 1
+            if longest >= max(100, n // 100):
+                i = int(starts[int(np.argmax(lengths))])
+                self.warn(f"channel {name!r} is flat for {longest} samples from sample {i} "
+                          "(dropout or stuck sensor?)")
+
+    # -- dataset --------------------------------------------------------------------
+    def select(self, channels):
+        """Keep only ``channels`` (str or list), in that order; unknown names fail."""
+        if channels is None:
+            return
+        wanted = [channels] if isinstance(channels, str) else list(channels)
+        missing = [c for c in wanted if c not in self.channels]
+        if missing:
+            self.fail(f"no channel {missing[0]!r}; the file has {', '.join(self.channels)}")
+        self.channels = {c: self.channels[c] for c in wanted}
+
+    def build(self, *, fs, t0=0.0, time=None, shaft_speed_rpm=None, default_channel=None,
+              data=None, channels=None):
+        """Assemble and check the Dataset.
+
+        Parameters
+        ----------
+        fs : sampling rate, Hz.
+        t0 : time of the first sample, s (the time coordinate is ``t0 + k / fs``).
+        time : explicit time values (uneven time base), overrides ``fs``/``t0``.
+        shaft_speed_rpm : stored when known.
+        default_channel : overrides the rule "first acceleration channel".
+        data : an mmap/bytes of the whole file to hash (avoids reading it again).
+        channels : channel selection (see :meth:`select`).
+        """
+        import xarray as xr
+        from .. import __version__, schema
+
+        if isinstance(self.units, dict):
+            extra = set(self.units) - self._used_units
+            if extra:
+                self.fail(f"units= names channel(s) {sorted(extra)} that the file does not have; "
+                          f"it has {', '.join(self.channels)}")
+        self.select(channels)
+        if not self.channels:
+            self.fail("no channels found")
+        lengths = {n: v.size for n, (v, _) in self.channels.items()}
+        if len(set(lengths.values())) != 1:
+            self.fail(f"channels have different lengths {lengths}; read them separately with "
+                      "channels=[...]")
+        n = next(iter(lengths.values()))
+        if n < 2:
+            self.fail(f"only {n} sample(s): not a time history")
+        if time is None:
+            fs = float(fs)
+            if not (np.isfinite(fs) and fs > 0):
+                self.fail(f"sampling rate {fs!r} Hz is not positive; pass fs=<Hz>")
+            t = float(t0) + np.arange(n, dtype=np.float64) / fs
+        else:
+            t = np.asarray(time, dtype=np.float64)
+            if t.size != n:
+                self.fail(f"time column has {t.size} values for {n} samples")
+            dt = np.diff(t)
+            if not np.all(np.isfinite(t)) or not np.all(dt > 0):
+                k = int(np.flatnonzero(~(dt > 0))[0]) if not np.all(dt > 0) else 0
+                self.fail(f"time values are not strictly increasing (at sample {k + 1}); "
+                          "sort or repair the time column, or pass fs= and drop it")
+            fs = 1.0 / float(np.median(dt))
+        if self.sha256 is None:
+            self.sha256 = "" if not self.checksum else file_sha256(self.path, data)
+        q_acc = [k for k, (_, a) in self.channels.items() if a.get("quantity") == "acceleration"]
+        default = default_channel if default_channel in self.channels else \
+            (q_acc[0] if q_acc else next(iter(self.channels)))
+        attrs = {
+            "sampling_rate_hz": float(fs),
+            "bearing_lab_version": __version__,
+            "source_file": str(self.path.resolve()),
+            "source_sha256": self.sha256,
+            "reader": self.reader.name,
+            "reader_libraries": library_versions(self.reader.libraries),
+            "warnings": "; ".join(self.warnings),
+            "default_channel": default,
+            "start_time_s": float(t[0]),
+            "n_samples": int(n),
+        }
+        if shaft_speed_rpm is not None and np.isfinite(float(shaft_speed_rpm)):
+            attrs["shaft_speed_rpm"] = float(shaft_speed_rpm)
+        for k, v in self.attrs.items():
+            if v is not None and k not in attrs:
+                attrs[k] = _attr_value(v)
+        tvar = xr.Variable("time", t, {"units": "s", "long_name": "time", "standard_name": "time"})
+        data_vars = {k: xr.Variable("time", v, a) for k, (v, a) in self.channels.items()}
+        ds = xr.Dataset(data_vars, coords={"time": tvar}, attrs=attrs)
+        try:
+            schema.check_dataset(ds, kind="recording")
+        except BearingLabError as exc:  # pragma: no cover - a reader bug
+            self.fail(str(exc))
+        return ds

@@ -1,0 +1,124 @@
+"""MATLAB file access shared by the Testlab, CWRU and MFPT readers.
+
+Why: the three formats are all ``.mat`` files and are told apart only by their
+variable names, so sniffing lists variables (cheaply, cached) and reading turns
+both v5 (scipy.io) and v7.3 (HDF5, h5py) into the same plain Python structure:
+structs -> dict, char arrays -> str, numeric arrays -> squeezed ndarray.  Field
+order differs between files, so readers always look fields up by name.
+"""
+from __future__ import annotations
+
+import functools
+from pathlib import Path
+
+import numpy as np
+
+HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
+
+
+def mat_version(head: bytes) -> str | None:
+    """Return "5" (v5/v7, scipy), "7.3" (HDF5) or None from the first bytes."""
+    if not head.startswith(b"MATLAB"):
+        return None
+    if b"MATLAB 7.3" in head[:128] or head[512:520] == HDF5_SIGNATURE:
+        return "7.3"
+    return "5"
+
+
+@functools.lru_cache(maxsize=64)
+def _variables(path: str, mtime: float, size: int) -> tuple[str, ...]:
+    with open(path, "rb") as fh:
+        head = fh.read(1024)
+    v = mat_version(head)
+    if v == "7.3":
+        import h5py
+        with h5py.File(path, "r") as f:
+            return tuple(k for k in f.keys() if not k.startswith("#"))
+    if v == "5":
+        import scipy.io
+        return tuple(name for name, _, _ in scipy.io.whosmat(path))
+    return ()
+
+
+def mat_variables(path) -> tuple[str, ...]:
+    """Return the variable names of a MATLAB file (empty if it is not one)."""
+    p = Path(path)
+    st = p.stat()
+    return _variables(str(p), st.st_mtime, st.st_size)
+
+
+def _plain(obj):
+    """scipy.io.loadmat output (struct_as_record=False, squeeze_me=True) -> plain Python."""
+    from scipy.io.matlab import mat_struct
+    if isinstance(obj, mat_struct):
+        return {k: _plain(getattr(obj, k)) for k in obj._fieldnames}
+    if isinstance(obj, np.ndarray):
+        if obj.dtype.kind == "U":
+            if obj.size == 0:
+                return ""
+            if obj.ndim <= 1 and all(len(s) <= 1 for s in obj.ravel()):
+                return "".join(obj.ravel().tolist())
+            return [str(s) for s in obj.ravel()]
+        if obj.dtype == object:
+            return [_plain(o) for o in obj.ravel()]
+        return obj
+    if isinstance(obj, str):
+        return obj
+    return obj
+
+
+def _h5_plain(f, obj):
+    import h5py
+    if isinstance(obj, h5py.Group):
+        return {k: _h5_plain(f, obj[k]) for k in obj.keys() if not k.startswith("#")}
+    cls = obj.attrs.get("MATLAB_class", b"")
+    cls = cls.decode() if isinstance(cls, bytes) else str(cls)
+    if obj.attrs.get("MATLAB_empty", 0):
+        return "" if cls == "char" else np.empty(0)
+    data = obj[()]
+    if obj.dtype.kind == "O" or obj.dtype == h5py.ref_dtype:
+        return [_h5_plain(f, f[r]) for r in np.asarray(data).ravel()]
+    if cls == "char":
+        arr = np.asarray(data, dtype=np.uint16).T
+        if arr.ndim == 2 and arr.shape[0] > 1:
+            return ["".join(map(chr, row)).rstrip("\x00") for row in arr]
+        return "".join(map(chr, arr.ravel()))
+    arr = np.asarray(data)
+    if arr.ndim >= 2:
+        arr = arr.T
+    arr = np.squeeze(arr)
+    if cls == "logical":
+        arr = arr.astype(bool)
+    return arr
+
+
+def load_mat(path, variable_names=None) -> dict:
+    """Load a MATLAB file (v5 or v7.3) as plain Python objects.
+
+    Parameters
+    ----------
+    path : str or Path
+    variable_names : list of str, optional
+        Load only these variables.
+
+    Returns
+    -------
+    dict
+        Variable name -> value (structs as dicts, strings as str, arrays squeezed).
+    """
+    with open(path, "rb") as fh:
+        head = fh.read(1024)
+    v = mat_version(head)
+    if v == "7.3":
+        import h5py
+        out = {}
+        with h5py.File(path, "r") as f:
+            for k in f.keys():
+                if k.startswith("#") or (variable_names and k not in variable_names):
+                    continue
+                out[k] = _h5_plain(f, f[k])
+        return out
+    import scipy.io
+    m = scipy.io.loadmat(path, squeeze_me=True, struct_as_record=False,
+                         variable_names=variable_names)
+    return {k: _plain(v) for k, v in m.items() if not k.startswith("__")}

@@ -1,0 +1,140 @@
+"""Case Western Reserve University bearing data (``.mat`` with ``X###_DE_time`` ...).
+
+Why the registry: CWRU files store neither the sampling rate nor units.  The
+rate comes from ``data/recordings.csv`` through :mod:`bearing_lab.datasets`
+(record 97 is 48 kHz, the drive-end 12k set 12 kHz); an unregistered record is
+refused with a request for ``fs=``.  Values are in g (the Bearing Data Center's
+description), converted to m s-2.
+
+Channels are chosen by the variable-name pattern ``X<record>_<DE|FE|BA>_time``,
+never by the file's number alone: some files carry another record's variable
+names, and some hold two records (then the file name's number, or ``record=``,
+picks one).  Channel names: ``DE`` (drive end, the default channel), ``FE`` (fan
+end), ``BA`` (base).  The motor speed comes from ``X<record>RPM`` (else the
+registry).
+"""
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+
+from ._base import ENGINES, RecordingBuilder, RecordingReader
+from ._matlab import load_mat, mat_variables, mat_version
+
+_CHAN = re.compile(r"^X(\d+)_(DE|FE|BA)_time$")
+_RPM = re.compile(r"^X(\d+)RPM$")
+
+
+class CwruReader(RecordingReader):
+    """Read CWRU Bearing Data Center ``.mat`` files."""
+
+    name = "cwru"
+    description = "CWRU Bearing Data Center .mat (X###_DE_time, X###_FE_time, X###_BA_time, X###RPM)"
+    extensions = (".mat",)
+    libraries = ("scipy",)
+
+    def guess_can_open(self, path, head):
+        return mat_version(head) is not None and any(_CHAN.match(n) for n in mat_variables(path))
+
+    def open_dataset(self, path, *, channels=None, fs=None, record=None, units="g",
+                     checksum=True):
+        """Read the drive-end, fan-end and base channels of one CWRU record.
+
+        Parameters
+        ----------
+        path : str or Path
+        channels : str or list of str, optional
+            Subset of ``"DE"``, ``"FE"``, ``"BA"``.
+        fs : float, optional
+            Sampling rate, Hz (default: the registry's rate for the record).
+        record : int, optional
+            Which record's variables to read when the file holds several.
+        units : str
+            Unit of the stored values (the data centre's: ``"g"``).
+        checksum : bool
+            Compute ``source_sha256``.
+
+        Returns
+        -------
+        xarray.Dataset
+        """
+        from .. import datasets
+
+        path = Path(path)
+        b = RecordingBuilder(path, self, units=units, checksum=checksum)
+        if mat_version(open(path, "rb").read(1024)) is None:
+            b.fail("not a MATLAB file (no 'MATLAB' header)")
+        names = mat_variables(path)
+        found = {}
+        for n in names:
+            m = _CHAN.match(n)
+            if m:
+                found.setdefault(int(m.group(1)), {})[m.group(2)] = n
+        if not found:
+            b.fail(f"no CWRU channel variables X###_DE_time/_FE_time/_BA_time (variables: "
+                   f"{', '.join(names) or 'none'})")
+        mnum = re.match(r"^(\d+)", path.name)
+        file_no = int(mnum.group(1)) if mnum else None
+        if record is not None:
+            if int(record) not in found:
+                b.fail(f"record={record} has no variables in the file; it holds records "
+                       f"{', '.join(map(str, sorted(found)))}")
+            rec = int(record)
+        elif len(found) == 1:
+            rec = next(iter(found))
+        elif file_no in found:
+            rec = file_no
+        else:
+            b.fail(f"the file holds variables of records {', '.join(map(str, sorted(found)))}; "
+                   "pass record=<number> to pick one")
+        if "DE" not in found[rec]:
+            b.warn(f"record {rec} has no drive-end (DE) channel")
+        wanted = [v for k, v in found[rec].items()]
+        rpm_vars = [n for n in names if _RPM.match(n)]
+        rpm_var = f"X{rec:03d}RPM" if f"X{rec:03d}RPM" in names else (
+            f"X{rec}RPM" if f"X{rec}RPM" in names else (rpm_vars[0] if len(rpm_vars) == 1 else None))
+        m = load_mat(path, variable_names=wanted + ([rpm_var] if rpm_var else []))
+        # sampling rate: the file name's record first, then the variables' record
+        cands = [n for n in dict.fromkeys([file_no, rec]) if n is not None]
+        regs = {n: datasets.cwru_record(n) for n in cands}
+        rates = {r.fs_hz for r in regs.values() if r is not None and r.fs_hz}
+        reg = regs.get(file_no) or regs.get(rec)
+        if fs is None:
+            if len(rates) == 1:
+                fs = rates.pop()
+            elif not rates:
+                b.fail(f"CWRU record {rec} is not in the registry (data/recordings.csv), and CWRU "
+                       "files do not store their sampling rate; pass fs=12000 or fs=48000 (CLI "
+                       "--fs) as the data centre lists it")
+            else:
+                b.fail(f"records {cands} have different registered rates {sorted(rates)}; pass fs=")
+            b.attrs["sampling_rate_source"] = "registry data/recordings.csv"
+        else:
+            b.attrs["sampling_rate_source"] = "user"
+        order = [c for c in ("DE", "FE", "BA") if c in found[rec]]
+        for c in order:
+            v = np.asarray(m[found[rec][c]], dtype=np.float64).ravel()
+            b.add_channel(c, v, None, file_name=found[rec][c],
+                          attrs={"location": {"DE": "drive end", "FE": "fan end",
+                                              "BA": "base"}[c]})
+        rpm = None
+        if rpm_var and np.size(m.get(rpm_var, [])) >= 1:
+            rpm = float(np.ravel(m[rpm_var])[0])
+            b.attrs["shaft_speed_source"] = f"file variable {rpm_var}"
+        elif reg is not None and reg.rpm:
+            rpm = reg.rpm
+            b.attrs["shaft_speed_source"] = "registry data/recordings.csv"
+        b.attrs["cwru_record"] = rec
+        if file_no is not None and file_no != rec:
+            b.attrs["cwru_file_number"] = file_no
+        if reg is not None:
+            b.attrs.update({"cwru_defect": reg.defect, "cwru_load_hp": reg.load_hp,
+                            "cwru_defect_size_in": reg.defect_size_in,
+                            "cwru_defect_position": reg.defect_position or None,
+                            "bearing": reg.bearing, "registry_name": reg.name})
+        return b.build(fs=fs, shaft_speed_rpm=rpm, default_channel="DE", channels=channels)
+
+
+ENGINES["cwru"] = CwruReader

@@ -1,0 +1,548 @@
+"""Universal File Format dataset 58 (ASCII) and 58b (binary): Testlab/catman exports.
+
+Why our own parser instead of ``pyuff.UFF(...).read_sets()``: pyuff 2.5.8 drops a
+truncated last set silently, returns 42 values for a header that promises
+2 508 876, lets NaN tokens through, reports 0 from ``get_set_formats()`` for
+binary sets and reads the whole file twice (once to find the blocks, once to
+parse them) with a per-value ``struct.unpack``.  This module reads the fixed
+headers itself (the same field widths as pyuff), maps the file once, seeks past
+each binary payload while scanning (so a 1 GB 58b is scanned header by header)
+and converts each payload with one ``numpy.frombuffer``.  pyuff stays the
+reference: the tests compare our values with pyuff's on every real file, the
+export (:mod:`bearing_lab.io.export`) is read back by pyuff, and the benchmark
+measures both.
+
+Handled: point counts checked against the header (refused, or kept with a
+warning when ``allow_truncated=True``); truncated payloads; the rate snapped to
+a whole number of Hz when the printed increment (E13.5) rounded it (the file's
+value kept in ``file_sampling_rate_hz``); non-zero start time kept in the time
+coordinate; repeated node/direction made unique (``1+Z``, ``1+Z_2``); uneven
+abscissa kept as the time coordinate (refused when not increasing); dataset 164
+unit factors applied when a channel has no unit label; CR/LF or padding around a
+binary payload; both byte orders, 4- and 8-byte floats; D exponents.
+"""
+from __future__ import annotations
+
+import math
+import re
+from pathlib import Path
+
+import numpy as np
+
+from ._base import ENGINES, RecordingBuilder, RecordingReader, clean_name, map_file
+
+_DELIM = re.compile(rb"^[ \t]*-1[ \t]*\r?$", re.M)
+_DIRS = {1: "+X", 2: "+Y", 3: "+Z", -1: "-X", -2: "-Y", -3: "-Z", 4: "+RX", 5: "+RY", 6: "+RZ",
+         -4: "-RX", -5: "-RY", -6: "-RZ"}
+# UFF specific data type -> quantity (for channels whose label does not say)
+_SPEC_QUANTITY = {8: "displacement", 11: "velocity", 12: "acceleration", 15: "pressure",
+                  13: "force", 9: "force", 17: "time"}
+_SPEC_SI = {"displacement": ("m", 1, 0), "velocity": ("m/s", 1, 0), "acceleration": ("m/s2", 1, 0),
+            "pressure": ("Pa", -1, 1), "force": ("N", 0, 1)}
+
+
+def _dec(b: bytes) -> str:
+    try:
+        return b.decode("utf-8")
+    except UnicodeDecodeError:
+        return b.decode("latin-1")
+
+
+def _float(tok: str) -> float:
+    return float(tok.strip().replace("D", "E").replace("d", "e"))
+
+
+def _fields(line: bytes, widths):
+    s = _dec(line.rstrip(b"\r\n")).ljust(sum(widths))
+    out, i = [], 0
+    for w in widths:
+        out.append(s[i:i + w])
+        i += w
+    return out
+
+
+class _Set:
+    """One block of the file: type, byte range, header and (for 58) where the data are."""
+
+    def __init__(self, index, typ, binary, start):
+        self.index, self.type, self.binary, self.start = index, typ, binary, start
+        self.header = {}
+        self.data_start = self.data_end = None
+        self.truncated = False
+
+
+class Uff58Reader(RecordingReader):
+    """Read UFF dataset 58/58b time histories (one channel per set)."""
+
+    name = "uff58"
+    description = "Universal File Format dataset 58 / 58b time histories (.uff, .unv)"
+    extensions = (".uff", ".unv", ".uf", ".58")
+    libraries = ("numpy",)
+
+    def guess_can_open(self, path, head):
+        lines = head.lstrip(b"\xef\xbb\xbf").splitlines()
+        lines = [ln for ln in lines[:6] if ln.strip()]
+        return len(lines) >= 2 and lines[0].strip() == b"-1" and \
+            re.fullmatch(rb"\d+b?", lines[1].split()[0] if lines[1].split() else b"") is not None
+
+    def open_dataset(self, path, *, channels=None, units=None, sensitivity=None,
+                     allow_truncated=False, fs=None, snap_rate=True, checksum=True):
+        """Read the time-history sets of a UFF file into one recording Dataset.
+
+        Parameters
+        ----------
+        path : str or Path
+        channels : str or list of str, optional
+            Channel names to read (others are not converted); needed when sets
+            have different rates or lengths.
+        units : str or dict, optional
+            Unit label for every channel, or channel -> label, overriding the file's.
+        sensitivity : str, dict or False, optional
+            For voltage channels, e.g. ``"9.91mV/g"``.
+        allow_truncated : bool
+            Keep the values present when a header promises more (warning) instead
+            of refusing the file.
+        fs : float, optional
+            Sampling rate, Hz, replacing the header's increment.
+        snap_rate : bool
+            Snap a rate that the printed increment rounded (51200.13 -> 51200 Hz).
+        checksum : bool
+            Compute ``source_sha256``.
+
+        Returns
+        -------
+        xarray.Dataset
+        """
+        path = Path(path)
+        b = RecordingBuilder(path, self, units=units, sensitivity=sensitivity, checksum=checksum)
+        mm = map_file(path)
+        try:
+            return self._read(mm, b, channels, allow_truncated, fs, snap_rate)
+        finally:
+            mm.close()
+
+    # -- scanning -------------------------------------------------------------------
+    def _line(self, mm, pos):
+        if pos >= len(mm):
+            return None, pos
+        end = mm.find(b"\n", pos)
+        if end < 0:
+            return mm[pos:], len(mm)
+        return mm[pos:end + 1], end + 1
+
+    def _scan(self, mm, b, allow_truncated):
+        sets, pos, n = [], 0, len(mm)
+        if mm[:3] == b"\xef\xbb\xbf":
+            pos = 3
+        while True:
+            line, nxt = self._line(mm, pos)
+            if line is None:
+                break
+            if not line.strip():
+                pos = nxt
+                continue
+            if line.strip() != b"-1":
+                where = f"set {len(sets) + 1}" if sets else "the start"
+                b.fail(f"expected a '    -1' block delimiter at byte {pos} ({where}), got "
+                       f"{bytes(line[:40])!r}: not a Universal File, or a corrupt one")
+            start = pos
+            tline, pos = self._line(mm, nxt)
+            if tline is None or not tline.strip():
+                b.fail(f"file ends after a '-1' delimiter at byte {start}: truncated")
+            m = re.fullmatch(rb"\s*(\d+)(b?)(.*?)\s*", tline, re.S)
+            if not m:
+                b.fail(f"dataset type line at byte {nxt} is {bytes(tline[:40])!r}, not a number")
+            st = _Set(len(sets) + 1, int(m.group(1)), bool(m.group(2)), start)
+            if st.binary:
+                parts = m.group(3).split()
+                try:
+                    bo, fp, nasc, nbytes = (int(x) for x in parts[:4])
+                except ValueError:
+                    b.fail(f"set {st.index} (dataset {st.type}b): binary header line "
+                           f"{bytes(tline[:60])!r} is unreadable")
+                if bo not in (1, 2) or fp not in (1, 2) or not 0 < nasc < 1000 or nbytes < 0:
+                    b.fail(f"set {st.index}: binary header says byte order {bo}, float format "
+                           f"{fp}, {nasc} header lines, {nbytes} bytes; expected byte order 1 "
+                           "(little) or 2 (big) and IEEE floats")
+                hl = []
+                for _ in range(nasc):
+                    ln, pos = self._line(mm, pos)
+                    if ln is None:
+                        b.fail(f"set {st.index} (dataset {st.type}b) ends inside its header: "
+                               "truncated")
+                    hl.append(ln)
+                st.header_lines, st.bo, st.nbytes = hl, bo, nbytes
+                st.data_start = pos
+                if st.type == 58:
+                    self._parse_header58(st, b)
+                    need = st.n_values * st.itemsize
+                else:
+                    need = nbytes
+                avail = n - pos
+                if need > avail:
+                    st.truncated = True
+                    st.data_end = pos + (avail // max(getattr(st, "itemsize", 1), 1)) * \
+                        max(getattr(st, "itemsize", 1), 1)
+                    sets.append(st)
+                    break
+                st.data_end = pos + need
+                pos = self._after_binary(mm, b, st, st.data_end)
+                sets.append(st)
+            else:
+                m2 = _DELIM.search(mm, pos)
+                if m2 is None:
+                    st.truncated = True
+                    end = len(mm)
+                    pos = len(mm)
+                else:
+                    end = m2.start()
+                    pos = m2.end()
+                st.block = (nxt + len(tline), end)
+                if st.type == 58:
+                    hdr_lines = []
+                    p = st.block[0]
+                    for _ in range(11):
+                        ln, p = self._line(mm, p)
+                        if ln is None or p > end + 1:
+                            b.fail(f"set {st.index} (dataset 58) ends inside its 11-line header: "
+                                   "truncated or corrupt")
+                        hdr_lines.append(ln)
+                    st.header_lines = hdr_lines
+                    st.data_start, st.data_end = p, end
+                    self._parse_header58(st, b)
+                sets.append(st)
+        return sets
+
+    def _after_binary(self, mm, b, st, pos):
+        """Return the position after the closing delimiter of a binary set."""
+        line, nxt = self._line(mm, pos)
+        if line is None:
+            b.warn(f"set {st.index}: closing '-1' delimiter missing at the end of the file")
+            return len(mm)
+        if line.strip() == b"-1":
+            return nxt
+        if not line.strip():
+            line2, nxt2 = self._line(mm, nxt)
+            if line2 is not None and line2.strip() == b"-1":
+                return nxt2
+        m = _DELIM.search(mm, pos)
+        if m is None:
+            b.warn(f"set {st.index}: closing '-1' delimiter missing after the data")
+            return len(mm)
+        pad = m.start() - pos
+        b.warn(f"set {st.index}: {pad} bytes of padding after the binary data ignored")
+        return m.end()
+
+    def _parse_header58(self, st, b):
+        hl = st.header_lines
+        if len(hl) < 11:
+            b.fail(f"set {st.index} (dataset 58): header has {len(hl)} lines, expected 11")
+        h = st.header
+        for i in range(5):
+            h[f"id{i + 1}"] = _dec(hl[i].rstrip(b"\r\n")).strip()
+        try:
+            f = _fields(hl[5], [5, 10, 5, 10, 11, 10, 4, 11, 10, 4])
+            h["func_type"] = int(f[0])
+            h["func_id"], h["ver_num"], h["load_case_id"] = int(f[1] or 0), int(f[2] or 0), \
+                int(f[3] or 0)
+            h["rsp_ent_name"] = f[4].strip()
+            h["rsp_node"], h["rsp_dir"] = int(f[5]), int(f[6])
+            h["ref_ent_name"] = f[7].strip()
+            h["ref_node"] = int(f[8]) if f[8].strip() else 0
+            h["ref_dir"] = int(f[9]) if f[9].strip() else 0
+        except ValueError:
+            b.fail(f"set {st.index} (dataset 58): record 6 {bytes(hl[5][:60])!r} is unreadable "
+                   "(function type, node, direction)")
+        try:
+            toks = _dec(hl[6]).split()
+            if len(toks) != 6:
+                toks = _fields(hl[6], [10, 10, 10, 13, 13, 13])
+            h["ord_data_type"], h["num_pts"], h["abscissa_spacing"] = (int(t) for t in toks[:3])
+            h["abscissa_min_text"], h["abscissa_inc_text"] = toks[3].strip(), toks[4].strip()
+            h["abscissa_min"], h["abscissa_inc"] = _float(toks[3]), _float(toks[4])
+            h["z_axis_value"] = _float(toks[5])
+        except (ValueError, IndexError):
+            b.fail(f"set {st.index} (dataset 58): record 7 {bytes(hl[6][:80])!r} is unreadable "
+                   "(data type, number of points, increment)")
+        for rec, axis in zip(hl[7:11], ("abscissa", "ordinate", "orddenom", "z_axis")):
+            f = _fields(rec, [10, 5, 5, 5, 21, 21])
+            try:
+                h[f"{axis}_spec_data_type"] = int(f[0])
+                h[f"{axis}_len_unit_exp"] = int(f[1] or 0)
+                h[f"{axis}_force_unit_exp"] = int(f[2] or 0)
+                h[f"{axis}_temp_unit_exp"] = int(f[3] or 0)
+            except ValueError:
+                b.fail(f"set {st.index} (dataset 58): {axis} record {bytes(rec[:60])!r} is unreadable")
+            h[f"{axis}_axis_lab"] = f[4].strip()
+            h[f"{axis}_axis_units_lab"] = f[5].strip()
+        odt, npts, spacing = h["ord_data_type"], h["num_pts"], h["abscissa_spacing"]
+        if odt not in (2, 4, 5, 6):
+            b.fail(f"set {st.index}: ordinate data type {odt} is not 2/4 (real) or 5/6 (complex)")
+        if npts <= 0:
+            b.fail(f"set {st.index}: header promises {npts} points")
+        if spacing not in (0, 1):
+            b.fail(f"set {st.index}: abscissa spacing {spacing} is not 0 (uneven) or 1 (even)")
+        st.complex = odt in (5, 6)
+        st.double = odt in (4, 6)
+        st.per_point = (2 if st.complex else 1) + (1 if spacing == 0 else 0)
+        st.n_values = npts * st.per_point
+        st.itemsize = 8 if st.double else 4
+
+    # -- data -----------------------------------------------------------------------
+    def _values(self, mm, st, b, allow_truncated):
+        h = st.header
+        if st.binary:
+            nbytes = st.data_end - st.data_start
+            count = nbytes // st.itemsize
+            dt = np.dtype(("<" if st.bo == 1 else ">") + ("f8" if st.double else "f4"))
+            vals = np.frombuffer(mm, dtype=dt, count=count, offset=st.data_start)
+        else:
+            text = mm[st.data_start:st.data_end]
+            if b"D" in text or b"d" in text:
+                text = text.replace(b"D", b"E").replace(b"d", b"e")
+            toks = text.split()
+            vals = self._parse_tokens(toks, st, b)
+            if vals.size != st.n_values and vals.size > 0:
+                fixed = self._fixed_width(text, st)
+                if fixed is not None and fixed.size == st.n_values:
+                    vals = fixed
+        got, want = vals.size, st.n_values
+        if got != want:
+            pts = got // st.per_point
+            what = (f"set {st.index} ({h.get('rsp_ent_name') or h.get('id1')!r}): header promises "
+                    f"{h['num_pts']} points, {pts} present")
+            if got > want:
+                b.fail(f"{what} (more values than promised): corrupt header or data")
+            if pts < 2:
+                b.fail(f"{what}: truncated, nothing to keep")
+            if not allow_truncated:
+                b.fail(f"{what}: truncated file; pass allow_truncated=True (CLI --allow-truncated) "
+                       f"to keep the {pts} points")
+            b.warn(f"{what}: truncated, kept the {pts} points present")
+            vals = vals[:pts * st.per_point]
+        elif st.truncated and not st.binary:
+            b.warn(f"set {st.index}: closing '-1' delimiter missing at the end of the file")
+        return vals
+
+    def _parse_tokens(self, toks, st, b):
+        try:
+            return np.array(toks, dtype=np.float64) if toks else np.empty(0)
+        except ValueError:
+            for i, t in enumerate(toks):
+                try:
+                    float(t)
+                except ValueError:
+                    b.fail(f"set {st.index}: corrupt number {bytes(t[:30])!r} at value {i} of the "
+                           "data block")
+            raise  # pragma: no cover
+
+    def _fixed_width(self, text, st):
+        """Parse fixed-width fields (numbers printed without separating blanks)."""
+        h = st.header
+        if st.complex:
+            return None
+        widths = [13] if not st.double else ([20] if h["abscissa_spacing"] == 1 else [13, 20])
+        out = []
+        try:
+            for line in text.splitlines():
+                line = line.rstrip()
+                i, k = 0, 0
+                while i < len(line):
+                    w = widths[k % len(widths)]
+                    tok = line[i:i + w]
+                    if tok.strip():
+                        out.append(float(tok))
+                    i += w
+                    k += 1
+        except ValueError:
+            return None
+        return np.asarray(out)
+
+    # -- channels -------------------------------------------------------------------
+    def _channel_name(self, st, k):
+        h = st.header
+        ent = h.get("rsp_ent_name", "")
+        if ent and ent.upper() != "NONE":
+            return clean_name(ent, f"ch{k}")
+        node, d = h.get("rsp_node", 0), h.get("rsp_dir", 0)
+        if node:
+            return f"{node}{_DIRS.get(d, '')}" if d else f"node{node}"
+        return f"ch{k}"
+
+    def _unit_from_164(self, st, units164):
+        """Unit label from the ordinate's spec data type and exponents when the label is empty."""
+        h = st.header
+        q = _SPEC_QUANTITY.get(h["ordinate_spec_data_type"])
+        if q is None or q not in _SPEC_SI:
+            return None, None
+        label = _SPEC_SI[q][0]
+        factor = 1.0
+        if units164 is not None:
+            lf, ff = units164
+            factor = 1.0 / (lf ** h["ordinate_len_unit_exp"] * ff ** h["ordinate_force_unit_exp"])
+        return label, factor
+
+    def _read(self, mm, b, channels, allow_truncated, fs_override, snap_rate):
+        if len(mm) == 0:  # pragma: no cover - mmap refuses empty files earlier
+            b.fail("file is empty")
+        sets = self._scan(mm, b, allow_truncated)
+        if not sets:
+            b.fail("no datasets found between '-1' delimiters")
+        units164 = None
+        others, nontime = [], []
+        times = []
+        for st in sets:
+            if st.type == 164 and not st.binary:
+                units164 = self._parse_164(mm, st, b)
+            elif st.type == 151 and not st.binary:
+                lines = bytes(mm[st.block[0]:st.block[1]]).splitlines()
+                if len(lines) >= 2:
+                    b.attrs["uff_model_name"] = _dec(lines[0]).strip()
+                    b.attrs["uff_model_description"] = _dec(lines[1]).strip()
+                if len(lines) >= 6:
+                    b.attrs["uff_program"] = _dec(lines[5]).strip()
+            elif st.type == 58:
+                h = st.header
+                if h["func_type"] != 1 or h.get("abscissa_spec_data_type") not in (17, 0, 1):
+                    nontime.append(f"{st.index} (function type {h['func_type']})")
+                else:
+                    times.append(st)
+            else:
+                others.append(st.type)
+        if not times:
+            found = sorted({s.type for s in sets})
+            extra = f"; 58 sets that are not time responses: {', '.join(nontime)}" if nontime else ""
+            b.fail(f"no time-history datasets (dataset 58 with function type 1) in the file: "
+                   f"it holds datasets {', '.join(map(str, found))}{extra}; export a time history "
+                   "from the measurement software")
+        if others:
+            b.warn(f"dropped {len(others)} non-time-history sets (datasets "
+                   f"{', '.join(map(str, sorted(set(others))))})")
+        if nontime:
+            b.warn(f"dropped dataset-58 sets that are not time responses: {', '.join(nontime)}")
+        # names first (cheap), then selection, then data
+        names, used = [], {}
+        for k, st in enumerate(times, 1):
+            base = self._channel_name(st, k)
+            used[base] = used.get(base, 0) + 1
+            names.append(base if used[base] == 1 else f"{base}_{used[base]}")
+        if channels is not None:
+            wanted = [channels] if isinstance(channels, str) else list(channels)
+            missing = [c for c in wanted if c not in names]
+            if missing:
+                b.fail(f"no channel {missing[0]!r}; the file has {', '.join(names)}")
+            picked = [(names.index(c), c) for c in wanted]
+        else:
+            picked = list(enumerate(names))
+        groups = {}
+        for i, name in picked:
+            st = times[i]
+            h = st.header
+            inc_raw = h["abscissa_inc"]
+            key = (h["num_pts"], h["abscissa_spacing"], h["abscissa_inc_text"],
+                   h["abscissa_min_text"])
+            groups.setdefault(key, []).append((i, name))
+        if len(groups) > 1:
+            desc = "; ".join(f"{', '.join(n for _, n in g)}: {k[0]} points, increment {k[2]} s"
+                             for k, g in groups.items())
+            b.fail(f"channels differ in rate, length or start ({desc}); read one group at a time "
+                   "with channels=[...]")
+        first = times[picked[0][0]]
+        h0 = first.header
+        time = None
+        for i, name in picked:
+            st = times[i]
+            h = st.header
+            vals = self._values(mm, st, b, allow_truncated)
+            x = None
+            if h["abscissa_spacing"] == 0:
+                k = 3 if st.complex else 2
+                x, vals = vals[0::k], vals[1::k] if not st.complex else vals[1::k] + 1j * vals[2::k]
+            elif st.complex:
+                vals = vals[0::2] + 1j * vals[1::2]
+            if st.complex:
+                b.fail(f"set {st.index} ({name!r}) holds complex values (ordinate data type "
+                       f"{h['ord_data_type']}): not a time history")
+            if x is not None:
+                if time is None:
+                    time = np.asarray(x, dtype=np.float64)
+                elif time.size != x.size or not np.array_equal(time, x):
+                    b.fail("channels have different uneven time bases; read them separately "
+                           "with channels=[...]")
+            label = h["ordinate_axis_units_lab"]
+            factor164 = None
+            if not label or label.upper() == "NONE":
+                label, factor164 = self._unit_from_164(st, units164)
+                if factor164 not in (None, 1.0):
+                    vals = np.asarray(vals, dtype=np.float64) * factor164
+            attrs = {k: h[k] for k in ("id1", "id2", "id3", "id4", "id5", "rsp_ent_name")
+                     if h.get(k) and h[k].upper() != "NONE"}
+            attrs.update({"uff_set": st.index, "uff_rsp_node": h["rsp_node"],
+                          "uff_rsp_dir": h["rsp_dir"], "uff_func_type": h["func_type"],
+                          "uff_ord_data_type": h["ord_data_type"],
+                          "uff_ordinate_axis_lab": h["ordinate_axis_lab"],
+                          "uff_binary": int(st.binary)})
+            if factor164 not in (None, 1.0):
+                attrs["uff_164_factor"] = factor164
+            b.add_channel(name, vals, label, attrs=attrs,
+                          quantity=_SPEC_QUANTITY.get(h["ordinate_spec_data_type"]))
+        # rate
+        inc, t0 = h0["abscissa_inc"], h0["abscissa_min"]
+        fs = None
+        if time is not None:
+            b.warn("uneven abscissa: the file's time values are kept as the time coordinate "
+                   "(sampling_rate_hz is the median rate)")
+            b.attrs["uneven_time"] = 1
+        elif fs_override is not None:
+            fs = float(fs_override)
+            b.attrs["file_sampling_rate_hz"] = 1.0 / inc if inc > 0 else 0.0
+        else:
+            if not inc > 0:
+                b.fail(f"abscissa increment {h0['abscissa_inc_text']!r} is not positive; pass fs=<Hz>")
+            fs = 1.0 / inc
+            if snap_rate:
+                fs = self._snap(fs, h0["abscissa_inc_text"], b)
+        for k in ("id1", "id2", "id3", "id4", "id5"):
+            if h0.get(k) and h0[k].upper() != "NONE":
+                b.attrs[f"uff_{k}"] = h0[k]
+        b.attrs["uff_n_sets"] = len(sets)
+        if units164 is not None:
+            b.attrs["uff_164_length_factor"], b.attrs["uff_164_force_factor"] = units164
+        return b.build(fs=fs, t0=t0, time=time, data=mm, channels=None)
+
+    def _snap(self, fs, text, b):
+        """Snap ``fs`` to the whole number of Hz whose increment prints as ``text``."""
+        cand = round(fs)
+        if cand <= 0 or cand == fs:
+            return fs
+        txt = text.replace("D", "E").replace("d", "e")
+        mant = re.match(r"\s*[-+]?(\d*)\.?(\d*)[eE]?([-+]?\d*)", txt)
+        if not mant or not mant.group(3):
+            return fs
+        digits = len((mant.group(1) + mant.group(2)).lstrip("0")) or 1
+        inc = float(txt)
+        ulp = 10.0 ** (math.floor(math.log10(abs(inc))) - (digits - 1))
+        # the writer may round or truncate the last printed digit: accept one unit of it
+        if abs(1.0 / cand - inc) <= ulp * (1 + 1e-9):
+            b.warn(f"sampling rate snapped from {fs:.6f} Hz to {cand} Hz (the increment is "
+                   f"printed as {text})")
+            b.attrs["file_sampling_rate_hz"] = fs
+            return float(cand)
+        return fs
+
+    def _parse_164(self, mm, st, b):
+        lines = bytes(mm[st.block[0]:st.block[1]]).splitlines()
+        try:
+            toks = lines[1].replace(b"D", b"E").split()
+            length, force = float(toks[0]), float(toks[1])
+            b.attrs["uff_units_system"] = _dec(lines[0][10:30]).strip()
+        except (IndexError, ValueError):
+            b.warn(f"set {st.index} (dataset 164, units) is unreadable and was ignored")
+            return None
+        if not (length > 0 and force > 0):
+            b.warn(f"set {st.index} (dataset 164) has factors {length}, {force}; ignored")
+            return None
+        return (length, force)
+
+
+ENGINES["uff58"] = Uff58Reader

@@ -1,0 +1,105 @@
+"""WAV files from portable analysers and recorders, with a required calibration.
+
+Why a calibration is required: a WAV file stores numbers relative to the
+converter's full scale and nothing about volts or g.  The user says what full
+scale means, either physically (``full_scale="50 g"``) or electrically
+(``full_scale="5 V"`` plus ``sensitivity="9.91mV/g"``).  Read with
+``scipy.io.wavfile`` (no extra dependency); integer samples are scaled by
+2**(bits-1) (8-bit: offset 128), float samples are taken as ±1 full scale.
+Samples at the converter's limits are reported as clipping.
+"""
+from __future__ import annotations
+
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from .. import units as _units
+from ..errors import RecordingError
+from ._base import ENGINES, RecordingBuilder, RecordingReader
+
+
+class WavReader(RecordingReader):
+    """Read PCM/float WAV files with a user calibration."""
+
+    name = "wav"
+    description = "WAV (PCM or float) with a calibration: full_scale='5 V' + sensitivity, or '50 g'"
+    extensions = (".wav",)
+    libraries = ("scipy",)
+
+    def guess_can_open(self, path, head):
+        return head[:4] in (b"RIFF", b"RIFX", b"RF64") and head[8:12] == b"WAVE"
+
+    def open_dataset(self, path, *, full_scale=None, sensitivity=None, channels=None,
+                     checksum=True):
+        """Read a WAV file and calibrate it.
+
+        Parameters
+        ----------
+        path : str or Path
+        full_scale : str
+            What digital full scale (1.0, or 2**(bits-1)) means: ``"5 V"`` (then
+            ``sensitivity`` is needed) or a physical value such as ``"50 g"``.
+        sensitivity : str, optional
+            ``"9.91mV/g"`` when ``full_scale`` is a voltage.
+        channels : str or list of str, optional
+            ``ch1``, ``ch2`` ...
+        checksum : bool
+
+        Returns
+        -------
+        xarray.Dataset
+        """
+        import scipy.io.wavfile as wavfile
+
+        path = Path(path)
+        b = RecordingBuilder(path, self, sensitivity=sensitivity, checksum=checksum)
+        if full_scale is None:
+            b.fail("a WAV file has no physical unit: pass full_scale='5 V' with "
+                   "sensitivity='9.91mV/g', or full_scale='50 g' (CLI --full-scale, --sensitivity)")
+        try:
+            fs_value, unit = _units.parse_quantity(full_scale)
+        except RecordingError as exc:
+            b.fail(str(exc))
+        if not fs_value > 0:
+            b.fail(f"full_scale {full_scale!r} must be positive")
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            try:
+                rate, data = wavfile.read(path)
+            except (ValueError, EOFError, OSError, IndexError) as exc:
+                b.fail(f"not a readable WAV file ({exc})")
+        for w in caught:
+            b.warn(f"WAV: {w.message}")
+        data = np.asarray(data)
+        if data.ndim == 1:
+            data = data[:, None]
+        kind = data.dtype.kind
+        if kind == "u":
+            scale, offset = 2.0 ** (8 * data.dtype.itemsize - 1), 2.0 ** (8 * data.dtype.itemsize - 1)
+        elif kind == "i":
+            bits = 8 * data.dtype.itemsize
+            scale, offset = 2.0 ** (bits - 1), 0.0
+        elif kind == "f":
+            scale, offset = 1.0, 0.0
+        else:
+            b.fail(f"sample type {data.dtype} is not supported")
+        b.attrs["wav_dtype"] = str(data.dtype)
+        b.attrs["full_scale"] = str(full_scale)
+        for j in range(data.shape[1]):
+            raw = data[:, j]
+            if kind in "iu":
+                info = np.iinfo(data.dtype)
+                n_clip = int(np.count_nonzero((raw == info.max) | (raw == info.min)))
+                if n_clip:
+                    b.warn(f"channel 'ch{j + 1}': {n_clip} samples at the converter's full scale: "
+                           "clipping")
+            elif np.any(np.abs(raw) >= 1.0):
+                b.warn(f"channel 'ch{j + 1}': samples at or beyond ±1.0 full scale: clipping")
+            x = (raw.astype(np.float64) - offset) / scale * (fs_value / unit.factor)
+            b.add_channel(f"ch{j + 1}", x, unit.label, attrs={"wav_channel": j + 1})
+        return b.build(fs=float(rate), channels=channels)
+
+
+ENGINES["wav"] = WavReader
