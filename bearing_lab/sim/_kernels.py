@@ -50,7 +50,7 @@ F_PSI0, F_PSIF, F_DPSI, F_DDEL, F_ZLO, F_ZHI = 0, 1, 2, 3, 4, 5
 TWO_PI = 2.0 * math.pi
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy", inline="always")
 def shaft_state(t, sp_t, sp_w, sp_th):
     """Shaft angle (rad) and speed (rad/s) at t for a piecewise-linear speed."""
     n = sp_t.shape[0]
@@ -71,13 +71,13 @@ def shaft_state(t, sp_t, sp_w, sp_th):
     return sp_th[lo] + sp_w[lo] * dt + 0.5 * slope * dt * dt, sp_w[lo] + slope * dt
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy", inline="always")
 def wrap(a):
-    """Angle wrapped to [-pi, pi)."""
-    return (a + math.pi) % TWO_PI - math.pi
+    """Angle wrapped to [-pi, pi) (floor, not fmod: fmod costs tens of ns)."""
+    return a - TWO_PI * math.floor((a + math.pi) / TWO_PI)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy", inline="always")
 def step_fn(x, x0, h0, x1, h1):
     """Adams STEP: cubic from (x0, h0) to (x1, h1), constant outside."""
     if x <= x0:
@@ -88,16 +88,20 @@ def step_fn(x, x0, h0, x1, h1):
     return h0 + (h1 - h0) * s * s * (3.0 - 2.0 * s)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy", inline="always")
 def impact(pen, pen_rate, k, e, cmax, dpen):
     """Adams IMPACT force for penetration ``pen`` >= 0 (clipped at zero: no pull)."""
     if pen <= 0.0:
         return 0.0
-    f = k * pen ** e + step_fn(pen, 0.0, 0.0, dpen, cmax) * pen_rate
+    if e == 1.5:
+        f = k * pen * math.sqrt(pen)
+    else:
+        f = k * pen ** e
+    f += step_fn(pen, 0.0, 0.0, dpen, cmax) * pen_rate
     return f if f > 0.0 else 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy", inline="always")
 def _interp_h(k, psi, dint, dflt, hbuf):
     """Drop h (m) and dh/dpsi at relative angle psi for defect k (linear)."""
     n = dint[k, D_NPSI]
@@ -112,7 +116,7 @@ def _interp_h(k, psi, dint, dflt, hbuf):
     return h0 + fr * (h1 - h0), (h1 - h0) / dflt[k, F_DPSI]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _interp_g(k, psi, delta, dint, dflt, gbuf):
     """G(psi, delta) (m^1.5) of defect k, bilinear; linear extrapolation in delta."""
     npsi = dint[k, D_NPSI]
@@ -142,13 +146,23 @@ def _interp_g(k, psi, delta, dint, dflt, gbuf):
     return g if g > 0.0 else 0.0
 
 
-@njit(cache=True)
-def race_force(race, phi, phidot, theta_s, omega_s, delta, delta_rate, k, p, dint, dflt, hbuf, gbuf):
-    """Normal force of one ball on ``race`` (0 outer, 1 inner) with defects."""
-    e = p[P_EXP]
-    cmax = p[P_CMAX]
-    dpen = p[P_DPEN]
-    ndef = int(p[P_NDEF])
+@njit(cache=True, error_model="numpy")
+def defect_force(kk, rel, reld, delta, delta_rate, k, p, dint, dflt, hbuf, gbuf):
+    """Normal force of a ball at relative angle ``rel`` inside the zone of defect kk."""
+    h, dh = _interp_h(kk, rel, dint, dflt, hbuf)
+    pen = delta - h
+    pen_rate = delta_rate - dh * reld
+    if pen <= 0.0:
+        return 0.0
+    if dint[kk, D_KIND] == 0:
+        return impact(pen, pen_rate, k, p[P_EXP], p[P_CMAX], p[P_DPEN])
+    f = k * _interp_g(kk, rel, delta, dint, dflt, gbuf) + step_fn(pen, 0.0, 0.0, p[P_DPEN], p[P_CMAX]) * pen_rate
+    return f if f > 0.0 else 0.0
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def find_zone(race, phi, phidot, theta_s, omega_s, ndef, dint, dflt):
+    """(defect index or -1, relative angle, relative angular speed) of a ball on ``race``."""
     for kk in range(ndef):
         if dint[kk, D_RACE] != race:
             continue
@@ -158,21 +172,12 @@ def race_force(race, phi, phidot, theta_s, omega_s, delta, delta_rate, k, p, din
         else:
             rel = wrap(phi - dflt[kk, F_PSI0] - theta_s)
             reld = phidot - omega_s
-        if rel < dflt[kk, F_ZLO] or rel > dflt[kk, F_ZHI]:
-            continue
-        h, dh = _interp_h(kk, rel, dint, dflt, hbuf)
-        pen = delta - h
-        pen_rate = delta_rate - dh * reld
-        if pen <= 0.0:
-            return 0.0
-        if dint[kk, D_KIND] == 0:
-            return impact(pen, pen_rate, k, e, cmax, dpen)
-        f = k * _interp_g(kk, rel, delta, dint, dflt, gbuf) + step_fn(pen, 0.0, 0.0, dpen, cmax) * pen_rate
-        return f if f > 0.0 else 0.0
-    return impact(delta, delta_rate, k, e, cmax, dpen)
+        if dflt[kk, F_ZLO] <= rel <= dflt[kk, F_ZHI]:
+            return kk, rel, reld
+    return -1, 0.0, 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _qs_ball(phi, phidot, theta_s, omega_s, dtot, dtot_rate, p, dint, dflt, hbuf, gbuf):
     """Quasi-static (massless) ball: load through inner and outer contacts in series."""
     ki = p[P_KI]
@@ -215,7 +220,7 @@ def _qs_ball(phi, phidot, theta_s, omega_s, dtot, dtot_rate, p, dint, dflt, hbuf
     return impact(dtot, dtot_rate, p[P_KEFF], e, cser, dpen)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def rhs(t, y, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, dy, fi_out, fo_out):
     """dy/dt of the bearing model; also writes the ball loads into fi_out/fo_out."""
     z = int(p[P_Z])
@@ -231,15 +236,36 @@ def rhs(t, y, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, dy, fi_out, fo_out):
     foy = 0.0
     mb = p[P_MB]
     qs = p[P_FID] > 0.5
+    ndef = int(p[P_NDEF])
+    has_def = ndef > 0
     base = 8
+    c0 = math.cos(phic)
+    s0 = math.sin(phic)
+    dc = math.cos(TWO_PI / z)
+    ds = math.sin(TWO_PI / z)
+    c = c0
+    s = s0
     for j in range(z):
+        if j > 0:
+            # rotate by 2π/Z; re-anchor every 4 balls to keep rounding at 1e-16
+            if j % 4 == 0:
+                c = math.cos(phic + TWO_PI * j / z)
+                s = math.sin(phic + TWO_PI * j / z)
+            else:
+                c, s = c * dc - s * ds, s * dc + c * ds
         phi = phic + TWO_PI * j / z
-        c = math.cos(phi)
-        s = math.sin(phi)
         if qs:
             dtot = (xi - xo) * c + (yi - yo) * s - 2.0 * pd4
             drate = (vxi - vxo) * c + (vyi - vyo) * s + ((xi - xo) * (-s) + (yi - yo) * c) * phidot
-            q = _qs_ball(phi, phidot, theta_s, omega_s, dtot, drate, p, dint, dflt, hbuf, gbuf)
+            kz = -1
+            if has_def:
+                kz, relz, reldz = find_zone(0, phi, phidot, theta_s, omega_s, ndef, dint, dflt)
+                if kz < 0:
+                    kz, relz, reldz = find_zone(1, phi, phidot, theta_s, omega_s, ndef, dint, dflt)
+            if kz >= 0:
+                q = _qs_ball(phi, phidot, theta_s, omega_s, dtot, drate, p, dint, dflt, hbuf, gbuf)
+            else:
+                q = impact(dtot, drate, p[P_KEFF], p[P_EXP], 0.5 * p[P_CMAX], p[P_DPEN])
             fi = q
             fo = q
         else:
@@ -249,8 +275,19 @@ def rhs(t, y, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, dy, fi_out, fo_out):
             d_or = qd - (vxo * c + vyo * s) - (xo * (-s) + yo * c) * phidot
             d_i = -qj + (xi * c + yi * s) - pd4
             d_ir = -qd + (vxi * c + vyi * s) + (xi * (-s) + yi * c) * phidot
-            fo = race_force(0, phi, phidot, theta_s, omega_s, d_o, d_or, p[P_KO], p, dint, dflt, hbuf, gbuf)
-            fi = race_force(1, phi, phidot, theta_s, omega_s, d_i, d_ir, p[P_KI], p, dint, dflt, hbuf, gbuf)
+            ko = -1
+            ki = -1
+            if has_def:
+                ko, relo, reldo = find_zone(0, phi, phidot, theta_s, omega_s, ndef, dint, dflt)
+                ki, reli, reldi = find_zone(1, phi, phidot, theta_s, omega_s, ndef, dint, dflt)
+            if ko >= 0:
+                fo = defect_force(ko, relo, reldo, d_o, d_or, p[P_KO], p, dint, dflt, hbuf, gbuf)
+            else:
+                fo = impact(d_o, d_or, p[P_KO], p[P_EXP], p[P_CMAX], p[P_DPEN])
+            if ki >= 0:
+                fi = defect_force(ki, reli, reldi, d_i, d_ir, p[P_KI], p, dint, dflt, hbuf, gbuf)
+            else:
+                fi = impact(d_i, d_ir, p[P_KI], p[P_EXP], p[P_CMAX], p[P_DPEN])
             dy[base + j] = qd
             dy[base + z + j] = (fi - fo) / mb + (p[P_RP] + qj) * phidot * phidot - p[P_G] * s
         fix -= fi * c
@@ -285,7 +322,7 @@ def rhs(t, y, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, dy, fi_out, fo_out):
         dy[sb + 3] = -2.0 * zt * w * y[sb + 3] - w * w * y[sb + 1] - ayo
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _step_limit(t, h, p, sp_t, sp_w, sp_th, dint, dflt, nsteps_def, hmax):
     """Bound the step near defects: land on zone entry, then take >= nsteps_def steps inside."""
     ndef = int(p[P_NDEF])
@@ -324,7 +361,7 @@ def _step_limit(t, h, p, sp_t, sp_w, sp_th, dint, dflt, nsteps_def, hmax):
     return hh
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _hermite(y0, y1, f0, f1, h, th):
     h00 = (1 + 2 * th) * (1 - th) ** 2
     h10 = th * (1 - th) ** 2
@@ -333,7 +370,7 @@ def _hermite(y0, y1, f0, f1, h, th):
     return h00 * y0 + h10 * h * f0 + h01 * y1 + h11 * h * f1
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def integrate(y, t, t_stop, h, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf,
               a_tab, b_tab, e_tab, c_tab, order, fsal, adaptive, rtol, atol, hmax, nsteps_def,
               vel_idx, vel_sign, fine_t, fine_out, fine_pos, out_t, out_state, out_pos, stats):
@@ -437,7 +474,7 @@ def integrate(y, t, t_stop, h, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf,
     return t, h, fine_pos, out_pos, 0
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def loads_at(out_t, out_state, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, fi_all, fo_all):
     """Ball loads (N) at the output samples from the interpolated states."""
     n = out_state.shape[1]
