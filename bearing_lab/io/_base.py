@@ -191,6 +191,7 @@ class RecordingBuilder:
         self.attrs: dict = {}
         self.sha256: str | None = None
         self._used_units = set()
+        self._sens_ignored: list[str] = []
 
     # -- messages -------------------------------------------------------------------
     def fail(self, msg: str):
@@ -280,12 +281,8 @@ class RecordingBuilder:
                 si, si_unit, q = s.to_si(volts), s.unit.si, s.unit.quantity
                 vattrs["sensitivity"] = s.text
         else:
-            if sens not in (None, False, True) and not isinstance(self.sensitivity, dict) \
-                    and "sensitivity ignored" not in " ".join(self.warnings):
-                self.warn(f"sensitivity {sens!r} ignored: channel {name!r} is already in "
-                          f"{use_label} (not volts)")
-            elif isinstance(self.sensitivity, dict) and sens is not None:
-                self.warn(f"sensitivity {sens!r} ignored: channel {name!r} is in {use_label}")
+            if sens not in (None, False, True):
+                self._sens_ignored.append(name)
             if already_si or (unit.factor == 1.0 and unit.offset == 0.0):
                 si = x
             else:
@@ -361,6 +358,9 @@ class RecordingBuilder:
             if extra:
                 self.fail(f"units= names channel(s) {sorted(extra)} that the file does not have; "
                           f"it has {', '.join(self.channels)}")
+        if self._sens_ignored:
+            self.warn(f"sensitivity ignored for channel(s) {', '.join(self._sens_ignored)}: "
+                      "they are not in volts")
         self.select(channels)
         if not self.channels:
             self.fail("no channels found")

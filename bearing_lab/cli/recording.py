@@ -1,0 +1,191 @@
+"""Sub-commands ``import``, ``info`` and ``data`` (``data fetch``, ``data list``).
+
+Why here: the CLI only parses arguments and prints; reading is
+:func:`bearing_lab.io.open_recording`, writing :func:`bearing_lab.io.to_netcdf`
+and fetching :func:`bearing_lab.datasets.fetch`.  Every problem with the input
+is a :class:`~bearing_lab.errors.RecordingError`, which the CLI prints as one
+line with exit status 2.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import warnings
+
+
+def _options(args) -> dict:
+    opts = {}
+    if getattr(args, "sensitivity", None):
+        opts["sensitivity"] = False if args.sensitivity.lower() in ("none", "off") else args.sensitivity
+    if getattr(args, "fs", None) is not None:
+        opts["fs"] = args.fs
+    if getattr(args, "channels", None):
+        opts["channels"] = [c for c in args.channels.split(",") if c]
+    if getattr(args, "units", None):
+        opts["units"] = args.units
+    if getattr(args, "allow_truncated", False):
+        opts["allow_truncated"] = True
+    if getattr(args, "full_scale", None):
+        opts["full_scale"] = args.full_scale
+    if getattr(args, "record", None) is not None:
+        opts["record"] = args.record
+    return opts
+
+
+def _add_read_options(p):
+    p.add_argument("--format", "-f", default=None,
+                   help="reader name (default: sniffed from the content); see `bearing-lab info --formats`")
+    p.add_argument("--sensitivity", default=None,
+                   help="sensor sensitivity for voltage channels, e.g. 9.91mV/g ('none' keeps volts)")
+    p.add_argument("--fs", type=float, default=None, help="sampling rate, Hz (overrides the file)")
+    p.add_argument("--channels", default=None, help="comma-separated channel names to read")
+    p.add_argument("--units", default=None,
+                   help="unit of the stored values where the file has none or an unknown one (e.g. g)")
+    p.add_argument("--allow-truncated", action="store_true",
+                   help="keep the points present when a UFF header promises more")
+    p.add_argument("--full-scale", default=None, help="WAV calibration, e.g. '5 V' or '50 g'")
+    p.add_argument("--record", type=int, default=None, help="CWRU record number in a multi-record file")
+
+
+def _open(args):
+    from ..io import open_recording
+    opts = _options(args)
+    fmt = args.format
+    if fmt is None:
+        from ..io import guess_format
+        from pathlib import Path
+        p = Path(args.file)
+        if p.is_file() and p.stat().st_size:
+            fmt = guess_format(p)
+    if fmt is not None:
+        from ..io import ENGINES
+        if fmt in ENGINES:  # drop CLI options this reader does not take, unless given on purpose
+            known = ENGINES[fmt]().option_names()
+            dropped = [k for k in opts if k not in known]
+            if dropped:
+                flags = ", ".join("--" + k.replace("_", "-") for k in dropped)
+                from ..errors import RecordingError
+                raise RecordingError(f"{args.file}: the {fmt!r} reader does not use {flags}")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # they are in ds.attrs['warnings'] and printed below
+        return open_recording(args.file, format=fmt, **opts)
+
+
+def _cmd_import(args) -> int:
+    from ..io import get_warnings, to_netcdf
+    ds = _open(args)
+    to_netcdf(ds, args.output)
+    for w in get_warnings(ds):
+        print(f"warning: {w}", file=sys.stderr)
+    n = ds.sizes["time"]
+    fs = ds.attrs["sampling_rate_hz"]
+    print(f"{args.output}: {len(ds.data_vars)} channel(s) {', '.join(ds.data_vars)}, {n} samples "
+          f"at {fs:g} Hz ({n / fs:.4g} s), reader {ds.attrs['reader']}")
+    return 0
+
+
+def describe(ds) -> dict:
+    """Return the summary ``bearing-lab info`` prints (also used for ``--json``)."""
+    from ..io import get_warnings
+    n = ds.sizes.get("time", 0)
+    fs = float(ds.attrs.get("sampling_rate_hz", 0.0))
+    return {
+        "file": ds.attrs.get("source_file"),
+        "reader": ds.attrs.get("reader"),
+        "sampling_rate_hz": fs,
+        "samples": int(n),
+        "duration_s": (n / fs) if fs else None,
+        "start_time_s": float(ds["time"].values[0]) if n else None,
+        "shaft_speed_rpm": ds.attrs.get("shaft_speed_rpm"),
+        "default_channel": ds.attrs.get("default_channel"),
+        "channels": {k: {"units": v.attrs.get("units"), "original_units": v.attrs.get("original_units"),
+                         "quantity": v.attrs.get("quantity"),
+                         "rms": float((v.values.astype(float) ** 2).mean() ** 0.5) if v.size else None}
+                     for k, v in ds.data_vars.items()},
+        "sha256": ds.attrs.get("source_sha256"),
+        "warnings": get_warnings(ds),
+    }
+
+
+def _cmd_info(args) -> int:
+    if args.formats:
+        from ..io import list_engines
+        for name, desc in list_engines().items():
+            print(f"{name:14s} {desc}")
+        return 0
+    if not args.file:
+        from ..errors import RecordingError
+        raise RecordingError("info: give a FILE (or --formats)")
+    ds = _open(args)
+    d = describe(ds)
+    if args.json:
+        print(json.dumps(d, indent=1, default=str))
+        return 0
+    print(f"file:      {d['file']}")
+    print(f"reader:    {d['reader']}    sha256 {d['sha256'][:16]}…" if d["sha256"] else
+          f"reader:    {d['reader']}")
+    print(f"rate:      {d['sampling_rate_hz']:g} Hz, {d['samples']} samples, "
+          f"{d['duration_s']:.4g} s from {d['start_time_s']:.6g} s")
+    if d["shaft_speed_rpm"] is not None:
+        print(f"shaft:     {d['shaft_speed_rpm']:g} rpm")
+    print(f"channels:  (default {d['default_channel']})")
+    for k, c in d["channels"].items():
+        print(f"  {k:12s} {c['units']:6s} (file: {c['original_units'] or '-'}) {c['quantity']:13s} "
+              f"rms {c['rms']:.4g}")
+    print(f"warnings:  {len(d['warnings'])}")
+    for w in d["warnings"]:
+        print(f"  - {w}")
+    return 0
+
+
+def _cmd_fetch(args) -> int:
+    from .. import datasets
+    for name in args.names:
+        p = datasets.fetch(name, mirror=args.mirror, dest=args.dest, download=not args.no_download)
+        print(f"{name}: {p}")
+    return 0
+
+
+def _cmd_list(args) -> int:
+    from .. import datasets
+    for r in datasets.load_registry().values():
+        if args.dataset and not r.dataset.startswith(args.dataset):
+            continue
+        cond = ", ".join(x for x in (r.defect, f"{r.defect_size_in} in" if r.defect_size_in else "",
+                                     r.defect_position, f"{r.load_hp:g} hp" if r.load_hp is not None
+                                     else "", f"{r.rpm:g} rpm" if r.rpm else "",
+                                     f"{r.fs_hz:g} Hz" if r.fs_hz else "") if x)
+        print(f"{r.name:34s} {'sha256' if r.sha256 else 'no-hash':7s} {cond}")
+    return 0
+
+
+def register(subparsers) -> None:
+    """Add ``import``, ``info`` and ``data`` to the ``bearing-lab`` parser."""
+    p = subparsers.add_parser("import", help="read a rig recording and write it as netCDF4",
+                              description="Read a recording (UFF58/58b, Testlab MAT/text, CSV, WAV, "
+                              "CWRU/MFPT .mat, IMS, TDMS, MDF4) into SI units and write netCDF4.")
+    p.add_argument("file", help="the recording")
+    _add_read_options(p)
+    p.add_argument("-o", "--output", required=True, help="output .nc file")
+    p.set_defaults(func=_cmd_import)
+
+    p = subparsers.add_parser("info", help="channels, rate, duration, units and warnings of a recording")
+    p.add_argument("file", nargs="?", help="a recording or a .nc")
+    _add_read_options(p)
+    p.add_argument("--json", action="store_true", help="print JSON")
+    p.add_argument("--formats", action="store_true", help="list the readers and exit")
+    p.set_defaults(func=_cmd_info)
+
+    p = subparsers.add_parser("data", help="registered public recordings (fetch, list)")
+    sub = p.add_subparsers(dest="data_command", metavar="ACTION")
+    f = sub.add_parser("fetch", help="copy (mirror) or download registered recordings, hash-checked")
+    f.add_argument("names", nargs="+", metavar="NAME", help="registry name, e.g. cwru/130_OR007@6_0.mat")
+    f.add_argument("--mirror", default=None, help="local mirror directory (default $BEARING_LAB_MIRROR)")
+    f.add_argument("--dest", default=None, help="target directory (default data/cache or $BEARING_LAB_DATA)")
+    f.add_argument("--no-download", action="store_true", help="never use the network")
+    f.set_defaults(func=_cmd_fetch)
+    ls = sub.add_parser("list", help="list the registry")
+    ls.add_argument("--dataset", default=None, help="filter by dataset prefix (cwru, ims, mfpt, lms)")
+    ls.set_defaults(func=_cmd_list)
+    p.set_defaults(func=lambda a: (p.print_help(), 2)[1])
