@@ -86,7 +86,8 @@ class Uff58Reader(RecordingReader):
             re.fullmatch(rb"\d+b?", lines[1].split()[0] if lines[1].split() else b"") is not None
 
     def open_dataset(self, path, *, channels=None, units=None, sensitivity=None,
-                     allow_truncated=False, fs=None, snap_rate=True, checksum=True):
+                     allow_truncated=False, fs=None, snap_rate=True, byte_order=None,
+                     checksum=True):
         """Read the time-history sets of a UFF file into one recording Dataset.
 
         Parameters
@@ -106,6 +107,9 @@ class Uff58Reader(RecordingReader):
             Sampling rate, Hz, replacing the header's increment.
         snap_rate : bool
             Snap a rate that the printed increment rounded (51200.13 -> 51200 Hz).
+        byte_order : "little" or "big", optional
+            Override the byte order the binary headers declare (for files whose
+            header is wrong; refused otherwise with a clear message).
         checksum : bool
             Compute ``source_sha256``.
 
@@ -115,11 +119,18 @@ class Uff58Reader(RecordingReader):
         """
         path = Path(path)
         b = RecordingBuilder(path, self, units=units, sensitivity=sensitivity, checksum=checksum)
+        if byte_order not in (None, "little", "big"):
+            b.fail(f"Invalid value for the 'byte_order' parameter. Allowed values are 'little' "
+                   f"and 'big', but got {byte_order!r} instead")
+        self._force_bo = {None: None, "little": 1, "big": 2}[byte_order]
         mm = map_file(path)
         try:
             return self._read(mm, b, channels, allow_truncated, fs, snap_rate)
         finally:
-            mm.close()
+            try:
+                mm.close()
+            except BufferError:  # a view is still referenced by a traceback; GC closes it
+                pass
 
     # -- scanning -------------------------------------------------------------------
     def _line(self, mm, pos):
@@ -171,7 +182,8 @@ class Uff58Reader(RecordingReader):
                         b.fail(f"set {st.index} (dataset {st.type}b) ends inside its header: "
                                "truncated")
                     hl.append(ln)
-                st.header_lines, st.bo, st.nbytes = hl, bo, nbytes
+                st.header_lines, st.nbytes = hl, nbytes
+                st.bo = self._force_bo or bo
                 st.data_start = pos
                 if st.type == 58:
                     self._parse_header58(st, b)
@@ -295,7 +307,15 @@ class Uff58Reader(RecordingReader):
             nbytes = st.data_end - st.data_start
             count = nbytes // st.itemsize
             dt = np.dtype(("<" if st.bo == 1 else ">") + ("f8" if st.double else "f4"))
-            vals = np.frombuffer(mm, dtype=dt, count=count, offset=st.data_start)
+            raw = np.frombuffer(mm, dtype=dt, count=count, offset=st.data_start)
+            if self._implausible(raw) and not self._implausible(raw.byteswap()):
+                order = "little" if st.bo == 1 else "big"
+                other = "big" if st.bo == 1 else "little"
+                b.fail(f"set {st.index}: the header declares {order}-endian data but the values "
+                       f"only make sense {other}-endian: the byte order in the file is wrong; "
+                       f"pass byte_order='{other}' to read it anyway")
+            vals = raw.astype(np.float64)
+            del raw  # no view of the map may outlive it
         else:
             text = mm[st.data_start:st.data_end]
             if b"D" in text or b"d" in text:
@@ -323,6 +343,17 @@ class Uff58Reader(RecordingReader):
         elif st.truncated and not st.binary:
             b.warn(f"set {st.index}: closing '-1' delimiter missing at the end of the file")
         return vals
+
+    @staticmethod
+    def _implausible(v):
+        """True if many values are NaN/Inf or of absurd magnitude (wrong byte order)."""
+        v = np.asarray(v[:4096], dtype=np.float64)
+        if v.size == 0:
+            return False
+        with np.errstate(over="ignore", invalid="ignore"):
+            a = np.abs(v)
+            ok = np.isfinite(v) & ((a == 0) | ((a > 1e-30) & (a < 1e30)))
+        return ok.mean() < 0.9
 
     def _parse_tokens(self, toks, st, b):
         try:
