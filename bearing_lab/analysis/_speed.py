@@ -5,10 +5,12 @@ error moves BPFI by more than a bin; stored "rpm" values of public recordings
 are nominal.  The estimate has two stages:
 
 1. Harmonic family search: on the amplitude spectrum, each candidate ``f0``
-   scores the sum over ``h = 1..n_harmonics`` of the line-to-floor ratio (dB,
-   clipped to 0..20 dB) found at ``h * f0``.  With a fixed number of harmonics a
-   sub-harmonic ``f0/2`` only collects half of the family, so the true family
-   wins.  Lines within 1.5 bins of mains harmonics (50 and 60 Hz multiples by
+   scores the weighted sum over ``h = 1..n_harmonics`` (weights 0.9**(h-1)) of
+   the line-to-floor ratio (dB, capped at 20 dB; lines under 10 dB count 0)
+   found at ``h * f0``.  With a fixed number of harmonics a sub-harmonic
+   ``f0/2`` only collects half of the family, so the true family wins; an
+   octave check then prefers ``f0/2`` or ``f0/3`` when their own odd lines are
+   present (even harmonics next to mains can otherwise win).  Lines within 1.5 bins of mains harmonics (50 and 60 Hz multiples by
    default) are masked, because ``2 f_r`` sits next to 60 Hz at 1797 r/min.
 2. Interpolated-DFT refinement of every harmonic that stands clear of the floor
    (Quinn's second estimator on the rectangular-window DFT, or the exact
@@ -33,6 +35,9 @@ __all__ = ["shaft_frequency", "interpolated_peak", "line_floor_db"]
 #: the refinement: for a Rayleigh-distributed floor the chance that a noise bin
 #: exceeds the median by 10 dB is exp(-ln2 * 10) ~ 1e-3.
 LINE_SNR_DB = 10.0
+#: Line SNRs are capped here in the family score so that one huge non-shaft line
+#: (bearing-fault or electrical) cannot outweigh a family of shaft harmonics.
+SNR_CAP_DB = 20.0
 
 
 def interpolated_peak(X, k, *, method):
@@ -118,7 +123,7 @@ def _method_for(window):
                         f"(Quinn's estimator) and 'hann', but got {window!r} instead.")
 
 
-def shaft_frequency(x, fs, *, window, rpm=None, prior_tolerance=0.1, fmin=5.0, fmax=100.0,
+def shaft_frequency(x, fs, *, window, rpm=None, prior_tolerance=0.05, fmin=5.0, fmax=100.0,
                     n_harmonics=20, mains_hz=(50.0, 60.0)):
     """Shaft (rotation) frequency from a vibration signal, without a tachometer.
 
@@ -136,11 +141,14 @@ def shaft_frequency(x, fs, *, window, rpm=None, prior_tolerance=0.1, fmin=5.0, f
         Nominal speed, r/min: a prior restricting the search to
         ``rpm/60 * (1 +- prior_tolerance)``.
     prior_tolerance : float
-        Relative half-width of the prior window (default 0.1).
+        Relative half-width of the prior window (default 0.05: induction-motor
+        slip stays within a few per cent).
     fmin, fmax : float
         Search range without a prior, Hz (default 5-100 Hz, i.e. 300-6000 r/min).
     n_harmonics : int
-        Number of harmonics in the family score (default 20).
+        Number of harmonics in the family score (default 20).  Use 1 for a
+        single tone: a family search over many harmonics of noise can then
+        outscore one capped line.
     mains_hz : sequence of float
         Mains frequencies whose harmonics are masked (within 1.5 bins).  Pass
         ``()`` to disable.
@@ -193,6 +201,14 @@ def shaft_frequency(x, fs, *, window, rpm=None, prior_tolerance=0.1, fmin=5.0, f
         raise AnalysisError(f"shaft_frequency: x lasts {n / fs:.3g} s; its 1/T = {df:.3g} Hz "
                             f"bins cannot resolve a shaft line at {lo:.3g} Hz (record at least "
                             f"{4 / lo:.3g} s)")
+    return _harmonic_family(x, fs, lo, hi, n_harmonics=n_harmonics, method=method,
+                            mains_hz=mains_hz, rpm_given=rpm is not None, fmin=fmin)
+
+
+def _harmonic_family(x, fs, lo, hi, *, n_harmonics, method, mains_hz=(), rpm_given=False, fmin=None):
+    """Family search in [lo, hi] + interpolated refinement; returns (f0, n_lines)."""
+    n = x.size
+    df = fs / n
     xw = x - x.mean()
     if method == "hann":
         w = np.hanning(n + 1)[:-1]
@@ -202,13 +218,15 @@ def shaft_frequency(x, fs, *, window, rpm=None, prior_tolerance=0.1, fmin=5.0, f
     X = _fft.rfft(xw)[: top + 2]
     amp = np.abs(X)
     snr = line_floor_db(amp, width=max(31, int(round(10.0 / df))))
-    snr = np.clip(snr, 0.0, 20.0)
+    snr = np.clip(snr, 0.0, SNR_CAP_DB)
     f = np.arange(amp.size) * df
     masked = np.zeros(amp.size, bool)
     for fm in mains_hz or ():
         for m in np.arange(fm, f[-1] + fm, fm):
             masked |= np.abs(f - m) <= 1.5 * df
-    score_spec = np.where(masked, 0.0, snr)
+    # only clear lines count (>= LINE_SNR_DB): noise bins would otherwise add a
+    # few dB per harmonic and a long family of noise could outscore one true line
+    score_spec = np.where(masked | (snr < LINE_SNR_DB), 0.0, snr)
     # candidates: step so that the highest harmonic moves by at most half a bin
     step = 0.5 * df / nh
     cand = np.arange(lo, hi + step, step)
@@ -216,17 +234,25 @@ def shaft_frequency(x, fs, *, window, rpm=None, prior_tolerance=0.1, fmin=5.0, f
     pos = np.rint(cand[:, None] * h[None, :] / df).astype(int)
     pos = np.clip(pos, 1, amp.size - 2)
     vals = np.maximum(np.maximum(score_spec[pos - 1], score_spec[pos]), score_spec[pos + 1])
-    score = vals.sum(axis=1)
-    f0 = float(cand[int(np.argmax(score))])
+    # harmonic weights 0.9**(h-1) (Hermes' compression) break the tie between a
+    # lone line and its sub-harmonics in favour of the line itself
+    score = (vals * 0.9 ** (h - 1)).sum(axis=1)
+    # candidates within a bin of the family tie (the score takes the best of 3
+    # bins): take the middle of the plateau that holds the maximum
+    i_best = int(np.argmax(score))
+    j = i_best
+    while j + 1 < score.size and score[j + 1] >= score[i_best]:
+        j += 1
+    f0 = float(0.5 * (cand[i_best] + cand[j]))
     # octave check: a family of even harmonics (2 f_r next to mains, say) also
     # scores well at 2 f_r; prefer f0/d when at least half (and 3) of the first
     # n_harmonics harmonics of f0/d that are not harmonics of f0 are clear lines
     # (a noise bin passes with chance ~3e-3; a true family passes nearly all).
     for d in (2, 3):
         sub = f0 / d
-        if sub < lo * (1 - 1e-9) and rpm is not None:
+        if sub < lo * (1 - 1e-9) and rpm_given:
             continue
-        if sub < min(lo, fmin) or sub < 4 * df:
+        if sub < min(lo, fmin if fmin is not None else lo) or sub < 4 * df:
             continue
         hh = np.array([j for j in range(1, nh + 1) if j % d])
         kk = np.rint(hh * sub / df).astype(int)
@@ -241,7 +267,7 @@ def shaft_frequency(x, fs, *, window, rpm=None, prior_tolerance=0.1, fmin=5.0, f
         k0 = int(round(hh * f0 / df))
         if k0 + 2 >= amp.size or k0 < 2:
             continue
-        win = np.arange(k0 - 1, k0 + 2)
+        win = np.arange(max(k0 - 2, 1), min(k0 + 3, amp.size - 1))
         k = int(win[np.argmax(amp[win])])
         if masked[k] or snr[k] < LINE_SNR_DB or amp[k] < amp[k - 1] or amp[k] < amp[k + 1]:
             continue
