@@ -80,7 +80,7 @@ def _h5_plain(f, obj):
         return [_h5_plain(f, f[r]) for r in np.asarray(data).ravel()]
     if cls == "char":
         arr = np.asarray(data, dtype=np.uint16).T
-        if arr.ndim == 2 and arr.shape[0] > 1:
+        if arr.ndim == 2 and min(arr.shape) > 1:
             return ["".join(map(chr, row)).rstrip("\x00") for row in arr]
         return "".join(map(chr, arr.ravel()))
     arr = np.asarray(data)
