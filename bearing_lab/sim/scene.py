@@ -300,7 +300,7 @@ class Scene:
         defects = []
         for i, m in enumerate(d["defect"]):
             where = "defect" if len(d["defect"]) == 1 else f"defect[{i}]"
-            m = dict(m)
+            m = {k: _convert(v, k, f"{where}.{k}") for k, v in m.items()}
             m.pop("contact_model", None)
             defect = Defect.from_mapping(m, where=where)
             defect.validate(bearing)
