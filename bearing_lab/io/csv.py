@@ -28,9 +28,14 @@ def _split(line, delim):
 
 
 def _delimiter(lines):
+    """The delimiter most lines agree on (tab, semicolon, comma), else None (blanks)."""
+    lines = [ln for ln in lines if ln.strip()]
     for d in ("\t", ";", ","):
-        counts = {ln.count(d) for ln in lines if ln.strip()}
-        if len(counts) == 1 and counts.pop() > 0:
+        counts = [ln.count(d) for ln in lines]
+        if not counts:
+            continue
+        mode = max(set(counts), key=counts.count)
+        if mode > 0 and counts.count(mode) >= 0.9 * len(counts):
             return d
     return None
 
