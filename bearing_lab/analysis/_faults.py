@@ -119,7 +119,7 @@ def fault_line(f, ses, expected_hz, *, shaft_hz=None, tolerance=0.02, n_harmonic
     >>> x = np.exp(-900 * (t % (1 / 107.3))) * np.sin(2 * np.pi * 3000 * t)
     >>> x = x + np.random.default_rng(0).normal(0, 0.3, t.size)
     >>> f, ses = squared_envelope_spectrum(x, fs, window="hann", band=(2000, 4000), fmax=1000)
-    >>> r = fault_line(f, ses, 105.0)
+    >>> r = fault_line(f, ses, 106.0)
     >>> r["detected"], round(r["measured_hz"], 1)
     (True, 107.3)
     """

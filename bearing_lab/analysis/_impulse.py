@@ -157,7 +157,7 @@ def impulses(x, fs, *, band=None, threshold=None, min_separation=1e-3, level=0.1
     threshold : float, optional
         Envelope threshold in the unit of x; default ``DETECTION_FACTOR`` (4)
         times the median envelope (false-alarm rate ~1.5e-5 per sample in
-        Gaussian noise).
+        Gaussian noise), and at least 1e-3 times the largest envelope value.
     min_separation : float
         Runs closer than this are one impulse, s (default 1 ms; give about half
         the excitation period when it is known).
@@ -190,7 +190,11 @@ def impulses(x, fs, *, band=None, threshold=None, min_separation=1e-3, level=0.1
     else:
         y = x - x.mean()
     env = np.sqrt(squared_envelope(y, fs))
-    thr = DETECTION_FACTOR * np.median(env) if threshold is None else float(threshold)
+    if threshold is None:
+        # at least -60 dB of the largest envelope value, for noise-free signals
+        thr = max(DETECTION_FACTOR * float(np.median(env)), 1e-3 * float(env.max()))
+    else:
+        thr = float(threshold)
     if not thr > 0:
         raise AnalysisError(f"impulses: threshold={thr!r} must be positive")
     above = env >= thr
@@ -217,6 +221,8 @@ def impulses(x, fs, *, band=None, threshold=None, min_separation=1e-3, level=0.1
         base = np.median(seg)
         e = np.abs(seg - base)
         p = float(e.max())
+        if p == 0:
+            continue
         lev = min(max(level, thr / p if p > 0 else level), 0.999)
         dur, t_in, t_out = _duration_1d(seg, fs, lev)
         out["time"].append((k + d) / fs)

@@ -147,8 +147,8 @@ def shape_factor(x, *, axis=-1):
     --------
     >>> import numpy as np
     >>> from bearing_lab.analysis import shape_factor
-    >>> round(float(shape_factor(np.sin(2 * np.pi * np.arange(1000) / 100))), 4)
-    1.1107
+    >>> round(float(shape_factor(np.sin(2 * np.pi * (np.arange(1000) + 0.5) / 100))), 3)
+    1.111
     """
     x = _x(x, "shape_factor", axis)
     a = np.abs(x)

@@ -246,8 +246,11 @@ def plot_analysis(x, fs, *, bearing, rpm=None, shaft_hz=None, channel="", units=
         fm = result["fault_frequencies"][k]["measured_hz"]
         if fm is not None:
             fm = fm * (2 if k == "bsf" else 1)
-            ax3.annotate(f"{name} found {fm:.2f} Hz", xy=(fm, ymax), xytext=(fm, ymax * 1.05),
-                         color=c, fontsize=8, ha="center")
+            i = int(np.argmin(np.abs(ex["f"] - fm)))
+            ax3.plot([fm], [ex["ses"][i] * 1.04 + 0.02 * ymax], marker="v", ls="none", color=c, ms=7,
+                     label=f"{name} found {fm:.2f} Hz, {result['fault_frequencies'][k]['harmonics']} "
+                           f"harmonics, SNR {result['fault_frequencies'][k]['snr_db']:.0f} dB")
+    ax3.set_ylim(0, 1.15 * ymax)
     ax3.legend(loc="upper right", fontsize=8)
     if path is not None:
         fig.savefig(str(path), dpi=110)
