@@ -111,13 +111,16 @@ def _run(asm, method, rtol, *, progress, t_end_override=None, step=None, max_ste
     fine_out = np.zeros((fine_t.size, 2))
     out_state = np.zeros((n_out, n))
     A, b, e, c, order, fsal = method
+    rtol = float(rtol)
+    defect_steps = float(defect_steps)
     adaptive = bool(np.any(e != 0))
     hmax = max_step if max_step is not None else d["solver"]["max_step_s"]
     if not adaptive:
-        h = step if step is not None else d["solver"]["step_s"]
+        h = float(step if step is not None else d["solver"]["step_s"])
         hmax = h
     else:
         h = min(1e-6, hmax)
+    hmax = float(hmax)
     atol = asm.atol_scale * rtol
     y = asm.y0.copy()
     t = 0.0
