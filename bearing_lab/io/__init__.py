@@ -75,12 +75,17 @@ def guess_format(path) -> str:
     path = Path(path)
     with open(path, "rb") as fh:
         head = fh.read(8192)
+    corrupt = None
     for name, cls in ENGINES.items():
         try:
             if cls().guess_can_open(path, head):
                 return name
+        except RecordingError as exc:  # looks like the format but is damaged
+            corrupt = corrupt or exc
         except Exception:  # a sniffing accident is just "not mine"
             continue
+    if corrupt is not None:
+        raise corrupt
     msg = (f"{path}: no reader recognises this file (it starts with {head[:16]!r}); installed "
            f"engines: {_engine_list()}; if you know the format, pass format='<engine>' "
            "(CLI --format)")

@@ -9,6 +9,8 @@ order differs between files, so readers always look fields up by name.
 from __future__ import annotations
 
 import functools
+import struct
+import zlib
 from pathlib import Path
 
 import numpy as np
@@ -26,7 +28,7 @@ def mat_version(head: bytes) -> str | None:
 
 
 @functools.lru_cache(maxsize=64)
-def _variables(path: str, mtime: float, size: int) -> tuple[str, ...]:
+def _variables(path: str, mtime: int, size: int) -> tuple[str, ...]:
     with open(path, "rb") as fh:
         head = fh.read(1024)
     v = mat_version(head)
@@ -40,11 +42,30 @@ def _variables(path: str, mtime: float, size: int) -> tuple[str, ...]:
     return ()
 
 
+def _corrupt(path, exc):
+    from ..errors import RecordingError
+    return RecordingError(f"{path}: the MATLAB file is truncated or corrupt "
+                          f"({type(exc).__name__}: {exc}); export or download it again")
+
+
+_ERRORS = (OSError, ValueError, TypeError, KeyError, IndexError, EOFError, AttributeError,
+           NotImplementedError, zlib.error, struct.error, UnicodeDecodeError)
+
+
 def mat_variables(path) -> tuple[str, ...]:
-    """Return the variable names of a MATLAB file (empty if it is not one)."""
+    """Return the variable names of a MATLAB file (empty if it is not one).
+
+    Raises
+    ------
+    RecordingError
+        If the file says it is a MATLAB file but its variable table is unreadable.
+    """
     p = Path(path)
     st = p.stat()
-    return _variables(str(p), st.st_mtime, st.st_size)
+    try:
+        return _variables(str(p), st.st_mtime_ns, st.st_size)
+    except _ERRORS as exc:
+        raise _corrupt(p, exc) from exc
 
 
 def _plain(obj):
@@ -106,6 +127,13 @@ def load_mat(path, variable_names=None) -> dict:
     dict
         Variable name -> value (structs as dicts, strings as str, arrays squeezed).
     """
+    try:
+        return _load_mat(path, variable_names)
+    except _ERRORS as exc:
+        raise _corrupt(path, exc) from exc
+
+
+def _load_mat(path, variable_names):
     with open(path, "rb") as fh:
         head = fh.read(1024)
     v = mat_version(head)
