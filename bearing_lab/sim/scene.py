@@ -276,6 +276,8 @@ def _validate_mapping(raw: dict) -> dict:
             where = f"{key}.{sub}"
             if sub not in SCHEMA[key]:
                 raise SceneError(f"unknown key {where!r}; [{key}] keys are " + ", ".join(SCHEMA[key]))
+            if v is None:  # an unset optional key (as stored in Scene.data): keep the default
+                continue
             out[key][sub] = _check(v, sub, SCHEMA[key][sub], where)
     out["defect"] = defects
     return out

@@ -1,0 +1,33 @@
+"""`bearing-lab study paper`: the paper's four parametric studies."""
+from __future__ import annotations
+
+import sys
+
+from ..errors import BearingLabError
+
+
+def _study(args) -> int:
+    if args.which != "paper":
+        raise BearingLabError(f"study {args.which!r}: the only study set is 'paper'")
+    from ..studies import STUDIES, run_paper_studies
+    names = args.only or list(STUDIES)
+    bad = [n for n in names if n not in STUDIES]
+    if bad:
+        raise BearingLabError(f"--only {bad[0]!r}: allowed values are " + ", ".join(STUDIES))
+    table = run_paper_studies(args.output, progress=not args.quiet, studies=names)
+    for r in table.to_dataframe().itertuples():
+        print(f"{r.study:7s} {r.label:12s} peak disp {r.peak_displacement*1e6:7.4f} µm  "
+              f"peak acc {r.peak_acceleration/9.80665:7.2f} g  p-p {r.acceleration_peak_to_peak/9.80665:7.2f} g  "
+              f"duration {r.excitation_duration*1e3:6.3f} ms (L/v {r.crossing_time*1e3:6.3f} ms)")
+    print(f"wrote {args.output}/index.html, studies.nc and PNG figures "
+          f"({table.attrs['total_wall_time_s']:.1f} s)", file=sys.stderr)
+    return 0
+
+
+def register(sub) -> None:
+    p = sub.add_parser("study", help="run the paper's parametric studies (size, offset, skew, speed)")
+    p.add_argument("which", choices=["paper"], help="the study set")
+    p.add_argument("-o", "--output", default="reports/studies", metavar="DIR")
+    p.add_argument("--only", action="append", metavar="STUDY", help="size, offset, skew or speed")
+    p.add_argument("-q", "--quiet", action="store_true")
+    p.set_defaults(func=_study)
