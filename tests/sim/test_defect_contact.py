@@ -204,3 +204,27 @@ def test_halfspace_against_hertz_and_local_law():
     centre, edge = r["positions"]
     assert centre["local_law"] < centre["halfspace"] < 1.0
     assert edge["local_law"] < edge["halfspace"] < 1.0
+
+
+def test_ball_defect_tables():
+    """A ball defect against a race: the same contact-plane geometry as a race defect, with
+    psi measured on the ball (arc = ball radius * psi)."""
+    ball = Defect(race="ball", length=1e-3, width=1e-3)
+    race = Defect(race="outer", length=1e-3, width=1e-3)
+    assert rigid_drop(ball, B6308, against="outer") == pytest.approx(rigid_drop(race, B6308))
+    Tb = contact_table(ball, B6308, model="area", delta_max=DMAX, against="outer")
+    Tr = contact_table(race, B6308, model="area", delta_max=DMAX)
+    assert Tb.race == "ball/outer"
+    assert Tb.track_radius == pytest.approx(B6308.ball_diameter / 2)
+    k = _col(Tb, 8e-6)
+    assert Tb.G[_row(Tb, 0.0), k] == pytest.approx(Tr.G[_row(Tr, 0.0), k], rel=0.01)
+    s_b = Tb.psi * Tb.track_radius
+    s_r = Tr.psi * Tr.track_radius
+    assert s_b[0] == pytest.approx(s_r[0], rel=0.02) and s_b[-1] == pytest.approx(s_r[-1], rel=0.02)
+    Ti = contact_table(ball, B6308, model="drop", delta_max=DMAX, against="inner")
+    assert Ti.drop[_row(Ti, 0.0)] == pytest.approx(
+        rigid_drop(Defect(race="inner", length=1e-3, width=1e-3), B6308), rel=1e-6)
+    with pytest.raises(SceneError, match="against"):
+        contact_table(ball, B6308, model="area", delta_max=DMAX)
+    with pytest.raises(SceneError, match="against"):
+        contact_table(race, B6308, model="area", delta_max=DMAX, against="inner")

@@ -11,6 +11,8 @@ Conventions (SI)
           direction of increasing track coordinate ``s`` (see :mod:`.model`).  The table
           spans the defect's extent along the track plus the reach of the contact at
           ``delta_max`` plus a margin; outside ``[psi_min, psi_max]`` the contact is intact.
+          For a ball defect (``against="outer"|"inner"``) psi is the contact point's angle
+          ON THE BALL relative to the defect centre (arc ``r_b * psi``), same sense.
 ``delta`` the ball's approach to the race relative to the INTACT surface (m, >= 0 into the
           race: outward for the outer race, inward for the inner race); uniform grid from 0
           to ``delta_max``.  Negative approach: no contact.
@@ -115,7 +117,8 @@ class ContactTable:
     intact_fraction : (n_psi, n_delta); intact share of the interpenetration area.
     model, race : str.
     psi_min, psi_max : float, rad; the table's range (outside it the contact is intact).
-    track_radius : m, groove-bottom radius; the defect spans s = track_radius * psi.
+    track_radius : m, radius on the defected body: the groove-bottom radius for a race
+        defect, the ball radius for a ball defect; the defect spans s = track_radius * psi.
     info : dict of diagnostics (lattice sizes, build time, intact-law ratio).
     """
 
@@ -212,7 +215,8 @@ _CACHE_SIZE = 64
 
 
 def contact_table(defect: Defect, bearing, *, model: str, clearance: float = 0.0,
-                  delta_max: float, n_psi: int | None = None, n_delta: int = 41) -> ContactTable:
+                  delta_max: float, n_psi: int | None = None, n_delta: int = 41,
+                  against: str | None = None) -> ContactTable:
     """Tabulate the contact of a ball with the defected race (see the module docstring).
 
     Tables are cached in-process by their arguments (a defect's ``angle`` does not enter
@@ -229,8 +233,14 @@ def contact_table(defect: Defect, bearing, *, model: str, clearance: float = 0.0
         most loaded ball; 20e-6 for the 6308 at 480 N).
     n_psi : psi grid size; default: about 40 points per along-track contact reach.
     n_delta : delta grid size (default 41).
+    against : for a ball defect only, the race it strikes, "outer" or "inner" (build one
+        table per race).  psi is then measured on the ball: the contact point's angle on the
+        ball relative to the defect centre (arc ``ball_radius * psi``), and the outline is
+        laid on the contact plane to first order (ball arc = race arc); the floor gap is the
+        race's (intact gap + depth to first order).
     """
-    key = (_defect_key(defect), bearing, model, float(clearance), float(delta_max), n_psi, n_delta)
+    key = (_defect_key(defect), bearing, model, float(clearance), float(delta_max), n_psi, n_delta,
+           against)
     try:
         hit = _CACHE.get(key)
     except TypeError:       # unhashable bearing: no cache
@@ -238,7 +248,7 @@ def contact_table(defect: Defect, bearing, *, model: str, clearance: float = 0.0
     if hit is not None:
         return hit
     table = _build(defect, bearing, model=model, clearance=clearance, delta_max=delta_max,
-                   n_psi=n_psi, n_delta=n_delta)
+                   n_psi=n_psi, n_delta=n_delta, against=against)
     for name in ("psi", "delta", "G", "drop", "intact_fraction"):
         getattr(table, name).flags.writeable = False
     if key is not None:
@@ -253,22 +263,32 @@ def _defect_key(defect: Defect):
     return replace(defect, angle=0.0)
 
 
-def _build(defect, bearing, *, model, clearance, delta_max, n_psi, n_delta) -> ContactTable:
+def _build(defect, bearing, *, model, clearance, delta_max, n_psi, n_delta,
+           against=None) -> ContactTable:
     t0 = time.perf_counter()
     c0 = time.process_time()
     if model not in CONTACT_MODELS:
         raise SceneError(f"Invalid value for the 'model' parameter. Allowed values are "
                          f"{', '.join(map(repr, CONTACT_MODELS))}, but got {model!r} instead.")
-    if defect.race == "ball":
-        raise NotImplementedError("contact_table: ball defects are not implemented yet")
     if not (math.isfinite(delta_max) and delta_max > 0):
         raise SceneError(f"{delta_max=} m must be positive and finite")
     if n_delta < 3:
         raise SceneError(f"{n_delta=} must be at least 3")
     if n_psi is not None and n_psi < 8:
         raise SceneError(f"{n_psi=} must be at least 8")
-    geom = RaceGeometry.from_bearing(bearing, defect.race, clearance=clearance)
-    R = geom.track_radius
+    if defect.race == "ball":
+        if against not in ("outer", "inner"):
+            raise SceneError(f"a ball defect needs against='outer' or 'inner' (the race it "
+                             f"strikes), got {against!r}")
+        geom = RaceGeometry.from_bearing(bearing, against, clearance=clearance)
+        R = geom.ball_radius          # psi is measured on the ball
+    else:
+        if against not in (None, defect.race):
+            raise SceneError(f"against={against!r} is only for ball defects "
+                             f"(this defect is on the {defect.race} race)")
+        geom = RaceGeometry.from_bearing(bearing, defect.race, clearance=clearance)
+        R = geom.track_radius
+    Rg = geom.track_radius
     b_reach, a_reach = geom.reach(delta_max)
     if a_reach >= 0.9 * geom.z_limit:
         raise SceneError(f"{delta_max=} m: the contact would reach the groove's edge; "
@@ -288,9 +308,9 @@ def _build(defect, bearing, *, model, clearance, delta_max, n_psi, n_delta) -> C
     delta = np.linspace(0.0, delta_max, n_delta)
 
     # ---- geometric drops (exact, no lattice)
-    drop2 = drop_profile_2d(defect, geom, psi)
+    drop2 = drop_profile_2d(defect, geom, psi, psi_radius=R)
     if model == "profile":
-        drop = drop_profile_1d(defect, geom, psi)
+        drop = drop_profile_1d(defect, geom, psi, psi_radius=R)
     else:
         drop = drop2
 
@@ -302,8 +322,8 @@ def _build(defect, bearing, *, model, clearance, delta_max, n_psi, n_delta) -> C
     nzh = math.ceil(a_w / dz)
     z = (np.arange(2 * nzh) - nzh + 0.5) * dz
     srel = np.arange(-nb, nb + 1) * ds
-    h0 = geom.approach(srel[:, None] / R, z[None, :])
-    hf = geom.approach(srel[:, None] / R, z[None, :], depth=defect.depth)
+    h0 = geom.approach(srel[:, None] / Rg, z[None, :])
+    hf = geom.approach(srel[:, None] / Rg, z[None, :], depth=defect.depth)
     n_glob = (n_psi - 1) * m + 2 * nb + 1
     s_glob = psi[0] * R + (np.arange(n_glob) - nb) * ds
     f = _coverage(defect, s_glob, z, ds, dz)
@@ -379,5 +399,5 @@ def _build(defect, bearing, *, model, clearance, delta_max, n_psi, n_delta) -> C
     if model == "halfspace":
         info.update(info_hs)
     return ContactTable(psi=psi, delta=delta, G=G, drop=drop, intact_fraction=intact_fraction,
-                        model=model, race=defect.race, psi_min=float(psi[0]),
+                        model=model, race=defect.race if defect.race != "ball" else f"ball/{against}", psi_min=float(psi[0]),
                         psi_max=float(psi[-1]), track_radius=R, info=info)

@@ -162,15 +162,19 @@ def _boundary_points(defect: Defect, geom: RaceGeometry, spacing: float | None =
     return s[keep], z[keep]
 
 
-def drop_profile_2d(defect: Defect, geom: RaceGeometry, psi, *, chunk: int = 64) -> np.ndarray:
+def drop_profile_2d(defect: Defect, geom: RaceGeometry, psi, *, chunk: int = 64,
+                    psi_radius: float | None = None) -> np.ndarray:
     """Rigid-ball drop (m) at ball positions ``psi`` (rad from the defect centre), 3-D.
 
     ``drop = 0`` where the point under the ball centre is intact; otherwise the smallest
-    approach over the defect outline, capped by the depth (the floor).
+    approach over the defect outline, capped by the depth (the floor).  ``psi_radius``
+    converts psi to arc length on the defected body (default: the groove bottom; the ball
+    radius for a ball defect, whose outline is laid on the contact plane).
     """
     psi = np.atleast_1d(np.asarray(psi, dtype=float))
     R = geom.track_radius
-    inside = defect.contains(psi * R, np.zeros_like(psi))
+    Rp = R if psi_radius is None else psi_radius
+    inside = defect.contains(psi * Rp, np.zeros_like(psi))
     out = np.zeros_like(psi)
     if not np.any(inside):
         return out
@@ -178,16 +182,16 @@ def drop_profile_2d(defect: Defect, geom: RaceGeometry, psi, *, chunk: int = 64)
     if sb.size == 0:
         out[inside] = defect.depth
         return out
-    phib = sb / R
     idx = np.flatnonzero(inside)
     for i in range(0, idx.size, chunk):
         j = idx[i:i + chunk]
-        h = geom.approach(phib[None, :] - psi[j, None], zb[None, :])
+        h = geom.approach((sb[None, :] - Rp * psi[j, None]) / R, zb[None, :])
         out[j] = np.clip(h.min(axis=1), 0.0, defect.depth)
     return out
 
 
-def drop_profile_1d(defect: Defect, geom: RaceGeometry, psi) -> np.ndarray:
+def drop_profile_1d(defect: Defect, geom: RaceGeometry, psi, *,
+                    psi_radius: float | None = None) -> np.ndarray:
     """Drop (m) for the along-track reduction of the defect ("profile" model).
 
     The defect is replaced by its intervals along the track centre line, each extended to
@@ -196,11 +200,12 @@ def drop_profile_1d(defect: Defect, geom: RaceGeometry, psi) -> np.ndarray:
     """
     psi = np.atleast_1d(np.asarray(psi, dtype=float))
     R = geom.track_radius
+    Rp = R if psi_radius is None else psi_radius
     out = np.zeros_like(psi)
     intervals = defect.centreline_intervals()
     if not intervals:
         return out
-    s = psi * R
+    s = psi * Rp
     inside = np.zeros(psi.shape, dtype=bool)
     for a, b in intervals:
         inside |= (s >= a) & (s <= b)
@@ -209,21 +214,25 @@ def drop_profile_1d(defect: Defect, geom: RaceGeometry, psi) -> np.ndarray:
     edges = np.array([e for ab in intervals for e in ab])
     z = np.linspace(-geom.z_limit, geom.z_limit, 8001)
     j = np.flatnonzero(inside)
-    h = geom.approach(edges[None, :, None] / R - psi[j, None, None], z[None, None, :])
+    h = geom.approach((edges[None, :, None] - Rp * psi[j, None, None]) / R, z[None, None, :])
     out[j] = np.clip(h.min(axis=(1, 2)), 0.0, defect.depth)
     return out
 
 
-def rigid_drop(defect: Defect, bearing, *, clearance: float = 0.0) -> float:
+def rigid_drop(defect: Defect, bearing, *, clearance: float = 0.0,
+               against: str | None = None) -> float:
     """How far (m) a rigid ball centred over the defect moves out before it touches.
 
     The ball centre is at the defect centre's angular position and on the track centre
     line (z = 0), exact sphere in the exact torus groove (see the module docstring).  For
     the 6308 outer race and a 1 x 1 mm, 0.5 mm deep defect this is 0.9413 µm
-    (``reference.md``).
+    (``reference.md``).  A ball defect needs ``against`` ("outer" or "inner"): the defect
+    centre at the contact point, its outline laid on the contact plane (first order).
     """
     if defect.race == "ball":
-        raise NotImplementedError("rigid_drop: ball defects are not implemented; "
-                                  "give race='outer' or 'inner'")
-    geom = RaceGeometry.from_bearing(bearing, defect.race, clearance=clearance)
+        if against not in ("outer", "inner"):
+            raise SceneError(f"a ball defect needs against='outer' or 'inner', got {against!r}")
+        geom = RaceGeometry.from_bearing(bearing, against, clearance=clearance)
+    else:
+        geom = RaceGeometry.from_bearing(bearing, defect.race, clearance=clearance)
     return float(drop_profile_2d(defect, geom, [0.0])[0])
