@@ -190,6 +190,19 @@ class RecordingBuilder:
         self.channels: dict[str, tuple[np.ndarray, dict]] = {}
         self.attrs: dict = {}
         self.sha256: str | None = None
+        self._hash_thread = None
+        if checksum:
+            # hash in parallel with parsing (hashlib releases the GIL); joined in build()
+            import threading
+            self._hash_result = {}
+
+            def _work():
+                try:
+                    self._hash_result["sha"] = file_sha256(self.path)
+                except OSError as exc:  # reported by the reader's own open
+                    self._hash_result["err"] = exc
+            self._hash_thread = threading.Thread(target=_work, daemon=True)
+            self._hash_thread.start()
         self._used_units = set()
         self._sens_ignored: list[str] = []
 
@@ -311,19 +324,27 @@ class RecordingBuilder:
             self.warn(f"channel {name!r} is a flat line (all {n} samples equal {lo:g})")
             return
         for ext, word in ((hi, "maximum"), (lo, "minimum")):
-            starts, lengths = _runs(x == ext)
+            at = x == ext
+            if np.count_nonzero(at) < 3:  # the usual case: one sample at the extreme
+                continue
+            starts, lengths = _runs(at)
             long = lengths >= 3
             if long.any():
                 self.warn(f"channel {name!r}: {int(lengths[long].sum())} samples in "
                           f"{int(long.sum())} runs stuck at the {word} {ext:.6g}: probable clipping")
-        same = np.diff(x) == 0
-        starts, lengths = _runs(same)
-        if lengths.size:
-            longest = int(lengths.max()) + 1
-            if longest >= max(100, n // 100):
-                i = int(starts[int(np.argmax(lengths))])
-                self.warn(f"channel {name!r} is flat for {longest} samples from sample {i} "
-                          "(dropout or stuck sensor?)")
+        # longest run of equal consecutive samples, from the change points only
+        limit = max(100, n // 100)
+        same = x[1:] == x[:-1]
+        if np.count_nonzero(same) < limit - 1:  # no run that long can exist: skip the scan
+            return
+        change = np.flatnonzero(~same)
+        bounds = np.concatenate(([-1], change, [n - 1]))
+        lengths = np.diff(bounds)
+        k = int(np.argmax(lengths))
+        longest = int(lengths[k])
+        if longest >= limit:
+            self.warn(f"channel {name!r} is flat for {longest} samples from sample "
+                      f"{int(bounds[k]) + 1} (dropout or stuck sensor?)")
 
     # -- dataset --------------------------------------------------------------------
     def select(self, channels):
@@ -387,7 +408,13 @@ class RecordingBuilder:
                           "sort or repair the time column, or pass fs= and drop it")
             fs = 1.0 / float(np.median(dt))
         if self.sha256 is None:
-            self.sha256 = "" if not self.checksum else file_sha256(self.path, data)
+            if self._hash_thread is not None:
+                self._hash_thread.join()
+                if "err" in self._hash_result:
+                    self.fail(f"cannot read the file for its checksum ({self._hash_result['err']})")
+                self.sha256 = self._hash_result["sha"]
+            else:
+                self.sha256 = ""
         q_acc = [k for k, (_, a) in self.channels.items() if a.get("quantity") == "acceleration"]
         default = default_channel if default_channel in self.channels else \
             (q_acc[0] if q_acc else next(iter(self.channels)))

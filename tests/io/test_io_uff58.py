@@ -238,3 +238,33 @@ def test_wrong_byte_order_override(write, sine):
     raw = uff58_block(sine, binary=True, bo=2, double=True).replace(b"58b     2", b"58b     1", 1)
     ds = open_recording(write("wrong_bo2.uff", raw), byte_order="big")
     np.testing.assert_array_equal(ds["acc"].values, sine)
+
+
+def test_big_58b_scanned_header_first(tmp_path):
+    """A 1 GB 58b: the scan reads only headers (seeks past payloads), so it is instant.
+
+    The file is sparse (the payload is a hole), so this costs no disk and no memory.
+    """
+    import time
+    from bearing_lab.io._base import RecordingBuilder, map_file
+    from bearing_lab.io.uff58 import Uff58Reader
+    n = 2 ** 27  # float64 -> 1 GiB per set
+    p = tmp_path / "big.uff"
+    head = uff58_block(np.zeros(1), binary=True, num_pts=n, nbytes=n * 8)
+    head = head[: head.rindex(b"\n", 0, len(head) - 8) + 1]  # header only, up to the payload
+    with open(p, "wb") as fh:
+        fh.write(head)
+        fh.seek(len(head) + n * 8)
+        fh.write(b"    -1\n")
+    r = Uff58Reader()
+    r._force_bo = None
+    mm = map_file(p)
+    try:
+        t0 = time.perf_counter()
+        sets = r._scan(mm, RecordingBuilder(p, r, checksum=False), False)
+        elapsed = time.perf_counter() - t0
+    finally:
+        mm.close()
+    assert len(sets) == 1 and sets[0].header["num_pts"] == n
+    assert sets[0].data_end - sets[0].data_start == n * 8
+    assert elapsed < 0.5
