@@ -1,0 +1,52 @@
+"""Optional readers: NI TDMS (npTDMS) and ASAM MDF (asammdf); skipped when not installed."""
+import numpy as np
+import pytest
+
+from bearing_lab import RecordingError, open_recording
+from bearing_lab.io._testing import check_reader
+
+
+def test_tdms(tmp_path, sine):
+    nptdms = pytest.importorskip("nptdms")
+    p = tmp_path / "rig.tdms"
+    props = {"wf_increment": 1e-3, "wf_start_offset": 0.5, "unit_string": "g"}
+    with nptdms.TdmsWriter(p) as w:
+        w.write_segment([nptdms.ChannelObject("Vib", "DE", sine, properties=props),
+                         nptdms.ChannelObject("Vib", "FE", 2 * sine, properties=props)])
+    ds = check_reader(p, format="tdms", tmp_path=tmp_path)
+    assert list(ds.data_vars) == ["DE", "FE"]
+    assert ds.attrs["sampling_rate_hz"] == 1000.0 and ds.time.values[0] == 0.5
+    np.testing.assert_allclose(ds["FE"].values, 2 * sine * 9.80665)
+
+
+def test_tdms_different_rates(tmp_path, sine):
+    nptdms = pytest.importorskip("nptdms")
+    p = tmp_path / "rates.tdms"
+    with nptdms.TdmsWriter(p) as w:
+        w.write_segment([
+            nptdms.ChannelObject("G", "a", sine, properties={"wf_increment": 1e-3, "unit_string": "g"}),
+            nptdms.ChannelObject("G", "b", sine[::2], properties={"wf_increment": 2e-3,
+                                                                  "unit_string": "g"})])
+    with pytest.raises(RecordingError, match="rates.tdms: channels differ in rate"):
+        open_recording(p)
+    assert open_recording(p, channels=["b"]).attrs["sampling_rate_hz"] == 500.0
+
+
+def test_tdms_corrupt(tmp_path):
+    pytest.importorskip("nptdms")
+    p = tmp_path / "bad.tdms"
+    p.write_bytes(b"TDSm" + bytes(range(200)))
+    with pytest.raises(RecordingError, match="bad.tdms"):
+        open_recording(p)
+
+
+def test_mdf(tmp_path, sine):
+    asammdf = pytest.importorskip("asammdf")
+    p = tmp_path / "rig.mf4"
+    t = np.arange(sine.size) / 1000.0
+    m = asammdf.MDF(version="4.10")
+    m.append([asammdf.Signal(sine, t, name="DE", unit="g")])
+    m.save(p, overwrite=True)
+    ds = check_reader(p, format="mdf", tmp_path=tmp_path)
+    assert ds.attrs["sampling_rate_hz"] == pytest.approx(1000.0)
+    np.testing.assert_allclose(ds["DE"].values, sine * 9.80665)
