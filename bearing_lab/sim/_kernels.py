@@ -40,12 +40,19 @@ P_SENS, P_SW, P_SZ = 31, 32, 33
 P_FID = 34
 P_TSTEP, P_FIX2, P_FIY2, P_FOX2, P_FOY2 = 35, 36, 37, 38, 39
 P_NDEF = 40
-P_SIZE = 41
+P_SPIN = 41
+P_SIZE = 42
 
-# ---- defect table layout: dint[k] = race, kind, npsi, ndelta, h_off, g_off
-#                            dflt[k] = psi0, psi_first, dpsi, ddelta, zone_lo, zone_hi
-D_RACE, D_KIND, D_NPSI, D_NDEL, D_HOFF, D_GOFF = 0, 1, 2, 3, 4, 5
-F_PSI0, F_PSIF, F_DPSI, F_DDEL, F_ZLO, F_ZHI = 0, 1, 2, 3, 4, 5
+# ---- defect table layout: dint[k] = race, kind, npsi, ndelta, h_off, g_off, ball
+#   race 0: outer race, 1: inner race, 2: ball defect meeting the outer race,
+#   3: ball defect meeting the inner race (a ball defect has one table per race);
+#                            dflt[k] = psi0, psi_first, dpsi, ddelta, zone_lo, zone_hi, scale
+#   scale (ball defects): ball radius / track radius, mapping the defect's arc on the ball
+#   to the equivalent angle on the race table (to the Hertz paraboloid order the gap
+#   depends on the relative curvature only, so a pit on the ball meeting the race at the
+#   contact point is the same pit on the race meeting the ball).
+D_RACE, D_KIND, D_NPSI, D_NDEL, D_HOFF, D_GOFF, D_BALL = 0, 1, 2, 3, 4, 5, 6
+F_PSI0, F_PSIF, F_DPSI, F_DDEL, F_ZLO, F_ZHI, F_SCALE = 0, 1, 2, 3, 4, 5, 6
 
 TWO_PI = 2.0 * math.pi
 
@@ -161,63 +168,65 @@ def defect_force(kk, rel, reld, delta, delta_rate, k, p, dint, dflt, hbuf, gbuf)
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def find_zone(race, phi, phidot, theta_s, omega_s, ndef, dint, dflt):
-    """(defect index or -1, relative angle, relative angular speed) of a ball on ``race``."""
+def rel_angle(kk, j, phi, phidot, theta_s, omega_s, spin, dint, dflt):
+    """Relative angle (on the defect's table) and its rate for ball j and defect kk."""
+    race = dint[kk, D_RACE]
+    if race == 0:
+        return wrap(phi - dflt[kk, F_PSI0]), phidot
+    if race == 1:
+        return wrap(phi - dflt[kk, F_PSI0] - theta_s), phidot - omega_s
+    # ball defect: spin angle of the defect on ball D_BALL, 0 facing the outer race
+    if j != dint[kk, D_BALL]:
+        return 10.0, 0.0
+    theta_b = dflt[kk, F_PSI0] + spin * theta_s
+    if race == 3:
+        theta_b -= math.pi
+    sc = dflt[kk, F_SCALE]
+    return wrap(theta_b) * sc, spin * omega_s * sc
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def find_zone(contact, j, phi, phidot, theta_s, omega_s, spin, ndef, dint, dflt):
+    """(defect index or -1, relative angle, rate) for ball j's ``contact`` (0 outer, 1 inner)."""
     for kk in range(ndef):
-        if dint[kk, D_RACE] != race:
+        if dint[kk, D_RACE] % 2 != contact:
             continue
-        if race == 0:
-            rel = wrap(phi - dflt[kk, F_PSI0])
-            reld = phidot
-        else:
-            rel = wrap(phi - dflt[kk, F_PSI0] - theta_s)
-            reld = phidot - omega_s
+        rel, reld = rel_angle(kk, j, phi, phidot, theta_s, omega_s, spin, dint, dflt)
         if dflt[kk, F_ZLO] <= rel <= dflt[kk, F_ZHI]:
             return kk, rel, reld
     return -1, 0.0, 0.0
 
 
 @njit(cache=True, error_model="numpy")
-def _qs_ball(phi, phidot, theta_s, omega_s, dtot, dtot_rate, p, dint, dflt, hbuf, gbuf):
-    """Quasi-static (massless) ball: load through inner and outer contacts in series."""
-    ki = p[P_KI]
-    ndef = int(p[P_NDEF])
+def _qs_ball(kk, rel, reld, dtot, dtot_rate, p, dint, dflt, hbuf, gbuf):
+    """Quasi-static (massless) ball whose contact kk has a defect: load through the two
+    contacts in series."""
     e = p[P_EXP]
     cser = 0.5 * p[P_CMAX]  # two equal dampers in series
     dpen = p[P_DPEN]
-    for kk in range(ndef):
-        race = dint[kk, D_RACE]
-        if race == 0:
-            rel = wrap(phi - dflt[kk, F_PSI0])
-            reld = phidot
+    h, dh = _interp_h(kk, rel, dint, dflt, hbuf)
+    pen = dtot - h
+    pen_rate = dtot_rate - dh * reld
+    if pen <= 0.0:
+        return 0.0
+    if dint[kk, D_KIND] == 0:
+        return impact(pen, pen_rate, p[P_KEFF], e, cser, dpen)
+    # 2-D table on one contact, Hertz on the other: split the approach by bisection
+    outer = dint[kk, D_RACE] % 2 == 0
+    k_def = p[P_KO] if outer else p[P_KI]
+    k_oth = p[P_KI] if outer else p[P_KO]
+    lo = 0.0
+    hi = dtot
+    for _ in range(40):
+        mid = 0.5 * (lo + hi)
+        r = k_def * _interp_g(kk, rel, mid, dint, dflt, gbuf) - k_oth * (dtot - mid) ** 1.5
+        if r > 0.0:
+            hi = mid
         else:
-            rel = wrap(phi - dflt[kk, F_PSI0] - theta_s)
-            reld = phidot - omega_s
-        if rel < dflt[kk, F_ZLO] or rel > dflt[kk, F_ZHI]:
-            continue
-        h, dh = _interp_h(kk, rel, dint, dflt, hbuf)
-        pen = dtot - h
-        pen_rate = dtot_rate - dh * reld
-        if pen <= 0.0:
-            return 0.0
-        if dint[kk, D_KIND] == 0:
-            return impact(pen, pen_rate, p[P_KEFF], e, cser, dpen)
-        # 2-D table on one race, Hertz on the other: split the approach by bisection
-        k_def = p[P_KO] if race == 0 else p[P_KI]
-        k_oth = p[P_KI] if race == 0 else p[P_KO]
-        lo = 0.0
-        hi = dtot
-        for _ in range(40):
-            mid = 0.5 * (lo + hi)
-            r = k_def * _interp_g(kk, rel, mid, dint, dflt, gbuf) - k_oth * (dtot - mid) ** 1.5
-            if r > 0.0:
-                hi = mid
-            else:
-                lo = mid
-        q = k_oth * (dtot - 0.5 * (lo + hi)) ** 1.5
-        f = q + step_fn(pen, 0.0, 0.0, dpen, cser) * pen_rate
-        return f if f > 0.0 else 0.0
-    return impact(dtot, dtot_rate, p[P_KEFF], e, cser, dpen)
+            lo = mid
+    q = k_oth * (dtot - 0.5 * (lo + hi)) ** 1.5
+    f = q + step_fn(pen, 0.0, 0.0, dpen, cser) * pen_rate
+    return f if f > 0.0 else 0.0
 
 
 @njit(cache=True, error_model="numpy")
@@ -238,6 +247,7 @@ def rhs(t, y, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, dy, fi_out, fo_out):
     qs = p[P_FID] > 0.5
     ndef = int(p[P_NDEF])
     has_def = ndef > 0
+    spin = p[P_SPIN]
     base = 8
     c0 = math.cos(phic)
     s0 = math.sin(phic)
@@ -259,11 +269,11 @@ def rhs(t, y, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, dy, fi_out, fo_out):
             drate = (vxi - vxo) * c + (vyi - vyo) * s + ((xi - xo) * (-s) + (yi - yo) * c) * phidot
             kz = -1
             if has_def:
-                kz, relz, reldz = find_zone(0, phi, phidot, theta_s, omega_s, ndef, dint, dflt)
+                kz, relz, reldz = find_zone(0, j, phi, phidot, theta_s, omega_s, spin, ndef, dint, dflt)
                 if kz < 0:
-                    kz, relz, reldz = find_zone(1, phi, phidot, theta_s, omega_s, ndef, dint, dflt)
+                    kz, relz, reldz = find_zone(1, j, phi, phidot, theta_s, omega_s, spin, ndef, dint, dflt)
             if kz >= 0:
-                q = _qs_ball(phi, phidot, theta_s, omega_s, dtot, drate, p, dint, dflt, hbuf, gbuf)
+                q = _qs_ball(kz, relz, reldz, dtot, drate, p, dint, dflt, hbuf, gbuf)
             else:
                 q = impact(dtot, drate, p[P_KEFF], p[P_EXP], 0.5 * p[P_CMAX], p[P_DPEN])
             fi = q
@@ -278,8 +288,8 @@ def rhs(t, y, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, dy, fi_out, fo_out):
             ko = -1
             ki = -1
             if has_def:
-                ko, relo, reldo = find_zone(0, phi, phidot, theta_s, omega_s, ndef, dint, dflt)
-                ki, reli, reldi = find_zone(1, phi, phidot, theta_s, omega_s, ndef, dint, dflt)
+                ko, relo, reldo = find_zone(0, j, phi, phidot, theta_s, omega_s, spin, ndef, dint, dflt)
+                ki, reli, reldi = find_zone(1, j, phi, phidot, theta_s, omega_s, spin, ndef, dint, dflt)
             if ko >= 0:
                 fo = defect_force(ko, relo, reldo, d_o, d_or, p[P_KO], p, dint, dflt, hbuf, gbuf)
             else:
@@ -332,22 +342,17 @@ def _step_limit(t, h, p, sp_t, sp_w, sp_th, dint, dflt, nsteps_def, hmax):
     theta_s, omega_s = shaft_state(t, sp_t, sp_w, sp_th)
     phic = p[P_PHI0] + p[P_FTF] * theta_s
     phidot = p[P_FTF] * omega_s
+    spin = p[P_SPIN]
     hh = h
     for kk in range(ndef):
-        if dint[kk, D_RACE] == 0:
-            reld = phidot
-            off = dflt[kk, F_PSI0]
-        else:
-            reld = phidot - omega_s
-            off = dflt[kk, F_PSI0] + theta_s
-        if abs(reld) < 1e-12:
-            continue
         zlo = dflt[kk, F_ZLO]
         zhi = dflt[kk, F_ZHI]
-        hdef = (zhi - zlo) / abs(reld) / nsteps_def
         for j in range(z):
-            rel = wrap(phic + TWO_PI * j / z - off)
+            rel, reld = rel_angle(kk, j, phic + TWO_PI * j / z, phidot, theta_s, omega_s, spin, dint, dflt)
+            if rel > 5.0 or abs(reld) < 1e-12:
+                continue
             if zlo <= rel <= zhi:
+                hdef = (zhi - zlo) / abs(reld) / nsteps_def
                 if hdef < hh:
                     hh = hdef
             elif reld > 0.0 and rel < zlo:

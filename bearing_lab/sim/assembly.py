@@ -203,30 +203,38 @@ def assemble(scene: Scene, *, fidelity: str | None = None) -> Assembly:
         else:
             f_out2 = st["f_out"] - old + new
 
-    # defects -> tables
+    # defects -> tables (a ball defect gets one table per race it meets)
+    import dataclasses
+    from .defects import contact_table
     models, tables = [], []
-    dint = np.zeros((max(len(scene.defects), 1), 6), dtype=np.int64)
-    dflt = np.zeros((max(len(scene.defects), 1), 6))
-    hparts, gparts = [], []
-    hoff = goff = 0
+    entries = []  # (race code, defect used for the table, psi0, ball, model)
     static_max = float(np.max(st["ball_loads"])) if len(st["ball_loads"]) else 0.0
     delta_max = max(3.0 * (max(static_max, 50.0) / ho.stiffness) ** (2 / 3), 5e-6)
     for kk, defect in enumerate(scene.defects):
-        if defect.race not in ("outer", "inner"):
-            raise SceneError(f"defect race {defect.race!r} is not simulated yet (outer and inner are)")
         req = (d["defect"][kk] or {}).get("contact_model", "auto")
         model = choose_contact_model(defect, req, b)
-        from .defects import contact_table
-        tab = contact_table(defect, b, model=model, clearance=scene.clearance, delta_max=delta_max)
         models.append(model)
+        if defect.race == "ball":
+            for code, race in ((2, "outer"), (3, "inner")):
+                entries.append((code, dataclasses.replace(defect, race=race, angle=0.0),
+                                defect.angle, 0, model))
+        else:
+            entries.append((0 if defect.race == "outer" else 1, defect, lz + defect.angle, -1, model))
+    n_e = max(len(entries), 1)
+    dint = np.zeros((n_e, 7), dtype=np.int64)
+    dflt = np.zeros((n_e, 7))
+    hparts, gparts = [], []
+    hoff = goff = 0
+    for kk, (code, dfc, psi0, ball, model) in enumerate(entries):
+        tab = contact_table(dfc, b, model=model, clearance=scene.clearance, delta_max=delta_max)
         tables.append(tab)
         psi = np.asarray(tab.psi, dtype=float)
         kind = 1 if model == "area" else 0
         h = np.ascontiguousarray(tab.drop, dtype=float)
         G = np.ascontiguousarray(tab.G, dtype=float)
-        dint[kk] = [0 if defect.race == "outer" else 1, kind, len(psi), G.shape[1], hoff, goff]
-        dflt[kk] = [lz + defect.angle, psi[0], psi[1] - psi[0],
-                    tab.delta[1] - tab.delta[0], psi[0], psi[-1]]
+        scale = b.ball_diameter / 2 / tab.track_radius if code >= 2 else 1.0
+        dint[kk] = [code, kind, len(psi), G.shape[1], hoff, goff, ball]
+        dflt[kk] = [psi0, psi[0], psi[1] - psi[0], tab.delta[1] - tab.delta[0], psi[0], psi[-1], scale]
         hparts.append(h)
         gparts.append(G.ravel() if kind == 1 else np.zeros(0))
         hoff += len(h)
@@ -262,7 +270,8 @@ def assemble(scene: Scene, *, fidelity: str | None = None) -> Assembly:
     p[K.P_SW] = 2 * math.pi * sens["frequency_hz"]
     p[K.P_SZ] = sens["damping_ratio"]
     p[K.P_FID] = 1.0 if fid == "quasi-static" else 0.0
-    p[K.P_NDEF] = len(scene.defects)
+    p[K.P_NDEF] = len(entries)
+    p[K.P_SPIN] = b.frequency_factors()["bsf"]
 
     # initial state
     n_ball_states = 0 if fid == "quasi-static" else 2 * z
