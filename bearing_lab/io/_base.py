@@ -238,7 +238,7 @@ class RecordingBuilder:
         return option
 
     def add_channel(self, name, values, label, *, already_si=False, quantity=None,
-                    attrs=None, file_name=None):
+                    attrs=None, file_name=None, inplace=False):
         """Add one channel.
 
         Parameters
@@ -251,6 +251,7 @@ class RecordingBuilder:
         quantity : physical quantity when the file says it and the label does not.
         attrs : extra variable attributes (file metadata).
         file_name : the channel's name in the file, for ``units``/``sensitivity`` dicts.
+        inplace : the reader no longer needs ``values``: scale it in place (saves a copy).
         """
         name = self.unique_name(name)
         original = file_name if file_name is not None else name
@@ -259,9 +260,13 @@ class RecordingBuilder:
             self.fail(f"channel {name!r} has shape {x.shape}; expected one dimension")
         if x.dtype.kind not in "iuf":
             self.fail(f"channel {name!r} holds {x.dtype} values, not numbers")
-        x = x.astype(np.float64, copy=False)
-        bad = ~np.isfinite(x)
-        if bad.any():
+        if x.dtype != np.float64:
+            x = x.astype(np.float64)
+            inplace = True
+        with np.errstate(all="ignore"):
+            total = float(np.add.reduce(x)) if x.size else 0.0
+        bad = None if np.isfinite(total) else ~np.isfinite(x)  # one cheap pass when all is well
+        if bad is not None and bad.any():
             first = int(np.flatnonzero(bad)[0])
             self.fail(f"channel {name!r} holds {int(bad.sum())} NaN/Inf values (first at sample "
                       f"{first}); the file is corrupt or has gaps: repair or cut it")
@@ -298,6 +303,10 @@ class RecordingBuilder:
                 self._sens_ignored.append(name)
             if already_si or (unit.factor == 1.0 and unit.offset == 0.0):
                 si = x
+            elif inplace and x.flags.writeable:
+                si = np.multiply(x, unit.factor, out=x)
+                if unit.offset:
+                    si += unit.offset
             else:
                 si = x * unit.factor + unit.offset
             si_unit = unit.si

@@ -116,7 +116,7 @@ class CwruReader(RecordingReader):
         order = [c for c in ("DE", "FE", "BA") if c in found[rec]]
         for c in order:
             v = np.asarray(m[found[rec][c]], dtype=np.float64).ravel()
-            b.add_channel(c, v, None, file_name=found[rec][c],
+            b.add_channel(c, v, None, file_name=found[rec][c], inplace=True,
                           attrs={"location": {"DE": "drive end", "FE": "fan end",
                                               "BA": "base"}[c]})
         rpm = None

@@ -78,7 +78,7 @@ class MfptReader(RecordingReader):
                     b.attrs[f"mfpt_{k.lower()}_hz"] = float(np.ravel(m[k])[0])
                 except (TypeError, ValueError):
                     pass
-        b.add_channel("acc", gs.ravel(), None, file_name="bearing.gs")
+        b.add_channel("acc", gs.ravel(), None, file_name="bearing.gs", inplace=True)
         return b.build(fs=fs, shaft_speed_rpm=rpm, default_channel="acc", channels=channels)
 
 

@@ -515,7 +515,7 @@ class Uff58Reader(RecordingReader):
                           "uff_binary": int(st.binary)})
             if factor164 not in (None, 1.0):
                 attrs["uff_164_factor"] = factor164
-            b.add_channel(name, vals, label, attrs=attrs,
+            b.add_channel(name, vals, label, attrs=attrs, inplace=True,
                           quantity=_SPEC_QUANTITY.get(h["ordinate_spec_data_type"]))
         # rate
         inc, t0 = h0["abscissa_inc"], h0["abscissa_min"]
