@@ -130,3 +130,18 @@ def test_misses_track():
     assert not near.misses_track(B6308, 20e-6)       # reach across at 20 µm is ~2.3 mm
     assert near.misses_track(B6308, 2e-6)
     assert rigid_drop(far, B6308) == 0.0
+
+
+def test_polygon_and_ellipse_outlines():
+    """A polygon drawn as the rectangle gives the rectangle's tables; a 1 mm circle is held
+    by its axial extremes like the 1 x 1 mm square (0.9413 µm)."""
+    from bearing_lab.sim.defects import contact_table
+    rect = Defect(length=3e-3, width=1e-3, skew=math.radians(30), offset=0.2e-3)
+    poly = Defect(shape="polygon", length=3e-3, width=1e-3, skew=rect.skew, offset=rect.offset,
+                  vertices=tuple(map(tuple, rect.local_vertices().tolist())))
+    assert rigid_drop(poly, B6308) == pytest.approx(rigid_drop(rect, B6308), rel=1e-6)
+    Tr = contact_table(rect, B6308, model="area", delta_max=20e-6)
+    Tp = contact_table(poly, B6308, model="area", delta_max=20e-6, n_psi=Tr.psi.size)
+    np.testing.assert_allclose(Tp.G, Tr.G, rtol=1e-9, atol=1e-12 * 20e-6 ** 1.5)
+    circle = Defect(shape="ellipse", length=1e-3, width=1e-3)
+    assert rigid_drop(circle, B6308) * 1e6 == pytest.approx(0.9413, rel=0.01)
