@@ -190,19 +190,6 @@ class RecordingBuilder:
         self.channels: dict[str, tuple[np.ndarray, dict]] = {}
         self.attrs: dict = {}
         self.sha256: str | None = None
-        self._hash_thread = None
-        if checksum:
-            # hash in parallel with parsing (hashlib releases the GIL); joined in build()
-            import threading
-            self._hash_result = {}
-
-            def _work():
-                try:
-                    self._hash_result["sha"] = file_sha256(self.path)
-                except OSError as exc:  # reported by the reader's own open
-                    self._hash_result["err"] = exc
-            self._hash_thread = threading.Thread(target=_work, daemon=True)
-            self._hash_thread.start()
         self._used_units = set()
         self._sens_ignored: list[str] = []
 
@@ -417,13 +404,8 @@ class RecordingBuilder:
                           "sort or repair the time column, or pass fs= and drop it")
             fs = 1.0 / float(np.median(dt))
         if self.sha256 is None:
-            if self._hash_thread is not None:
-                self._hash_thread.join()
-                if "err" in self._hash_result:
-                    self.fail(f"cannot read the file for its checksum ({self._hash_result['err']})")
-                self.sha256 = self._hash_result["sha"]
-            else:
-                self.sha256 = ""
+            # after parsing, so the bytes come from the page cache (or the reader's map)
+            self.sha256 = file_sha256(self.path, data) if self.checksum else ""
         q_acc = [k for k, (_, a) in self.channels.items() if a.get("quantity") == "acceleration"]
         default = default_channel if default_channel in self.channels else \
             (q_acc[0] if q_acc else next(iter(self.channels)))
