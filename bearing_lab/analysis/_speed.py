@@ -205,8 +205,14 @@ def shaft_frequency(x, fs, *, window, rpm=None, prior_tolerance=0.05, fmin=5.0, 
                             mains_hz=mains_hz, rpm_given=rpm is not None, fmin=fmin)
 
 
-def _harmonic_family(x, fs, lo, hi, *, n_harmonics, method, mains_hz=(), rpm_given=False, fmin=None):
-    """Family search in [lo, hi] + interpolated refinement; returns (f0, n_lines)."""
+def _harmonic_family(x, fs, lo, hi, *, n_harmonics, method, mains_hz=(), rpm_given=False, fmin=None,
+                     harmonic_weight=2, details=False):
+    """Family search in [lo, hi] + interpolated refinement; returns (f0, n_lines[, best_snr_db]).
+
+    ``harmonic_weight``: harmonic h enters the least squares with weight
+    SNR_h * h**harmonic_weight (2 for noise-limited lines, the Cramer-Rao
+    scaling; 0 where lines broaden with h, as for impacts with random slip).
+    """
     n = x.size
     df = fs / n
     xw = x - x.mean()
@@ -262,7 +268,7 @@ def _harmonic_family(x, fs, lo, hi, *, n_harmonics, method, mains_hz=(), rpm_giv
             f0 = sub
             break
     # refinement
-    est, wts, hs = [], [], []
+    est, wts, hs, snrs = [], [], [], []
     for hh in h:
         k0 = int(round(hh * f0 / df))
         if k0 + 2 >= amp.size or k0 < 2:
@@ -275,10 +281,11 @@ def _harmonic_family(x, fs, lo, hi, *, n_harmonics, method, mains_hz=(), rpm_giv
         if abs(d) > 1:
             continue
         est.append((k + d) * df)
-        wts.append(10 ** (snr[k] / 10) * hh * hh)
+        wts.append(10 ** (snr[k] / 10) * float(hh) ** harmonic_weight)
+        snrs.append(float(snr[k]))
         hs.append(hh)
     if not est:
-        return f0, 0
+        return (f0, 0, 0.0) if details else (f0, 0)
     est, wts, hs = np.array(est), np.array(wts), np.array(hs)
     good = np.ones(est.size, bool)
     for _ in range(3):
@@ -288,5 +295,8 @@ def _harmonic_family(x, fs, lo, hi, *, n_harmonics, method, mains_hz=(), rpm_giv
             break
         good = new
     # weighted LS of f_h = h f_r with weights SNR_h: the mean of f_h/h weighted by SNR_h h**2
+    # (with harmonic_weight=2; see the docstring)
     fr = float(np.sum(wts[good] * est[good] / hs[good]) / np.sum(wts[good]))
+    if details:
+        return fr, int(good.sum()), float(max(snrs))
     return fr, int(good.sum())
