@@ -125,16 +125,22 @@ def _interp_h(k, psi, dint, dflt, hbuf):
 
 @njit(cache=True, error_model="numpy")
 def _interp_g(k, psi, delta, dint, dflt, gbuf):
-    """G(psi, delta) (m^1.5) of defect k, bilinear; linear extrapolation in delta."""
+    """G(psi, delta) (m^1.5) of defect k.
+
+    The table holds G^(2/3) (an approach-like quantity, m), interpolated bilinearly and
+    raised to 1.5: exact on intact surface (G^(2/3) = delta is linear) and for a rigid drop
+    (max(delta - h, 0)), where interpolating G itself would overstate the convex delta^1.5
+    between grid nodes.  Linear extrapolation above the grid's delta range.
+    """
     npsi = dint[k, D_NPSI]
     nd = dint[k, D_NDEL]
     off = dint[k, D_GOFF]
     dd = dflt[k, F_DDEL]
     x = (psi - dflt[k, F_PSIF]) / dflt[k, F_DPSI]
-    if x <= 0.0 or x >= npsi - 1:
-        return delta ** 1.5 if delta > 0.0 else 0.0
     if delta <= 0.0:
         return 0.0
+    if x <= 0.0 or x >= npsi - 1:
+        return delta * math.sqrt(delta)
     i = int(x)
     fx = x - i
     yv = delta / dd
@@ -150,7 +156,7 @@ def _interp_g(k, psi, delta, dint, dflt, gbuf):
     g0 = a00 + fy * (a01 - a00)
     g1 = a10 + fy * (a11 - a10)
     g = g0 + fx * (g1 - g0)
-    return g if g > 0.0 else 0.0
+    return g * math.sqrt(g) if g > 0.0 else 0.0
 
 
 @njit(cache=True, error_model="numpy")

@@ -231,7 +231,8 @@ def assemble(scene: Scene, *, fidelity: str | None = None) -> Assembly:
         psi = np.asarray(tab.psi, dtype=float)
         kind = 1 if model == "area" else 0
         h = np.ascontiguousarray(tab.drop, dtype=float)
-        G = np.ascontiguousarray(tab.G, dtype=float)
+        # the kernel interpolates G^(2/3) (see _kernels._interp_g)
+        G = np.ascontiguousarray(np.maximum(tab.G, 0.0) ** (2.0 / 3.0), dtype=float)
         scale = b.ball_diameter / 2 / tab.track_radius if code >= 2 else 1.0
         dint[kk] = [code, kind, len(psi), G.shape[1], hoff, goff, ball]
         dflt[kk] = [psi0, psi[0], psi[1] - psi[0], tab.delta[1] - tab.delta[0], psi[0], psi[-1], scale]
