@@ -228,3 +228,19 @@ def test_ball_defect_tables():
         contact_table(ball, B6308, model="area", delta_max=DMAX)
     with pytest.raises(SceneError, match="against"):
         contact_table(race, B6308, model="area", delta_max=DMAX, against="inner")
+
+
+def test_intact_fraction_of_hertz_ellipse():
+    """Ball centred on a 1 x 1 mm defect at 300 N: the Hertz ellipse (0.90 x 0.16 mm) keeps
+    only its parts beyond |z| = 0.5 mm: 1 - (2/pi)(asin(c) + c sqrt(1 - c^2)), c = 0.5/a."""
+    T = contact_table(Defect(length=1e-3, width=1e-3), B6308, model="area", delta_max=DMAX,
+                      n_delta=81)
+    d300 = (300 / 3.27e10) ** (2 / 3)
+    a = 0.897e-3
+    c = 0.5e-3 / a
+    expected = 1 - (2 / math.pi) * (math.asin(c) + c * math.sqrt(1 - c * c))
+    j = _row(T, 0.0)
+    got = np.interp(d300, T.delta, T.intact_fraction[j])
+    assert got == pytest.approx(expected, abs=0.01)
+    assert np.all(T.intact_fraction[:, 0] == 1.0)
+    assert np.all(T.intact_fraction[0] == 1.0)

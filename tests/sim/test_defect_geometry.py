@@ -145,3 +145,16 @@ def test_polygon_and_ellipse_outlines():
     np.testing.assert_allclose(Tp.G, Tr.G, rtol=1e-9, atol=1e-12 * 20e-6 ** 1.5)
     circle = Defect(shape="ellipse", length=1e-3, width=1e-3)
     assert rigid_drop(circle, B6308) * 1e6 == pytest.approx(0.9413, rel=0.01)
+
+
+@pytest.mark.parametrize("race,load,k,a_mm,b_mm", [
+    ("outer", 50, 3.27e10, 0.49, 0.09), ("outer", 300, 3.27e10, 0.90, 0.16),
+    ("outer", 600, 3.27e10, 1.13, 0.20), ("inner", 300, 3.50e10, 1.09, 0.11)])
+def test_hertz_semi_axes_reference(race, load, k, a_mm, b_mm):
+    """reference.md: semi-axes (a across, b along) and kappa = a/b (5.639 outer, 9.550 inner)."""
+    from bearing_lab.sim.defects.geometry import hertz_semi_axes
+    g = RaceGeometry.from_bearing(B6308, race)
+    a, b = hertz_semi_axes(g, (load / k) ** (2 / 3))
+    assert a * 1e3 == pytest.approx(a_mm, abs=0.006)
+    assert b * 1e3 == pytest.approx(b_mm, abs=0.006)
+    assert a / b == pytest.approx(5.639 if race == "outer" else 9.550, rel=1e-3)

@@ -83,8 +83,11 @@ the ball-centred window slides by whole cells; each cell carries the fraction of
 the outline (4 x 4 sub-samples), so G is smooth in psi.  The sum over the window is a
 correlation evaluated as ``2 n_b + 1`` small matrix products.
 
-The ``intact_fraction`` is geometric for every model: the share of the intact-surface
-interpenetration area ``{h_intact < delta}`` that lies outside the outline (1 at delta = 0).
+The ``intact_fraction`` is geometric and the same for every model: the share of the intact
+Hertz contact ellipse at that approach (semi-axes from :func:`.geometry.hertz_semi_axes`,
+0.90 x 0.16 mm at 300 N on the 6308 outer race) that lies outside the outline (1 at
+delta = 0).  ``info["interpenetration_fraction"]`` is the same for the local law's
+footprint ``{h_intact < delta}``.
 """
 from __future__ import annotations
 
@@ -96,7 +99,7 @@ import numpy as np
 
 from bearing_lab.errors import SceneError
 
-from .geometry import RaceGeometry, drop_profile_1d, drop_profile_2d
+from .geometry import RaceGeometry, drop_profile_1d, drop_profile_2d, hertz_semi_axes
 from .model import Defect
 
 CONTACT_MODELS = ("profile", "drop", "area", "halfspace")
@@ -118,7 +121,8 @@ class ContactTable:
     delta : (n_delta,) m, uniform from 0; approach relative to the intact surface.
     G : (n_psi, n_delta) m^1.5; normal force = K_hertz * G.
     drop : (n_psi,) m; rigid-ball drop allowed at each psi (the model's own geometry).
-    intact_fraction : (n_psi, n_delta); intact share of the interpenetration area.
+    intact_fraction : (n_psi, n_delta); share of the intact Hertz contact ellipse at that
+        approach that lies outside the outline (geometric, the same for every model).
     model, race : str.
     psi_min, psi_max : float, rad; the table's range (outside it the contact is intact).
     track_radius : m, radius on the defected body: the groove-bottom radius for a race
@@ -336,6 +340,13 @@ def _build(defect, bearing, *, model, clearance, delta_max, n_psi, n_delta,
     ind0 = (h0[:, :, None] < d).astype(float)              # (2nb+1, nz, n_delta)
     area0 = ind0.sum(axis=(0, 1))
     frac_loss = np.zeros((n_psi, n_delta))
+    a_h, b_h = hertz_semi_axes(geom, delta)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        indh = ((srel[:, None, None] / b_h[None, None, :]) ** 2
+                + (z[None, :, None] / a_h[None, None, :]) ** 2 < 1.0).astype(float)
+    indh[:, :, delta <= 0] = 0.0
+    areah = indh.sum(axis=(0, 1))
+    hertz_loss = np.zeros((n_psi, n_delta))
     need_area = model == "area"
     if need_area:
         w0 = np.sqrt(np.maximum(d - h0[:, :, None], 0.0))
@@ -349,11 +360,14 @@ def _build(defect, bearing, *, model, clearance, delta_max, n_psi, n_delta,
         if not fk.any():
             continue
         frac_loss += fk @ ind0[kk]
+        hertz_loss += fk @ indh[kk]
         if need_area:
             loss += fk @ D[kk]
     del rows
     with np.errstate(invalid="ignore", divide="ignore"):
-        intact_fraction = np.where(area0 > 0, 1.0 - frac_loss / np.where(area0 > 0, area0, 1.0), 1.0)
+        pen_fraction = np.where(area0 > 0, 1.0 - frac_loss / np.where(area0 > 0, area0, 1.0), 1.0)
+        intact_fraction = np.where(areah > 0, 1.0 - hertz_loss / np.where(areah > 0, areah, 1.0), 1.0)
+    pen_fraction = np.clip(pen_fraction, 0.0, 1.0)
     intact_fraction = np.clip(intact_fraction, 0.0, 1.0)
 
     d15 = delta ** 1.5
@@ -396,7 +410,8 @@ def _build(defect, bearing, *, model, clearance, delta_max, n_psi, n_delta,
         "build_time_s": time.perf_counter() - t0, "build_cpu_s": time.process_time() - c0,
         "lattice_ds_m": ds, "lattice_dz_m": dz, "lattice_window": (2 * nb + 1, 2 * nzh),
         "psi_substeps": m, "reach_along_m": b_reach, "reach_across_m": a_reach,
-        "misses_track": misses, "drop_2d": drop2,
+        "misses_track": misses, "drop_2d": drop2, "interpenetration_fraction": pen_fraction,
+        "hertz_semi_axes_m": (a_h, b_h),
     }
     if law is not None:
         info["intact_law_ratio"] = law
