@@ -8,7 +8,6 @@ line with exit status 2.
 """
 from __future__ import annotations
 
-import argparse
 import json
 import sys
 import warnings

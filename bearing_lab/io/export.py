@@ -10,7 +10,6 @@ a dataset 164 that declares SI units.
 """
 from __future__ import annotations
 
-import math
 from datetime import datetime
 from pathlib import Path
 

@@ -3,7 +3,6 @@
 Only :class:`RecordingError` may escape, and its message names the file.  Kept
 fast: few derandomized examples, small copies written to a temporary directory.
 """
-import os
 import tempfile
 import warnings
 from pathlib import Path

@@ -1,5 +1,4 @@
 """Data registry: conditions, CWRU rates, fetch from a mirror with hash check."""
-import os
 from pathlib import Path
 
 import pytest
