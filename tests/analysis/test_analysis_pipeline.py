@@ -1,0 +1,115 @@
+"""analyze(): contract.md JSON schema, plot, and the `bearing-lab analyze` command."""
+import json
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from bearing_lab.analysis import analyze, plot_analysis
+from bearing_lab.cli import main
+from bearing_lab.errors import AnalysisError
+
+FAULT_KEYS = {"expected_hz", "measured_hz", "snr_db", "harmonics"}
+METRIC_KEYS = {"rms", "peak", "peak_to_peak", "crest_factor", "kurtosis", "impulse_factor",
+               "clearance_factor", "shape_factor"}
+TOP_KEYS = {"channel", "sampling_rate_hz", "shaft_hz", "diagnosis", "fault_frequencies",
+            "excitation_period_s", "metrics", "units"}
+
+
+def _outer_race_signal(fs=12000.0, seconds=10.0, fr=1797 / 60, seed=0):
+    t = np.arange(int(fs * seconds)) / fs
+    tau = t % (1 / (3.5848 * fr))
+    x = np.exp(-900 * tau) * np.sin(2 * np.pi * 3000 * tau)
+    x = x + 0.3 * sum(np.cos(2 * np.pi * h * fr * t + h) / h for h in range(1, 12))
+    return x + np.random.default_rng(seed).normal(0, 0.3, t.size), fs, fr
+
+
+def check_schema(r):
+    assert set(r) == TOP_KEYS
+    assert set(r["fault_frequencies"]) == {"bpfo", "bpfi", "bsf", "ftf"}
+    for v in r["fault_frequencies"].values():
+        assert set(v) == FAULT_KEYS
+        assert isinstance(v["expected_hz"], float) and isinstance(v["snr_db"], float)
+        assert v["measured_hz"] is None or isinstance(v["measured_hz"], float)
+        assert isinstance(v["harmonics"], int)
+    assert set(r["metrics"]) == METRIC_KEYS
+    assert all(isinstance(v, float) and np.isfinite(v) for v in r["metrics"].values())
+    assert r["diagnosis"] in ("outer_race", "inner_race", "ball", "none")
+    assert r["excitation_period_s"] is None or isinstance(r["excitation_period_s"], float)
+    json.dumps(r, allow_nan=False)
+
+
+def test_analyze_synthetic_outer_race_follows_contract():
+    x, fs, fr = _outer_race_signal()
+    r = analyze(x, fs, bearing="6205", channel="DE", units="m s-2")
+    check_schema(r)
+    assert r["diagnosis"] == "outer_race"
+    assert r["shaft_hz"] == pytest.approx(fr, abs=2e-3)
+    assert r["fault_frequencies"]["bpfo"]["measured_hz"] == pytest.approx(3.5848 * fr, rel=2e-3)
+    assert r["excitation_period_s"] == pytest.approx(1 / (3.5848 * fr), rel=1e-5)
+    assert r["channel"] == "DE" and r["units"] == "m s-2"
+
+
+def test_analyze_refuses_bad_input():
+    x, fs, _ = _outer_race_signal(seconds=2.0)
+    with pytest.raises(AnalysisError, match="bearing"):
+        analyze(x, fs, bearing="9999")
+    with pytest.raises(AnalysisError, match="NaN"):
+        analyze(np.r_[x, np.nan], fs, bearing="6205")
+    with pytest.raises(AnalysisError, match="fs"):
+        analyze(x, None, bearing="6205")
+    with pytest.raises(AnalysisError, match="too low"):
+        analyze(x, 1000.0, bearing="6205", shaft_hz=30.0)
+
+
+def test_plot_writes_png(tmp_path):
+    x, fs, _ = _outer_race_signal(seconds=3.0)
+    fig, r = plot_analysis(x, fs, bearing="6205", rpm=1797, path=tmp_path / "a.png")
+    assert (tmp_path / "a.png").stat().st_size > 10_000
+    assert len(fig.axes) == 3
+    assert "BPFO" in " ".join(t.get_text() for t in fig.axes[2].get_legend().get_texts())
+
+
+def _nc(tmp_path, x, fs):
+    t = np.arange(x.size) / fs
+    ds = xr.Dataset({"acc": ("time", x, {"units": "m s-2"})},
+                    coords={"time": ("time", t, {"units": "s"})},
+                    attrs={"sampling_rate_hz": fs, "bearing_lab_version": "0.1.0", "bearing": "6205",
+                           "shaft_speed_rpm": 1797.0})
+    path = tmp_path / "sig.nc"
+    ds.to_netcdf(path)
+    return path
+
+
+def test_cli_analyze_json_and_plot(tmp_path, capsys):
+    x, fs, fr = _outer_race_signal()
+    path = _nc(tmp_path, x, fs)
+    png = tmp_path / "fig.png"
+    assert main(["analyze", str(path), "--json", "--rpm", "file", "--plot", str(png)]) == 0
+    r = json.loads(capsys.readouterr().out)
+    check_schema(r)
+    assert r["diagnosis"] == "outer_race" and r["channel"] == "acc"
+    assert png.is_file()
+    assert main(["analyze", str(path), "--bearing", "6205"]) == 0
+    out = capsys.readouterr().out
+    assert "diagnosis: outer_race" in out and "BPFO" in out
+
+
+def test_cli_analyze_bad_input_exits_2(tmp_path, capsys):
+    x, fs, _ = _outer_race_signal(seconds=2.0)
+    path = _nc(tmp_path, x, fs)
+    assert main(["analyze", str(tmp_path / "missing.nc")]) == 2
+    assert main(["analyze", str(path), "--channel", "nope"]) == 2
+    err = capsys.readouterr().err
+    assert "nope" in err and err.count("\n") == 2
+    assert main(["analyze", str(path), "--rpm", "fast"]) == 2
+
+
+@pytest.mark.data
+def test_cli_analyze_real_recording(datafile, capsys):
+    path = datafile("cwru/130_OR007@6_0.mat")
+    assert main(["analyze", str(path), "--json"]) == 0
+    r = json.loads(capsys.readouterr().out)
+    check_schema(r)
+    assert r["diagnosis"] == "outer_race"
+    assert r["units"] == "m s-2"
