@@ -102,6 +102,7 @@ def open_recording(path, format=None, **options):
         ``.mat``, IMS ASCII, TDMS, MDF4, or a bearing_lab ``.nc``).
     format : str, optional
         Reader name (see :func:`list_engines`); sniffed from the content if None.
+        ``engine=`` is accepted as an alias (xarray's spelling).
     **options
         Passed to the reader's ``open_dataset`` (e.g. ``fs=12000``,
         ``sensitivity="9.91mV/g"``, ``channels=["DE"]``, ``units="g"``).
@@ -127,6 +128,11 @@ def open_recording(path, format=None, **options):
     ('m s-2', 12000.0)
     """
     path = Path(path)
+    if "engine" in options:  # xarray's spelling, accepted as an alias of format=
+        engine = options.pop("engine")
+        if format is not None and engine != format:
+            raise RecordingError(f"{path}: format={format!r} and engine={engine!r} disagree")
+        format = engine
     if not path.exists():
         raise RecordingError(f"{path}: file not found")
     if path.is_dir():

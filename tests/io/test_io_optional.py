@@ -50,3 +50,35 @@ def test_mdf(tmp_path, sine):
     ds = check_reader(p, format="mdf", tmp_path=tmp_path)
     assert ds.attrs["sampling_rate_hz"] == pytest.approx(1000.0)
     np.testing.assert_allclose(ds["DE"].values, sine * 9.80665)
+
+
+def test_tdms_fuzz(tmp_path, sine):
+    nptdms = pytest.importorskip("nptdms")
+    from hypothesis import HealthCheck, given, settings, strategies as st
+    src = tmp_path / "src.tdms"
+    with nptdms.TdmsWriter(src) as w:
+        w.write_segment([nptdms.ChannelObject("G", "a", sine[:300], properties={
+            "wf_increment": 1e-3, "unit_string": "g"})])
+    data = src.read_bytes()
+
+    @settings(max_examples=15, deadline=None, derandomize=True,
+              suppress_health_check=[HealthCheck.function_scoped_fixture])
+    @given(cut=st.floats(0, 1), flips=st.lists(st.tuples(st.floats(0, 1), st.integers(0, 255)),
+                                               max_size=5))
+    def run(cut, flips):
+        b = bytearray(data[:max(1, int(len(data) * cut))])
+        for pos, val in flips:
+            b[int(pos * (len(b) - 1))] = val
+        p = tmp_path / "fz.tdms"
+        p.write_bytes(bytes(b))
+        try:
+            open_recording(p, format="tdms")
+        except RecordingError as exc:
+            assert "fz.tdms" in str(exc)
+
+    run()
+
+
+def test_engine_alias(datafile):
+    ds = open_recording(datafile("lms/binary8byte_g.uff"), engine="uff58")
+    assert ds.attrs["reader"] == "uff58"
