@@ -190,6 +190,12 @@ class Uff58Reader(RecordingReader):
                     need = st.n_values * st.itemsize
                 else:
                     need = nbytes
+                shift = self._leading_break(mm, pos, need)
+                if shift:
+                    b.warn(f"set {st.index}: {shift} line-break byte(s) before the binary data "
+                           "skipped (a writer quirk)")
+                    pos += shift
+                    st.data_start = pos
                 avail = n - pos
                 if need > avail:
                     st.truncated = True
@@ -224,6 +230,22 @@ class Uff58Reader(RecordingReader):
                     self._parse_header58(st, b)
                 sets.append(st)
         return sets
+
+    @staticmethod
+    def _closes_at(mm, pos):
+        """True if the bytes at ``pos`` are blanks/line breaks then a '-1' line (or EOF)."""
+        tail = bytes(mm[pos:pos + 16])
+        stripped = tail.lstrip(b"\r\n")
+        return stripped.lstrip(b" ").startswith(b"-1") or (not stripped and pos >= len(mm) - 2)
+
+    def _leading_break(self, mm, pos, need):
+        """Bytes of stray CR/LF before a binary payload (some writers add them), else 0."""
+        if self._closes_at(mm, pos + need):
+            return 0
+        for k in (1, 2):
+            if bytes(mm[pos:pos + k]) in (b"\n", b"\r\n", b"\r") and self._closes_at(mm, pos + k + need):
+                return k
+        return 0
 
     def _after_binary(self, mm, b, st, pos):
         """Return the position after the closing delimiter of a binary set."""

@@ -268,3 +268,12 @@ def test_big_58b_scanned_header_first(tmp_path):
     assert len(sets) == 1 and sets[0].header["num_pts"] == n
     assert sets[0].data_end - sets[0].data_start == n * 8
     assert elapsed < 0.5
+
+
+def test_line_break_before_payload(write, sine):
+    raw = uff58_block(sine, binary=True)
+    i = raw.index(b"NONE                 NONE                \n", raw.index(b"Acceleration")) + 42
+    i = raw.index(b"\n", raw.index(b"NONE", i)) + 1  # end of the 11th header line
+    ds = open_recording(write("crlf.uff", raw[:i] + b"\r\n" + raw[i:]))
+    np.testing.assert_array_equal(ds["acc"].values, sine)
+    assert "line-break" in ds.attrs["warnings"]
