@@ -82,3 +82,19 @@ def test_tdms_fuzz(tmp_path, sine):
 def test_engine_alias(datafile):
     ds = open_recording(datafile("lms/binary8byte_g.uff"), engine="uff58")
     assert ds.attrs["reader"] == "uff58"
+
+
+def test_mdf_two_rasters_and_corrupt(tmp_path, sine):
+    asammdf = pytest.importorskip("asammdf")
+    p = tmp_path / "rasters.mf4"
+    m = asammdf.MDF(version="4.10")
+    m.append([asammdf.Signal(sine, np.arange(sine.size) / 1000.0, name="DE", unit="g")])
+    m.append([asammdf.Signal(sine[::2], np.arange(sine.size // 2) / 500.0, name="FE", unit="g")])
+    m.save(p, overwrite=True)
+    with pytest.raises(RecordingError, match="rasters.mf4: channels 'DE' and 'FE' have different"):
+        open_recording(p)
+    assert open_recording(p, channels=["FE"]).attrs["sampling_rate_hz"] == pytest.approx(500.0)
+    bad = tmp_path / "bad.mf4"
+    bad.write_bytes(p.read_bytes()[:300])
+    with pytest.raises(RecordingError, match="bad.mf4"):
+        open_recording(bad)
