@@ -491,7 +491,6 @@ class Uff58Reader(RecordingReader):
         for i, name in picked:
             st = times[i]
             h = st.header
-            inc_raw = h["abscissa_inc"]
             key = (h["num_pts"], h["abscissa_spacing"], h["abscissa_inc_text"],
                    h["abscissa_min_text"])
             groups.setdefault(key, []).append((i, name))
@@ -524,7 +523,8 @@ class Uff58Reader(RecordingReader):
                            "with channels=[...]")
             label = h["ordinate_axis_units_lab"]
             factor164 = None
-            if not label or label.upper() == "NONE":
+            if (not label or label.upper() == "NONE") and b.units is None:
+                # no label: the spec data type, unit exponents and dataset 164 say it
                 label, factor164 = self._unit_from_164(st, units164)
                 if factor164 not in (None, 1.0):
                     vals = np.asarray(vals, dtype=np.float64) * factor164
