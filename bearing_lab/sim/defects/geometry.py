@@ -237,10 +237,16 @@ def drop_profile_1d(defect: Defect, geom: RaceGeometry, psi, *,
     if not np.any(inside):
         return out
     edges = np.array([e for ab in intervals for e in ab])
-    z = np.linspace(-geom.z_limit, geom.z_limit, 8001)
     j = np.flatnonzero(inside)
-    h = geom.approach((edges[None, :, None] - Rp * psi[j, None, None]) / R, z[None, None, :])
-    out[j] = np.clip(h.min(axis=(1, 2)), 0.0, defect.depth)
+    dphi = (edges[None, :, None] - Rp * psi[j, None, None]) / R
+    # minimum over each full-width edge line: coarse scan in z, then a fine one around it
+    z = np.linspace(-geom.z_limit, geom.z_limit, 401)
+    h = geom.approach(dphi, z[None, None, :])
+    zc = z[np.argmin(h, axis=2)]                                  # (n, n_edges)
+    dz = z[1] - z[0]
+    zf = zc[:, :, None] + np.linspace(-dz, dz, 401)[None, None, :]
+    hf = geom.approach(dphi, zf)
+    out[j] = np.clip(np.minimum(h.min(axis=2), hf.min(axis=2)).min(axis=1), 0.0, defect.depth)
     return out
 
 
