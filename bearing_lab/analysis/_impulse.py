@@ -65,8 +65,8 @@ resolved : duration spans at least two sample intervals.
 """
 
 
-def _duration_1d(y, fs, level):
-    y = y - np.median(y)
+def _duration_1d(y, fs, level, baseline=None):
+    y = y - (np.median(y) if baseline is None else baseline)
     e = np.abs(y)
     p = e.max()
     if p == 0:
@@ -85,21 +85,35 @@ def _duration_1d(y, fs, level):
     return (t1 - t0) / fs, t0 / fs, t1 / fs
 
 
-def excitation_duration(x, fs, *, level=0.1, axis=-1):
+def excitation_duration(x, fs, *, level=0.1, baseline="median", axis=-1):
     """Excitation duration of one pulse (e.g. one defect passage), with entry and exit times.
 
-    The whole input along ``axis`` is taken as one impulse segment; see the
-    module docstring for the definition (first and last crossing of
-    ``level * max|x - median(x)|``, linearly interpolated).
+    Definition (the project's, shared by recordings and the simulator's studies):
+    with ``y = x - baseline`` over the whole input along ``axis`` (one pulse),
+    ``e = |y|`` and ``p = max(e)``, the *entry* is the first instant at which
+    ``e`` reaches ``level * p`` and the *exit* the last instant at which it is
+    still at ``level * p``, both interpolated linearly between the two samples
+    straddling the level; the excitation duration is ``exit - entry``.  For a
+    displacement pulse it is the pulse width at ``level`` of its height; for
+    an acceleration response it runs from the entry transient to where the
+    exit ringing decays below ``level`` of the largest peak (a constant
+    ``ln(1/level) / (zeta omega_n)`` added for a given structure, so durations
+    of different defects keep their order).  Results below two sample
+    intervals are interpolations, not resolved events.
 
     Parameters
     ----------
     x : array_like
-        One pulse per signal (displacement, acceleration, force, ...).
+        One pulse per signal (displacement, acceleration, force, ...), with
+        quiet margins before and after it.
     fs : float
         Sampling rate, Hz.
     level : float
-        Crossing level relative to the peak, 0 < level < 1 (default 0.1).
+        Crossing level relative to the peak, 0 < level < 1 (default 0.1, -20 dB).
+    baseline : "median", "first" or float
+        What the pulse departs from: the median of the input (default; right when
+        the pulse occupies less than half of the samples), the first sample
+        (a displacement that starts at rest), or a given value in the unit of x.
     axis : int
         Time axis.
 
@@ -128,7 +142,14 @@ def excitation_duration(x, fs, *, level=0.1, axis=-1):
         raise AnalysisError(f"excitation_duration: {level=} must lie strictly between 0 and 1")
     xm = np.moveaxis(x, axis, -1)
     flat = xm.reshape(-1, xm.shape[-1])
-    res = np.array([_duration_1d(row, fs, level) for row in flat])
+    if isinstance(baseline, str):
+        if baseline not in ("median", "first"):
+            raise AnalysisError(f"Invalid value for the 'baseline' parameter. Allowed values are "
+                                f"'median', 'first' or a number, but got {baseline!r} instead.")
+        base = np.median(flat, axis=-1) if baseline == "median" else flat[:, 0]
+    else:
+        base = np.full(flat.shape[0], float(baseline))
+    res = np.array([_duration_1d(row - b, fs, level, baseline=0.0) for row, b in zip(flat, base)])
     shape = xm.shape[:-1]
     if not shape:
         return float(res[0, 0]), float(res[0, 1]), float(res[0, 2])

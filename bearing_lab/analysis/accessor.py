@@ -34,6 +34,12 @@ class BearingAccessor:
     def welch_psd(self, **kw):
         return _x.welch_psd(self._da, **kw)
 
+    def bandpass(self, **kw):
+        return _x.bandpass(self._da, **kw)
+
+    def squared_envelope(self, **kw):
+        return _x.squared_envelope(self._da, **kw)
+
     def cepstral_prewhitening(self, **kw):
         return _x.cepstral_prewhitening(self._da, **kw)
 

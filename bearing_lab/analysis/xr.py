@@ -18,7 +18,8 @@ import xarray as xr
 from ..errors import AnalysisError
 from . import _impulse, _metrics, _spectral, _speed
 
-__all__ = ["amplitude_spectrum", "welch_psd", "squared_envelope_spectrum", "envelope_spectrum",
+__all__ = ["amplitude_spectrum", "welch_psd", "bandpass", "squared_envelope", "squared_envelope_spectrum",
+           "envelope_spectrum",
            "cepstral_prewhitening", "kurtogram_band", "shaft_frequency", "excitation_period",
            "excitation_duration", "metrics", "sampling_rate"]
 
@@ -31,9 +32,10 @@ def sampling_rate(da, *, dim="time", fs=None):
         return float(da.attrs["sampling_rate_hz"])
     if dim in da.coords and da.sizes[dim] > 1:
         t = np.asarray(da[dim].values, dtype=float)
-        dt = np.median(np.diff(t))
+        dt = (t[-1] - t[0]) / (t.size - 1)
         if dt > 0:
-            return float(1.0 / dt)
+            # 9 significant digits: t = arange(n) / fs gives back fs exactly
+            return float(f"{1.0 / dt:.9g}")
     name = da.name or "the DataArray"
     raise AnalysisError(f"{name}: no sampling rate (no attrs['sampling_rate_hz'] and no uniform "
                         f"{dim!r} coordinate); pass fs=")
@@ -73,6 +75,26 @@ def welch_psd(da, *, window, nperseg, noverlap=None, dim="time", fs=None):
                          output_dtypes=[float], dask_gufunc_kwargs=_kw({"frequency": f.size}))
     out = out.assign_coords(frequency=("frequency", f, {"units": "Hz"}))
     out.attrs = {"units": f"({_units(da)})2 Hz-1", "long_name": "power spectral density (Welch)"}
+    return out
+
+
+def bandpass(da, *, band, dim="time", fs=None):
+    """:func:`bearing_lab.analysis.bandpass` over ``dim`` (same units)."""
+    fs = sampling_rate(da, dim=dim, fs=fs)
+    out = xr.apply_ufunc(lambda x: _spectral.bandpass(x, fs, band=band), da, input_core_dims=[[dim]],
+                         output_core_dims=[[dim]], dask="parallelized", output_dtypes=[float],
+                         dask_gufunc_kwargs=_kw())
+    out.attrs = {"units": _units(da), "long_name": f"band-passed {band[0]:g}-{band[1]:g} Hz"}
+    return out
+
+
+def squared_envelope(da, *, band=None, prewhiten=False, dim="time", fs=None):
+    """:func:`bearing_lab.analysis.squared_envelope` over ``dim``; units (U)2."""
+    fs = sampling_rate(da, dim=dim, fs=fs)
+    out = xr.apply_ufunc(lambda x: _spectral.squared_envelope(x, fs, band=band, prewhiten=prewhiten), da,
+                         input_core_dims=[[dim]], output_core_dims=[[dim]], dask="parallelized",
+                         output_dtypes=[float], dask_gufunc_kwargs=_kw())
+    out.attrs = {"units": "1" if prewhiten else f"({_units(da)})2", "long_name": "squared envelope"}
     return out
 
 
@@ -142,10 +164,10 @@ def excitation_period(da, *, frequency_range, band=None, method="ses", dim="time
     return out
 
 
-def excitation_duration(da, *, level=0.1, dim="time", fs=None):
+def excitation_duration(da, *, level=0.1, baseline="median", dim="time", fs=None):
     """:func:`bearing_lab.analysis.excitation_duration` per signal: Dataset of duration, entry, exit (s)."""
     fs = sampling_rate(da, dim=dim, fs=fs)
-    d, t0, t1 = xr.apply_ufunc(lambda x: _impulse.excitation_duration(x, fs, level=level), da,
+    d, t0, t1 = xr.apply_ufunc(lambda x: _impulse.excitation_duration(x, fs, level=level, baseline=baseline), da,
                                input_core_dims=[[dim]], output_core_dims=[[], [], []],
                                dask="parallelized", output_dtypes=[float, float, float],
                                dask_gufunc_kwargs=_kw())

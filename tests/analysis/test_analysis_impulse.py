@@ -111,3 +111,15 @@ def test_excitation_duration_vectorised_and_checked():
         excitation_duration(tri, fs, level=1.5)
     with pytest.raises(AnalysisError, match="constant"):
         excitation_duration(np.zeros(100), fs)
+
+
+def test_excitation_duration_baseline_options():
+    fs = 100_000.0
+    t = np.arange(1000) / fs
+    # a displacement pulse on a static offset, occupying most of the window
+    x = 5.0 + np.clip(1 - np.abs(t - 5e-3) / 4.9e-3, 0, None)
+    d_first, _, _ = excitation_duration(x, fs, baseline="first")
+    d_value, _, _ = excitation_duration(x, fs, baseline=5.0)
+    assert d_first == pytest.approx(2 * 0.9 * 4.9e-3, rel=1e-6) and d_value == pytest.approx(d_first)
+    with pytest.raises(AnalysisError, match="baseline"):
+        excitation_duration(x, fs, baseline="mean")

@@ -77,3 +77,10 @@ def test_accessor_analyze_returns_contract_dict():
     da = xr.DataArray(x, dims="time", coords={"time": t}, attrs={"units": "m s-2"}, name="DE")
     r = da.bearing.analyze(bearing="6205", shaft_hz=fr)
     assert r["diagnosis"] == "outer_race" and r["channel"] == "DE"
+
+
+def test_envelope_wrappers(da):
+    se = bxr.squared_envelope(da, band=(100, 2000))
+    assert se.dims == da.dims and se.attrs["units"] == "(m s-2)2"
+    bp = da.bearing.bandpass(band=(100, 2000))
+    np.testing.assert_allclose(bp.values, ba.bandpass(da.values, 12000.0, band=(100, 2000)))
