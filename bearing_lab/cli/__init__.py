@@ -22,6 +22,7 @@ COMMAND_MODULES = [
     "study",      # study
     "validate",   # validate
     "bench",      # bench, sweep
+    "sweep",      # sweep (bearing_lab.sweep on Dask)
 ]
 
 

@@ -1,0 +1,560 @@
+"""Parameter sweeps: many scenes, one labelled Dataset, run in parallel on Dask.
+
+``sweep(scene, {"defect.offset_mm": [0, 0.25, 0.5], "speed_rpm": [900, 1800]})``
+simulates every combination of the swept values (a full grid) and returns one
+:class:`xarray.Dataset` with a dimension per swept key:
+
+- the dimension is named after the key with dots turned into underscores
+  (``defect.offset_mm`` -> ``defect_offset_mm``); its coordinate holds the
+  values (strings with units such as ``"0.5 mm"`` are converted to the key's
+  unit) and a ``units`` attribute taken from the key's suffix (``_mm`` -> mm);
+- every variable of :func:`bearing_lab.simulate`'s output, stacked along the
+  sweep dimensions (sweep dims first, then ``ball``/``time``); the time axis is
+  shared, so a sweep that changes ``output.duration_s`` or
+  ``output.sample_rate_hz`` (or the number of balls) is refused;
+- per-scene metrics of ``outer_ring_acc_y`` (``rms``, ``peak``,
+  ``crest_factor``, Pearson ``kurtosis``; the definitions of
+  :mod:`bearing_lab.analysis`), the compute time ``wall_time_s`` per scene,
+  ``solver_steps``, ``cached`` (the scene came from the cache) and
+  ``scene_hash`` (the cache key);
+- attributes ``sweep_params`` (JSON), ``sweep_n_scenes``,
+  ``sweep_cache_hits``, ``sweep_computed``, ``sweep_scheduler``,
+  ``sweep_wall_time_s``, the base ``scene_toml`` and the per-scene attributes
+  that are the same for every scene (bearing, sampling rate, version, ...).
+
+Scheduling (``scheduler=``):
+
+- ``None`` / ``"local"``: a :class:`dask.distributed.LocalCluster` of
+  ``n_workers`` (default 2) worker processes with one thread each, closed at
+  the end;
+- ``"tcp://host:port"``: an existing cluster (``dask.distributed.Client(address)``);
+  its workers need bearing_lab installed.  The client writes the cache, since
+  remote workers may not share its file system;
+- a :class:`dask.distributed.Client`: used as is (not closed);
+- ``"serial"``: in this process, no Dask.
+
+Every scene runs through the same function on every path and the results are
+placed by index, so a Dask sweep is bit for bit equal to a serial one.
+
+Cache: a finished scene is written to ``cache_dir/<hash>.nc`` (netCDF4, zlib,
+float64 kept exactly) where the hash is the sha256 of the resolved scene TOML
+(:meth:`Scene.to_toml`), the bearing_lab version and the simulate keywords.  A
+sweep that was stopped resumes: cached scenes are read, not recomputed.
+``cache_dir`` defaults to ``$BEARING_LAB_CACHE`` or ``~/.cache/bearing_lab/sweeps``;
+``cache_dir=False`` turns caching off.
+"""
+from __future__ import annotations
+
+import hashlib
+import itertools
+import json
+import math
+import os
+from pathlib import Path
+import sys
+import time as _time
+import types
+import uuid
+
+import numpy as np
+
+from . import __version__
+from .errors import BearingLabError, SceneError
+
+__all__ = ["sweep", "scene_hash", "default_cache_dir", "dim_name", "key_units"]
+
+# units of the --set key suffixes (scene.py's _SUFFIX), as CF/UDUNITS strings
+_UNIT_STRINGS = {
+    "_mm": "mm", "_um": "um", "_m": "m", "_n": "N", "_rpm": "rpm", "_s": "s", "_hz": "Hz",
+    "_deg": "degree", "_n_m": "N m-1", "_n_s_m": "N s m-1", "_kg": "kg", "_gpa": "GPa",
+    "_kg_m3": "kg m-3", "_m_s2": "m s-2",
+}
+# simulate()'s keywords and the scene keys they set (the same mapping simulate applies)
+_SIM_KW = {"duration": "output.duration_s", "fs": "output.sample_rate_hz", "rtol": "solver.rtol",
+           "method": "solver.method", "step": "solver.step_s", "fidelity": "fidelity"}
+_METRICS = ("rms", "peak", "crest_factor", "kurtosis")
+_METRIC_SIGNAL = "outer_ring_acc_y"
+
+
+# ---------------------------------------------------------------- helpers
+def default_cache_dir() -> Path:
+    """``$BEARING_LAB_CACHE`` or ``~/.cache/bearing_lab/sweeps``."""
+    env = os.environ.get("BEARING_LAB_CACHE")
+    return Path(env) if env else Path.home() / ".cache" / "bearing_lab" / "sweeps"
+
+
+def dim_name(key: str) -> str:
+    """The Dataset dimension of a swept key: ``defect.offset_mm`` -> ``defect_offset_mm``."""
+    return key.replace(".", "_")
+
+
+def key_units(key: str) -> str | None:
+    """The unit a key's suffix names (``speed_rpm`` -> ``"rpm"``), or None."""
+    for suf in sorted(_UNIT_STRINGS, key=len, reverse=True):
+        if key.endswith(suf):
+            return _UNIT_STRINGS[suf]
+    return None
+
+
+def _canonical(key: str) -> str:
+    from .sim.scene import _ALIASES
+    return _ALIASES.get(key, key)
+
+
+def scene_hash(scene_toml: str, simulate_kwargs: dict | None = None) -> str:
+    """sha256 of the resolved scene TOML, the bearing_lab version and the simulate keywords."""
+    h = hashlib.sha256()
+    h.update(scene_toml.encode())
+    h.update(b"\0bearing_lab " + __version__.encode())
+    h.update(b"\0" + json.dumps(simulate_kwargs or {}, sort_keys=True, default=repr).encode())
+    return h.hexdigest()
+
+
+def _values(key, values) -> list:
+    """The swept values of one key as a list (strings with units converted)."""
+    from .sim.scene import _convert, _parse_value
+    if isinstance(values, (str, bytes)) or not hasattr(values, "__iter__"):
+        raise SceneError(f"sweep parameter {key!r}: give a list of values, got {values!r}")
+    out = []
+    for v in values:
+        if isinstance(v, np.generic):
+            v = v.item()
+        if isinstance(v, str):
+            v = _parse_value(v)
+            v = _convert(v, key.split(".")[-1], f"sweep parameter {key}")
+        if isinstance(v, float) and not math.isfinite(v):
+            raise SceneError(f"sweep parameter {key!r}: value {v!r} is not finite")
+        out.append(v)
+    if not out:
+        raise SceneError(f"sweep parameter {key!r}: no values")
+    if len(set(map(repr, out))) != len(out):
+        dup = next(v for i, v in enumerate(out) if repr(v) in map(repr, out[:i]))
+        raise SceneError(f"sweep parameter {key!r}: value {dup!r} appears twice")
+    kinds = {type(v) for v in out}
+    if str in kinds and len(kinds) > 1:
+        raise SceneError(f"sweep parameter {key!r}: mixes text and numbers: {out!r}")
+    if kinds == {int, float}:  # one numeric type, so 0 and 0.0 resolve to the same scene
+        out = [float(v) for v in out]
+    if len(set(map(repr, out))) != len(out):
+        raise SceneError(f"sweep parameter {key!r}: a value appears twice in {out!r}")
+    return out
+
+
+def _coord(key, values):
+    kinds = {type(v) for v in values}
+    if kinds <= {int}:
+        arr = np.asarray(values, dtype=np.int64)
+    elif kinds <= {int, float}:
+        arr = np.asarray(values, dtype=float)
+    elif kinds <= {bool}:
+        arr = np.asarray(values, dtype=bool)
+    else:
+        arr = np.asarray([str(v) for v in values], dtype=object)
+    attrs = {"long_name": f"swept scene key {key}"}
+    u = key_units(key)
+    if u is not None:
+        attrs["units"] = u
+    elif arr.dtype.kind in "if":
+        attrs["units"] = "1"
+    return arr, attrs
+
+
+def _metrics(x: np.ndarray) -> dict:
+    """RMS, peak, crest factor, Pearson kurtosis (NaN where undefined)."""
+    try:
+        from .analysis import crest_factor, kurtosis, peak, rms
+        fns = {"rms": rms, "peak": peak, "crest_factor": crest_factor, "kurtosis": kurtosis}
+    except ImportError:  # pragma: no cover - analysis is part of the package
+        fns = None
+    out = {}
+    for name in _METRICS:
+        try:
+            if fns is not None:
+                out[name] = float(fns[name](x))
+                continue
+            r = float(np.sqrt(np.mean(x * x)))
+            p = float(np.max(np.abs(x)))
+            d = x - x.mean()
+            m2 = float(np.mean(d * d))
+            out[name] = {"rms": r, "peak": p, "crest_factor": p / r if r else math.nan,
+                         "kurtosis": float(np.mean(d ** 4)) / m2 ** 2 if m2 else math.nan}[name]
+        except BearingLabError:
+            out[name] = math.nan
+    return out
+
+
+# ---------------------------------------------------------------- one scene (runs on workers)
+def _write_cache(ds, path: Path) -> None:
+    from .io_netcdf import write_netcdf
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f".{path.stem}.{uuid.uuid4().hex}.tmp.nc")
+    try:
+        write_netcdf(ds, tmp)
+        os.replace(tmp, path)  # atomic: a stopped sweep never leaves a half-written scene
+    finally:
+        if tmp.exists():
+            tmp.unlink()
+
+
+def _read_cache(path: Path, digest: str):
+    import xarray as xr
+    if not path.is_file():
+        return None
+    try:
+        ds = xr.load_dataset(path, engine="netcdf4")
+    except (OSError, ValueError, RuntimeError):
+        return None  # unreadable: recompute
+    if ds.attrs.get("sweep_scene_hash") != digest:
+        return None
+    return ds
+
+
+def _simulate_scene(scene_toml: str, digest: str, cache_path: str | None):
+    """Simulate one resolved scene (given as TOML); write the cache file if asked.
+
+    The same function runs in-process (serial) and on Dask workers.
+    """
+    import tomllib
+    from .sim import load_scene, simulate
+    scene = load_scene(tomllib.loads(scene_toml))
+    ds = simulate(scene, progress=False)
+    ds.attrs["sweep_scene_hash"] = digest
+    if cache_path is not None:
+        _write_cache(ds, Path(cache_path))
+    return ds
+
+
+# ---------------------------------------------------------------- the sweep
+def _resolve(scene, params: dict, simulate_kwargs: dict):
+    """Validate the sweep; return (keys, value lists, base Scene, fixed overrides, scenes in C order)."""
+    from .sim import load_scene
+    if not isinstance(params, dict) or not params:
+        raise SceneError("sweep: give the swept parameters as a dict {key: [values, ...]}")
+    fixed = {}
+    unknown_kw = {"progress"} & set(simulate_kwargs)
+    if unknown_kw:
+        raise BearingLabError("sweep: 'progress' is the sweep's own progress bar, not a simulate option")
+    for kw, v in simulate_kwargs.items():
+        if v is None:
+            continue
+        fixed[_SIM_KW.get(kw, kw)] = v
+    keys, values, seen = [], [], {}
+    for key, vals in params.items():
+        if not isinstance(key, str) or not key:
+            raise SceneError(f"sweep: parameter names must be scene keys like 'speed_rpm', got {key!r}")
+        canon = _canonical(key)
+        if canon in seen:
+            raise SceneError(f"sweep parameter {key!r}: the same scene key as {seen[canon]!r}")
+        seen[canon] = key
+        if canon in {_canonical(k) for k in fixed}:
+            raise SceneError(f"sweep parameter {key!r} is also given as a fixed simulate option")
+        keys.append(key)
+        values.append(_values(key, vals))
+    dims = [dim_name(k) for k in keys]
+    clash = {d for d in dims if dims.count(d) > 1} | ({"time", "ball"} & set(dims))
+    if clash:
+        raise SceneError(f"sweep: parameter dimension name {sorted(clash)[0]!r} is taken; rename the key")
+    base = load_scene(scene, **fixed)
+    # each value on its own first, so an error names the key and value that caused it
+    for key, vals in zip(keys, values):
+        for v in vals:
+            try:
+                base.replace(**{key: v})
+            except SceneError as exc:
+                raise SceneError(f"sweep parameter {key}={v!r}: {exc}") from None
+    scenes = []
+    for combo in itertools.product(*values):
+        ov = dict(zip(keys, combo))
+        try:
+            scenes.append(base.replace(**ov))
+        except SceneError as exc:
+            what = ", ".join(f"{k}={v!r}" for k, v in ov.items())
+            raise SceneError(f"sweep scene {what}: {exc}") from None
+    shape = tuple(len(v) for v in values)
+    for what, get in (("output.duration_s", lambda s: s.duration),
+                      ("output.sample_rate_hz", lambda s: s.fs_out),
+                      ("the number of balls", lambda s: s.bearing.n_balls),
+                      ("output.ball_loads", lambda s: bool(s.data["output"]["ball_loads"]))):
+        arr = np.array([get(s) for s in scenes]).reshape(shape)
+        if np.all(arr == arr.flat[0]):
+            continue
+        culprits = [k for ax, k in enumerate(keys) if np.any(np.diff(arr, axis=ax) != 0)]
+        raise SceneError(f"sweep parameter {', '.join(map(repr, culprits))} changes {what}; all scenes "
+                         "of a sweep share one time axis and ball set (set duration=/fs= for the whole sweep)")
+    return keys, values, base, scenes
+
+
+def _client_for(scheduler, n_workers):
+    """(client, cluster-or-None, own_client, description)."""
+    try:
+        from dask.distributed import Client, LocalCluster
+    except ImportError:  # pragma: no cover
+        raise BearingLabError("sweep: Dask is not installed; `pip install bearing_lab[sweep]` "
+                              "or use scheduler='serial'") from None
+    if isinstance(scheduler, Client):
+        if n_workers is not None:
+            raise BearingLabError("sweep: n_workers applies to the local cluster, not to a given Client")
+        return scheduler, None, False, f"client {scheduler.scheduler.address}"
+    if scheduler in (None, "local"):
+        n = 2 if n_workers is None else int(n_workers)
+        if n < 1:
+            raise BearingLabError(f"sweep: n_workers={n_workers!r} must be at least 1")
+        import logging
+        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                               dashboard_address=None, silence_logs=logging.ERROR)
+        return Client(cluster), cluster, True, f"local cluster, {n} worker processes x 1 thread"
+    if isinstance(scheduler, str):
+        if n_workers is not None:
+            raise BearingLabError(f"sweep: n_workers applies to the local cluster; the cluster at "
+                                  f"{scheduler} has its own workers")
+        try:
+            client = Client(scheduler, timeout="10s")
+        except (OSError, TimeoutError, ValueError) as exc:
+            raise BearingLabError(f"sweep: cannot connect to the Dask scheduler {scheduler!r}: {exc}") from None
+        return client, None, True, f"scheduler {scheduler}"
+    raise BearingLabError(f"sweep: scheduler={scheduler!r}: use None (local cluster), 'serial', "
+                          "a 'tcp://host:port' address or a dask.distributed.Client")
+
+
+def sweep(scene, params: dict, *, scheduler=None, n_workers: int | None = None, cache_dir=None,
+          progress: bool = True, metrics: bool = True, **simulate_kwargs):
+    """Simulate every combination of swept scene keys; return one labelled Dataset.
+
+    Parameters
+    ----------
+    scene : built-in name, TOML path, dict or Scene (the base of every scene).
+    params : ``{key: [values, ...]}`` with ``--set`` keys (``speed_rpm``,
+        ``load.radial_n``, ``defect.offset_mm``, ``fidelity`` ...).  The grid is the
+        Cartesian product, in the order the keys are given.
+    scheduler : None/"local" (LocalCluster), "serial", "tcp://host:port" or a Client.
+    n_workers : worker processes of the local cluster (default 2).
+    cache_dir : where finished scenes are kept (default ``$BEARING_LAB_CACHE`` or
+        ``~/.cache/bearing_lab/sweeps``); False: no cache.
+    progress : tqdm bar over the scenes as they finish.
+    metrics : add rms, peak, crest_factor, kurtosis of outer_ring_acc_y.
+    **simulate_kwargs : fixed for every scene: ``duration``, ``fs``, ``rtol``,
+        ``method``, ``step``, ``fidelity`` or ``--set`` keys.
+
+    Returns
+    -------
+    xarray.Dataset (see the module docstring).
+
+    Raises
+    ------
+    SceneError : a bad key or value (the message names it), or a sweep that
+        changes the time axis.
+    BearingLabError : scheduler problems; errors of a scene's solve are re-raised
+        with the scene's swept values in the message.
+    """
+    import xarray as xr
+    t_start = _time.perf_counter()
+    keys, values, base, scenes = _resolve(scene, params, simulate_kwargs)
+    kw_for_hash = {k: v for k, v in simulate_kwargs.items() if v is not None}
+    tomls = [s.to_toml() for s in scenes]
+    digests = [scene_hash(t, kw_for_hash) for t in tomls]
+    if cache_dir is False:
+        cdir = None
+    else:
+        cdir = Path(cache_dir).expanduser() if cache_dir not in (None, True) else default_cache_dir()
+        try:
+            cdir.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise BearingLabError(f"sweep: cannot create the cache directory {cdir}: {exc}") from None
+    shape = tuple(len(v) for v in values)
+    n = len(scenes)
+
+    acc = _Stack(shape, n)
+    hits = 0
+    todo = []
+    for i, dg in enumerate(digests):
+        ds = _read_cache(cdir / f"{dg}.nc", dg) if cdir is not None else None
+        if ds is None:
+            todo.append(i)
+        else:
+            acc.put(i, ds, cached=True)
+            hits += 1
+
+    bar = None
+    if progress:
+        from tqdm.auto import tqdm
+        bar = tqdm(total=n, initial=hits, unit="scene", desc=f"sweep {base.name}", leave=False)
+
+    def label(i):
+        idx = np.unravel_index(i, shape)
+        return ", ".join(f"{k}={values[a][j]!r}" for a, (k, j) in enumerate(zip(keys, idx)))
+
+    def failed(i, exc):
+        if isinstance(exc, BearingLabError):
+            return type(exc)(f"sweep scene {label(i)}: {exc}")
+        return BearingLabError(f"sweep scene {label(i)}: {type(exc).__name__}: {exc}")
+
+    desc = "serial (in process)"
+    try:
+        if todo and scheduler == "serial":
+            for i in todo:
+                path = str(cdir / f"{digests[i]}.nc") if cdir is not None else None
+                try:
+                    ds = _simulate_scene(tomls[i], digests[i], path)
+                except Exception as exc:  # noqa: BLE001 - re-raised with the scene's values
+                    raise failed(i, exc) from exc
+                acc.put(i, ds, cached=False)
+                if bar is not None:
+                    bar.update(1)
+        elif todo:
+            client, cluster, own, desc = _client_for(scheduler, n_workers)
+            remote = cluster is None  # an existing cluster's workers may not share our disk
+            try:
+                from dask.distributed import as_completed
+                futures = {}
+                for i in todo:
+                    # workers of a local cluster share our disk and write the cache themselves
+                    path = str(cdir / f"{digests[i]}.nc") if (cdir is not None and not remote) else None
+                    fut = client.submit(_simulate_scene, tomls[i], digests[i], path,
+                                        key=f"bearing_lab-scene-{digests[i][:16]}-{uuid.uuid4().hex[:8]}",
+                                        pure=False)
+                    futures[fut] = i
+                for fut in as_completed(list(futures)):
+                    i = futures.pop(fut)
+                    try:
+                        ds = fut.result()
+                    except Exception as exc:  # noqa: BLE001
+                        for other in futures:
+                            other.cancel()
+                        raise failed(i, exc) from exc
+                    del fut
+                    if remote and cdir is not None:
+                        _write_cache(ds, cdir / f"{digests[i]}.nc")
+                    acc.put(i, ds, cached=False)
+                    if bar is not None:
+                        bar.update(1)
+            finally:
+                if own:
+                    client.close()
+                if cluster is not None:
+                    cluster.close()
+    finally:
+        if bar is not None:
+            bar.close()
+
+    # ---- assemble
+    coords = {}
+    for key, vals in zip(keys, values):
+        arr, attrs = _coord(key, vals)
+        coords[dim_name(key)] = (dim_name(key), arr, attrs)
+    sdims = tuple(dim_name(k) for k in keys)
+    out = acc.dataset(sdims, coords)
+    if metrics:
+        units = out[_METRIC_SIGNAL].attrs.get("units", "") if _METRIC_SIGNAL in out else ""
+        long = {"rms": "RMS", "peak": "peak (largest |x|)", "crest_factor": "crest factor (peak / RMS)",
+                "kurtosis": "Pearson kurtosis (Gaussian = 3)"}
+        for name in _METRICS:
+            out[name] = (sdims, acc.metrics[name].reshape(shape),
+                         {"units": units if name in ("rms", "peak") else "1",
+                          "long_name": f"{long[name]} of {_METRIC_SIGNAL}", "signal": _METRIC_SIGNAL})
+    out["wall_time_s"] = (sdims, acc.wall.reshape(shape),
+                          {"units": "s", "long_name": "compute time of the scene (simulate's wall_time_s, "
+                                                      "without compilation; from the run that filled the cache)"})
+    out["solver_steps"] = (sdims, acc.steps.reshape(shape), {"long_name": "accepted solver steps"})
+    out["cached"] = (sdims, acc.cached.reshape(shape).astype(np.int8),
+                     {"long_name": "1: the scene was read from the sweep cache", "flag_values": "0 1"})
+    out["scene_hash"] = (sdims, np.asarray(digests, dtype=object).reshape(shape),
+                         {"long_name": "sha256 of the resolved scene TOML, version and simulate options "
+                                       "(the cache file name)"})
+    out.attrs.update(acc.common_attrs)
+    out.attrs.update({
+        "title": f"bearing_lab sweep of scene {base.name!r}",
+        "scene_name": base.name,
+        "scene_toml": base.to_toml(),
+        "bearing_lab_version": __version__,
+        "sweep_params": json.dumps({k: v for k, v in zip(keys, values)}),
+        "sweep_dims": " ".join(sdims),
+        "sweep_n_scenes": int(n),
+        "sweep_cache_hits": int(hits),
+        "sweep_computed": int(n - hits),
+        "sweep_cache_dir": str(cdir) if cdir is not None else "",
+        "sweep_scheduler": desc if todo else "none (all scenes cached)",
+        "sweep_wall_time_s": float(_time.perf_counter() - t_start),
+        "sweep_simulate_kwargs": json.dumps(kw_for_hash, sort_keys=True, default=repr),
+    })
+    out.attrs.setdefault("Conventions", "CF-1.8")
+    return out
+
+
+# attributes that differ per scene or are replaced by the sweep's own
+_PER_SCENE_ATTRS = {"title", "scene_toml", "wall_time_s", "compile_time_s", "solver_steps",
+                    "solver_rejected_steps", "sweep_scene_hash", "scene_name"}
+
+
+class _Stack:
+    """Places each scene's variables at its grid index as results arrive (any order)."""
+
+    def __init__(self, shape, n):
+        self.shape, self.n = shape, n
+        self.arrays = None
+        self.template = None
+        self.metrics = {m: np.full(n, np.nan) for m in _METRICS}
+        self.wall = np.full(n, np.nan)
+        self.steps = np.zeros(n, dtype=np.int64)
+        self.cached = np.zeros(n, dtype=bool)
+        self.common_attrs = None
+
+    def put(self, i, ds, *, cached):
+        if self.arrays is None:
+            self.template = ds
+            self.arrays = {name: np.empty((self.n, *var.shape), dtype=var.dtype)
+                           for name, var in ds.data_vars.items()}
+            self.common_attrs = {k: v for k, v in ds.attrs.items() if k not in _PER_SCENE_ATTRS}
+        else:
+            t0 = self.template
+            if set(ds.data_vars) != set(self.arrays):
+                raise BearingLabError("sweep: scenes returned different variables "
+                                      f"({sorted(ds.data_vars)} vs {sorted(self.arrays)})")
+            if not np.array_equal(ds["time"].values, t0["time"].values):
+                raise SceneError("sweep: scenes have different time axes; all scenes of a sweep "
+                                 "must share output.duration_s and output.sample_rate_hz")
+            for k in list(self.common_attrs):
+                if not _same(ds.attrs.get(k), self.common_attrs[k]):
+                    del self.common_attrs[k]
+        for name, arr in self.arrays.items():
+            v = ds[name].transpose(*self.template[name].dims).values
+            if v.shape != arr.shape[1:]:
+                raise BearingLabError(f"sweep: variable {name} has shape {v.shape} in one scene "
+                                      f"and {arr.shape[1:]} in another")
+            arr[i] = v
+        if _METRIC_SIGNAL in ds:
+            for k, val in _metrics(np.asarray(ds[_METRIC_SIGNAL].values)).items():
+                self.metrics[k][i] = val
+        self.wall[i] = float(ds.attrs.get("wall_time_s", np.nan))
+        self.steps[i] = int(ds.attrs.get("solver_steps", 0))
+        self.cached[i] = cached
+
+    def dataset(self, sdims, coords):
+        import xarray as xr
+        t = self.template
+        data_vars = {}
+        for name, arr in self.arrays.items():
+            var = t[name]
+            data_vars[name] = ((*sdims, *var.dims), arr.reshape(*self.shape, *var.shape), dict(var.attrs))
+        all_coords = dict(coords)
+        for cname, c in t.coords.items():
+            all_coords[cname] = (c.dims, c.values, dict(c.attrs))
+        self.arrays = None  # hand the memory to the Dataset
+        return xr.Dataset(data_vars, coords=all_coords)
+
+
+def _same(a, b) -> bool:
+    try:
+        return bool(np.array_equal(np.asarray(a), np.asarray(b)))
+    except Exception:  # noqa: BLE001 - incomparable attributes are simply not common
+        return False
+
+
+# ``bearing_lab.sweep`` is this module once it has been imported (Python binds a
+# submodule on its package), so make the module callable: bearing_lab.sweep(...)
+# then works whether the name resolves to the function or to the module.
+class _CallableModule(types.ModuleType):
+    def __call__(self, *args, **kwargs):
+        return sweep(*args, **kwargs)
+
+
+sys.modules[__name__].__class__ = _CallableModule
