@@ -21,12 +21,13 @@ shaft_frequency(x, fs, *, window, rpm, ...)             -- (shaft Hz, number of 
 fault_line(f, ses, expected_hz, *, shaft_hz, tolerance, ...) -- dict: measured_hz, snr_db, harmonics, sidebands
 diagnose_ses(f, ses, fault_hz, *, shaft_hz, tolerance)  -- (diagnosis, lines per fault)
 excitation_period(x, fs, *, frequency_range, band, method) -- (period s, lines or impulses used)
-excitation_duration(x, fs, *, level=0.1, axis=-1)       -- (duration s, entry s, exit s) of one pulse
+excitation_duration(x, fs, *, level=0.1, baseline="median", axis=-1) -- (duration s, entry s, exit s) of one pulse
 impulses(x, fs, *, band, threshold, min_separation, level) -- Impulses(time, peak, duration, entry, exit, resolved)
 rms, peak, peak_to_peak, crest_factor, kurtosis, impulse_factor, clearance_factor, shape_factor (x, *, axis)
 metrics(x, *, axis=-1, units="1")                       -- dict of the eight metrics + "units"
 analyze(x, fs, *, bearing, rpm, shaft_hz, channel, units, ...) -- dict in contract.md's analyze --json schema
 plot_analysis(x, fs, *, bearing, ..., path)             -- (figure, result): waveform, spectrum, SES with markers
+xr                                                      -- xarray wrappers of the above (apply_ufunc, dask-friendly)
 """
 from ._spectral import (amplitude_spectrum, bandpass, cepstral_prewhitening, envelope_band,  # noqa: F401
                         fast_kurtogram, Kurtogram, squared_envelope, squared_envelope_spectrum, welch_psd)

@@ -209,9 +209,8 @@ def plot_analysis(x, fs, *, bearing, rpm=None, shaft_hz=None, channel="", units=
     >>> len(fig.axes)
     3
     """
-    import matplotlib
     if fig is None:
-        matplotlib.use("Agg", force=False)
+        # a bare Figure (no pyplot): no backend switch, no global state; savefig works headless
         from matplotlib.figure import Figure
         fig = Figure(figsize=(10, 9), layout="constrained")
     result, ex = _run(x, fs, bearing=bearing, rpm=rpm, shaft_hz=shaft_hz, **kwargs)

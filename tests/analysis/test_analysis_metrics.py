@@ -26,7 +26,6 @@ def test_sinusoid_closed_forms():
     assert impulse_factor(x) == pytest.approx(np.pi / 2, rel=1e-6)
     # mean(sqrt|2 sin|) = sqrt(2) * 2 Gamma(3/4) / (sqrt(pi) Gamma(5/4))
     from math import gamma, pi, sqrt
-    msq = sqrt(2) * 2 * gamma(0.75) / (sqrt(pi) * gamma(1.25)) / 2 * 1
     msq = sqrt(2) * gamma(0.75) / (sqrt(pi) * gamma(1.25))
     assert clearance_factor(x) == pytest.approx(2.0 / msq ** 2, rel=1e-5)
 
