@@ -244,3 +244,17 @@ def test_intact_fraction_of_hertz_ellipse():
     assert got == pytest.approx(expected, abs=0.01)
     assert np.all(T.intact_fraction[:, 0] == 1.0)
     assert np.all(T.intact_fraction[0] == 1.0)
+
+
+def test_table_dataset_roundtrip_and_plot(tmp_path):
+    import matplotlib
+    matplotlib.use("Agg")
+    import xarray as xr
+    T = contact_table(Defect(length=1e-3, width=1e-3), B6308, model="area", delta_max=DMAX)
+    path = tmp_path / "table.nc"
+    T.to_dataset().to_netcdf(path)
+    back = xr.load_dataset(path)
+    np.testing.assert_array_equal(back["G"].values, T.G)
+    assert back.attrs["model"] == "area" and back["delta"].attrs["units"] == "m"
+    fig = T.plot()
+    assert len(fig.axes[0].lines) == 4

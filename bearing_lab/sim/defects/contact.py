@@ -178,6 +178,49 @@ class ContactTable:
             out[inside] = g
         return out.reshape(shape)
 
+    def to_dataset(self):
+        """The table as an xarray Dataset (SI, ``units`` attributes), e.g. for netCDF."""
+        import xarray as xr
+        coords = {"psi": ("psi", np.asarray(self.psi), {"units": "rad",
+                  "long_name": "ball-centre angle minus defect-centre angle"}),
+                  "delta": ("delta", np.asarray(self.delta), {"units": "m",
+                  "long_name": "approach relative to the intact surface"})}
+        ds = xr.Dataset(
+            {"G": (("psi", "delta"), np.asarray(self.G), {"units": "m1.5",
+                   "long_name": "normal force / K_hertz"}),
+             "drop": ("psi", np.asarray(self.drop), {"units": "m",
+                      "long_name": "rigid-ball drop"}),
+             "intact_fraction": (("psi", "delta"), np.asarray(self.intact_fraction),
+                                 {"units": "1", "long_name": "intact share of the Hertz ellipse"})},
+            coords=coords,
+            attrs={"model": self.model, "race": self.race, "track_radius_m": self.track_radius,
+                   "psi_min": self.psi_min, "psi_max": self.psi_max})
+        return ds
+
+    def plot(self, deltas=(4e-6, 8e-6), *, ax=None, s_units: str = "mm"):
+        """Plot G / delta^1.5 (carried share of the intact load) and the intact fraction of
+        the Hertz ellipse against the ball's track position, at the approaches ``deltas``
+        (m).  Returns the figure."""
+        import matplotlib.pyplot as plt
+        scale = {"mm": 1e3, "m": 1.0, "um": 1e6}[s_units]
+        if ax is None:
+            fig, ax = plt.subplots(figsize=(6, 3.5))
+        else:
+            fig = ax.figure
+        s = np.asarray(self.psi) * self.track_radius * scale
+        for d in deltas:
+            k = int(np.argmin(np.abs(self.delta - d)))
+            dk = self.delta[k]
+            line, = ax.plot(s, self.G[:, k] / dk ** 1.5, label=f"G/δ^1.5, δ = {dk*1e6:.1f} µm")
+            ax.plot(s, self.intact_fraction[:, k], "--", color=line.get_color(),
+                    label=f"intact ellipse, δ = {dk*1e6:.1f} µm")
+        ax.set_xlabel(f"ball position over the defect, s ({s_units})")
+        ax.set_ylabel("share of intact")
+        ax.set_ylim(-0.05, 1.05)
+        ax.set_title(f"{self.race} race, model {self.model!r}")
+        ax.legend(fontsize=7)
+        return fig
+
     def kernel_arrays(self):
         """(psi_min, dpsi, ddelta, G) with G C-contiguous float64, for a jitted lookup."""
         n_psi, n_d = self.G.shape
