@@ -145,6 +145,12 @@ def analyze(x, fs, *, bearing, rpm=None, shaft_hz=None, channel="", units="m s-2
     prewhiten : bool
         Cepstral pre-whitening before band selection and SES (default False).
 
+    Notes
+    -----
+    The shaft speed comes from shaft harmonics in the spectrum.  A signal without
+    them (a noise-free simulation, say) needs ``rpm`` or ``shaft_hz``: without
+    either, the impact family itself would be taken for the shaft.
+
     Returns
     -------
     dict

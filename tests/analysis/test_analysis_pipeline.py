@@ -113,3 +113,39 @@ def test_cli_analyze_real_recording(datafile, capsys):
     check_schema(r)
     assert r["diagnosis"] == "outer_race"
     assert r["units"] == "m s-2"
+
+
+def _modulated_impacts(rate, mod_hz, fs=12000.0, seconds=10.0, seed=0):
+    """Impacts at `rate` ringing 3 kHz, amplitude-modulated at `mod_hz` (load-zone passage)."""
+    t = np.arange(int(fs * seconds)) / fs
+    tau = t % (1 / rate)
+    k = np.floor(t * rate) / rate  # impact instant of each sample's impulse
+    amp = 1 + 0.8 * np.cos(2 * np.pi * mod_hz * k)
+    x = amp * np.exp(-900 * tau) * np.sin(2 * np.pi * 3000 * tau)
+    return x + np.random.default_rng(seed).normal(0, 0.3, t.size), fs
+
+
+@pytest.mark.parametrize("kind, expected", [("bpfi", "inner_race"), ("bsf", "ball")])
+def test_synthetic_inner_race_and_ball_faults(kind, expected):
+    from bearing_lab import get_bearing
+    fr = 29.95
+    ff = get_bearing("6205").fault_frequencies(fr)
+    rate, mod = (ff["bpfi"], fr) if kind == "bpfi" else (2 * ff["bsf"], ff["ftf"])
+    x, fs = _modulated_impacts(rate, mod)
+    r = analyze(x, fs, bearing="6205", shaft_hz=fr)
+    assert r["diagnosis"] == expected
+    measured = r["fault_frequencies"][kind]["measured_hz"] * (2 if kind == "bsf" else 1)
+    assert measured == pytest.approx(rate, rel=2e-3)
+
+
+def test_inner_race_shaft_sidebands_are_counted():
+    from bearing_lab import get_bearing
+    from bearing_lab.analysis import diagnose_ses, squared_envelope_spectrum
+    fr = 29.95
+    ff = get_bearing("6205").fault_frequencies(fr)
+    x, fs = _modulated_impacts(ff["bpfi"], fr)
+    f, ses = squared_envelope_spectrum(x, fs, window="hann", band=(2000, 4000), fmax=1000)
+    diagnosis, lines = diagnose_ses(f, ses, ff, shaft_hz=fr)
+    assert diagnosis == "inner_race"
+    assert lines["bpfi"]["sidebands"] >= 4
+    assert lines["bpfo"]["sidebands"] == 0  # only counted for the inner race
