@@ -145,12 +145,6 @@ def analyze(x, fs, *, bearing, rpm=None, shaft_hz=None, channel="", units="m s-2
     prewhiten : bool
         Cepstral pre-whitening before band selection and SES (default False).
 
-    Notes
-    -----
-    The shaft speed comes from shaft harmonics in the spectrum.  A signal without
-    them (a noise-free simulation, say) needs ``rpm`` or ``shaft_hz``: without
-    either, the impact family itself would be taken for the shaft.
-
     Returns
     -------
     dict
@@ -159,6 +153,12 @@ def analyze(x, fs, *, bearing, rpm=None, shaft_hz=None, channel="", units="m s-2
         ftf: ``expected_hz``, ``measured_hz`` or None, ``snr_db``,
         ``harmonics``), ``excitation_period_s`` (None without a diagnosis),
         ``metrics`` (eight floats, kurtosis Pearson) and ``units``.
+
+    Notes
+    -----
+    The shaft speed comes from shaft harmonics in the spectrum.  A signal without
+    them (a noise-free simulation, say) needs ``rpm`` or ``shaft_hz``: without
+    either, the impact family itself would be taken for the shaft.
 
     References
     ----------
