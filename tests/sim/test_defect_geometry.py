@@ -181,3 +181,11 @@ def test_drop_against_brute_force_grid():
             # the grid is 5 µm: its minimum overestimates the drop by at most ~|grad h| * 3.5 µm
             assert fast <= brute + 1e-12
             assert brute - fast < 0.02e-6
+
+
+def test_ball_defect_validation():
+    Defect(race="ball", length=1e-3, width=1e-3).validate(B6308)
+    with pytest.raises(SceneError, match="ball"):
+        Defect(race="ball", length=8e-3, width=1e-3).validate(B6308)
+    with pytest.raises(SceneError, match="depth_mm"):
+        Defect(race="ball", length=1e-3, width=1e-3, depth=8e-3).validate(B6308)

@@ -409,21 +409,18 @@ def _build(defect, bearing, *, model, clearance, delta_max, n_psi, n_delta,
     d = delta[None, None, :]
     ind0 = (h0[:, :, None] < d).astype(float)              # (2nb+1, nz, n_delta)
     area0 = ind0.sum(axis=(0, 1))
-    frac_loss = np.zeros((n_psi, n_delta))
     a_h, b_h = hertz_semi_axes(geom, delta)
     with np.errstate(invalid="ignore", divide="ignore"):
         indh = ((srel[:, None, None] / b_h[None, None, :]) ** 2
                 + (z[None, :, None] / a_h[None, None, :]) ** 2 < 1.0).astype(float)
     indh[:, :, delta <= 0] = 0.0
     areah = indh.sum(axis=(0, 1))
-    hertz_loss = np.zeros((n_psi, n_delta))
     need_area = model == "area"
     if need_area:
         w0 = np.sqrt(np.maximum(d - h0[:, :, None], 0.0))
         wf = np.sqrt(np.maximum(d - hf[:, :, None], 0.0))
         I0 = w0.sum(axis=(0, 1))
         D = w0 - wf
-        loss = np.zeros((n_psi, n_delta))
     kernels = [ind0, indh] + ([D] if need_area else [])
     out = _correlate(f, np.concatenate(kernels, axis=2), m, n_psi)
     frac_loss, hertz_loss = out[:, :n_delta], out[:, n_delta:2 * n_delta]
@@ -482,6 +479,7 @@ def _build(defect, bearing, *, model, clearance, delta_max, n_psi, n_delta,
         info["intact_law_ratio"] = law
     if model == "halfspace":
         info.update(info_hs)
+    race = defect.race if defect.race != "ball" else f"ball/{against}"
     return ContactTable(psi=psi, delta=delta, G=G, drop=drop, intact_fraction=intact_fraction,
-                        model=model, race=defect.race if defect.race != "ball" else f"ball/{against}", psi_min=float(psi[0]),
+                        model=model, race=race, psi_min=float(psi[0]),
                         psi_max=float(psi[-1]), track_radius=R, info=info)

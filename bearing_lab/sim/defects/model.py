@@ -358,8 +358,9 @@ class Defect:
             section = db / 2
             sec_txt = "ball_diameter/2"
             halfw = math.pi * db / 8
-            if max(abs(z0), abs(z1), abs(s0), abs(s1)) > halfw + 1e-12:
-                raise SceneError(f"{where}: the outline reaches {max(abs(z0), abs(z1), abs(s0), abs(s1))*1e3:.3f} mm "
+            reach = max(abs(z0), abs(z1), abs(s0), abs(s1))
+            if reach > halfw + 1e-12:
+                raise SceneError(f"{where}: the outline reaches {reach*1e3:.3f} mm "
                                  f"from the defect centre; on a ball of {db*1e3:.3f} mm keep it within "
                                  f"{halfw*1e3:.3f} mm (an eighth of the circumference)")
         else:
