@@ -186,6 +186,6 @@ def test_drop_against_brute_force_grid():
 def test_ball_defect_validation():
     Defect(race="ball", length=1e-3, width=1e-3).validate(B6308)
     with pytest.raises(SceneError, match="ball"):
-        Defect(race="ball", length=8e-3, width=1e-3).validate(B6308)
+        Defect(race="ball", length=13e-3, width=1e-3).validate(B6308)
     with pytest.raises(SceneError, match="depth_mm"):
         Defect(race="ball", length=1e-3, width=1e-3, depth=8e-3).validate(B6308)
