@@ -390,6 +390,13 @@ class _CalibrationProblem:
         self.bins = [b for b, lv in zip(bins, level) if lv >= 0.01 * level.max()]
         self.f_ses, self.ses_e = A.squared_envelope_spectrum(e[: len(s)], fs, window="hann", fmax=6.0 / period)
         self.kh = [int(np.argmin(np.abs(self.f_ses - h / period))) for h in range(1, 6)]
+        self.peak_e = self.impact_peak(e, te)
+
+    def impact_peak(self, y, times):
+        """Median over impacts of max |y| within +-20 % of a period around each impact."""
+        w = max(1, int(0.2 * self.period * self.fs))
+        idx = (np.asarray(times) * self.fs).astype(int)
+        return float(np.median([np.max(np.abs(y[max(0, i - w): i + w + 1])) for i in idx]))
 
     @staticmethod
     def _ses_at(ses, k):
@@ -412,17 +419,19 @@ class _CalibrationProblem:
         r2 = np.array([0.5 * np.log((Pm[b].mean() + 1e-30) / (self.Pe[b].mean() + 1e-30)) for b in self.bins])
         _, ses_m = self.A.squared_envelope_spectrum(y, fs, window="hann", fmax=6.0 / self.period)
         r3 = np.array([0.25 * np.log(self._ses_at(ses_m, k) / self._ses_at(self.ses_e, k)) for k in self.kh])
-        r = np.concatenate([r1 / math.sqrt(len(r1)), r2 / math.sqrt(len(r2)), r3 / math.sqrt(len(r3))])
-        return (r, (r1, r2, r3)) if parts else r
+        r0 = np.array([np.log(max(self.impact_peak(y, self.ts), 1e-30) / max(self.peak_e, 1e-30))])
+        r = np.concatenate([r0, r1 / math.sqrt(len(r1)), r2 / math.sqrt(len(r2)), r3 / math.sqrt(len(r3))])
+        return (r, (r0, r1, r2, r3)) if parts else r
 
 
 def calibrate_sensor(experiment, simulation, fs, period, *, band=None,
                      frequency_bounds=(500.0, None), damping_bounds=(0.005, 0.5),
-                     gain_bounds=(1e-3, 1e3), pre=0.5e-3, post=None, n_starts=5):
+                     gain_bounds=(1e-3, 1e3), pre=0.5e-3, post=None, n_starts=3):
     """Fit the scene's ``[sensor]`` resonator (frequency, damping ratio, gain) to a recording.
 
-    Least squares, in log amplitude, on three views of the impacts:
+    Least squares, in log amplitude, on four views of the impacts:
 
+    0. the median impact peak (max |a| around each impact), which mostly sets the gain;
     1. the measured *impulse ringing*: the mean Hilbert envelope of the segments that
        start ``pre`` before each impact and last ``post`` (default 60 % of a period),
        experiment against the filtered simulation, peaks aligned;
@@ -432,6 +441,9 @@ def calibrate_sensor(experiment, simulation, fs, period, *, band=None,
 
     The experiment's noise floor (median envelope between impacts) is added to the
     model's envelope in quadrature, so a quiet simulation is not pushed to fit noise.
+    The resonance frequency is searched within +-30 % of the strongest peak of the measured
+    impact-segment spectrum inside ``frequency_bounds``: one resonator stands for one
+    dominant ringing band (a recording with two bands keeps the weaker one unfitted).
     ``simulation`` must be sensor-off (the resonator is applied with :func:`apply_sensor`);
     both signals at ``fs``.  Several starting frequencies avoid local minima.
     """
@@ -441,19 +453,26 @@ def calibrate_sensor(experiment, simulation, fs, period, *, band=None,
     residuals, model = prob.residuals, prob.model
 
     fmax_b = frequency_bounds[1] or 0.45 * fs
-    lo = np.log([frequency_bounds[0], damping_bounds[0], gain_bounds[0]])
-    hi = np.log([fmax_b, damping_bounds[1], gain_bounds[1]])
-    # gain start: match the mean envelope peaks
+    # the resonance is searched around the strongest peak of the measured impact-segment spectrum
+    # (smoothed over ~150 Hz) inside the bounds: one resonator can fit one dominant ringing band only
+    fseg, Pe = _segment_spectrum(prob.e, fs, te, prob.pre, prob.post)
+    k = max(1, int(round(150.0 / (fseg[1] - fseg[0]))))
+    Ps = np.convolve(Pe, np.ones(k) / k, mode="same")
+    inside = (fseg >= frequency_bounds[0]) & (fseg <= fmax_b)
+    f_peak = float(fseg[inside][np.argmax(Ps[inside])]) if inside.any() else 0.5 * (frequency_bounds[0] + fmax_b)
+    f_lo, f_hi = max(frequency_bounds[0], 0.7 * f_peak), min(fmax_b, 1.3 * f_peak)
+    lo = np.log([f_lo, damping_bounds[0], gain_bounds[0]])
+    hi = np.log([f_hi, damping_bounds[1], gain_bounds[1]])
     env1 = _mean_envelope(s, fs, ts, prob.pre, prob.post)
     best = None
-    for fn0 in np.geomspace(max(frequency_bounds[0] * 1.2, 800.0), fmax_b * 0.9, n_starts):
-        for z0 in (0.03, 0.12):
+    for fn0 in (0.9 * f_peak, f_peak, 1.1 * f_peak):
+        for z0 in (0.03, 0.1):
             y = apply_sensor(s, fs, fn0, z0, 1.0)
-            g0 = float(np.clip(env_e.max() / max(_mean_envelope(y, fs, ts, prob.pre, prob.post).max(), 1e-30),
+            g0 = float(np.clip(prob.peak_e / max(prob.impact_peak(y, ts), 1e-30),
                                gain_bounds[0] * 1.01, gain_bounds[1] * 0.99))
             x0 = np.clip(np.log([fn0, z0, g0]), lo + 1e-6, hi - 1e-6)
             try:
-                r = least_squares(residuals, x0, bounds=(lo, hi), x_scale=[0.3, 0.5, 1.0], max_nfev=40)
+                r = least_squares(residuals, x0, bounds=(lo, hi), x_scale=[0.2, 0.5, 1.0], max_nfev=40)
             except ValueError:
                 continue
             if best is None or r.cost < best.cost:
@@ -481,7 +500,7 @@ def calibrate_sensor(experiment, simulation, fs, period, *, band=None,
     return CalibrationResult(
         frequency_hz=fn, damping_ratio=zeta, gain=g, fit_error_db=rms_db(allr), initial_error_db=rms_db(r1b),
         n_impacts_experiment=int(te.size), n_impacts_simulation=int(ts.size),
-        bounds={"frequency_hz": (float(frequency_bounds[0]), float(fmax_b)),
+        bounds={"frequency_hz": (float(f_lo), float(f_hi)),
                 "damping_ratio": tuple(map(float, damping_bounds)), "gain": tuple(map(float, gain_bounds))},
         envelope_time=(np.arange(len(env_e)) - pk) / fs, envelope_experiment=env_e,
         envelope_before=env_b, envelope_after=env_a, limits=limits)
