@@ -152,9 +152,9 @@ def choose_contact_model(defect, requested: str, bearing) -> str:
     models stay selectable with ``contact_model = "profile"`` or ``"drop"``.
     """
     if requested and requested != "auto":
-        if requested not in ("profile", "drop", "area"):
+        if requested not in ("profile", "drop", "area", "halfspace"):
             raise SceneError(f"defect.contact_model={requested!r}; allowed values are "
-                             "'auto', 'profile', 'drop' and 'area'")
+                             "'auto', 'profile', 'drop', 'area' and 'halfspace'")
         return requested
     return "area"
 
@@ -231,7 +231,7 @@ def assemble(scene: Scene, *, fidelity: str | None = None) -> Assembly:
         tab = contact_table(dfc, b, model=model, clearance=scene.clearance, delta_max=delta_max)
         tables.append(tab)
         psi = np.asarray(tab.psi, dtype=float)
-        kind = 1 if model == "area" else 0
+        kind = 1 if model in ("area", "halfspace") else 0
         h = np.ascontiguousarray(tab.drop, dtype=float)
         # the kernel interpolates G^(2/3) (see _kernels._interp_g)
         G = np.ascontiguousarray(np.maximum(tab.G, 0.0) ** (2.0 / 3.0), dtype=float)

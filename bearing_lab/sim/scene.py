@@ -199,7 +199,7 @@ SCHEMA: dict[str, dict[str, tuple]] = {
     },
 }
 DEFECT_KEYS = {"race", "shape", "length_mm", "width_mm", "depth_mm", "offset_mm", "skew_deg",
-               "angle_deg", "vertices_mm", "contact_model"}
+               "angle_deg", "vertices_mm", "diameter_mm", "contact_model"}
 
 
 def _check(value, key, spec, where):
