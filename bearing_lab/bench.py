@@ -1,0 +1,324 @@
+"""Speed against error: the work-precision study behind ``bearing-lab bench``.
+
+For each benchmark scene every solver setting (fixed steps, adaptive tolerances),
+every fidelity (quasi-static balls, ball inertia) and every defect-contact model
+(along-track profile, rigid 2-D drop, 2-D with area loss) runs the same record; each
+is scored by its compute seconds per simulated second and its error in peak
+acceleration, RMS, excitation period and impulse duration against ONE converged
+reference per scene: the most complete model (multibody, "area" contact) with dp54 at
+rtol 1e-9 and a 2 µs step ceiling.  Convergence of that reference is established by
+a second run at rtol 1e-10 with a 1 µs ceiling; their difference is reported as the
+reference's own error.  scipy's ``solve_ivp`` (LSODA, Radau) integrates the same numba
+right-hand side in the same run, on a shorter window with its own reference.
+
+Outputs (``reports/performance/``): ``index.html`` (table and figures),
+``work_precision_<scene>.png`` (log cost against log error), ``performance.nc``
+(every row) and ``auto_rules.toml`` (the cheapest setting within the default
+tolerance per kind of scene, which ``fidelity = "auto"`` reads when it is copied to
+``bearing_lab/sim/auto_rules.toml``).
+"""
+from __future__ import annotations
+
+import base64
+import io
+import math
+from pathlib import Path
+import time
+
+import numpy as np
+import xarray as xr
+
+from .sim import load_scene
+from .sim.assembly import assemble
+from .sim.integrate import METHODS, _decimate_acc, _run, _warm_up, anti_alias_taps
+
+G0 = 9.80665
+TOL_PEAK = 0.01
+TOL_PERIOD = 0.001
+
+SCENES = [
+    ("paper-healthy", "paper-healthy", {}, "healthy"),
+    ("paper-slot", "paper-slot", {}, "defect"),
+    ("paper-O1-H=B/2", "paper-O1", {"defect.offset_mm": 0.5}, "defect"),
+    ("paper-O2-theta=60", "paper-O2", {"defect.skew_deg": 60.0}, "defect"),
+    ("cwru-or007-6", "cwru-or007-6", {}, "defect"),
+    ("paper-slot-300rpm", "paper-slot", {"speed_rpm": 300.0}, "defect-slow"),
+]
+
+MB_SETTINGS = ([("dp54", r, None, None) for r in (1e-3, 1e-4, 1e-5, 1e-6)]
+               + [("bs32", r, None, None) for r in (1e-3, 1e-4, 1e-5)]
+               + [("rk4", 0.0, h, None) for h in (1e-5, 5e-6, 2e-6)])
+QS_SETTINGS = ([("dp54", r, None, m) for r in (1e-4, 1e-5) for m in (2.5e-5, 1e-4)]
+               + [("bs32", r, None, m) for r in (1e-3, 1e-4) for m in (2.5e-5, 1e-4)])
+
+
+def _scene(base, ov, duration, fidelity="multibody", model=None):
+    sc = load_scene(base, fidelity=fidelity, **ov, **{"output.duration_s": duration})
+    if model is not None and sc.data["defect"]:
+        raw = dict(sc.data)
+        raw["defect"] = [dict(d, contact_model=model) for d in raw["defect"]]
+        sc = load_scene(raw)
+    return sc
+
+
+def _measures(acc, fs, scene):
+    """peak, RMS, excitation period, median impulse duration of an acceleration record."""
+    from .analysis import excitation_period, impulses
+    b = scene.bearing
+    fr = scene.nominal_rpm / 60
+    f0 = b.fault_frequencies(fr)
+    race = scene.defects[0].race if scene.defects else "outer"
+    fexp = f0["bpfi"] if race == "inner" else (2 * f0["bsf"] if race == "ball" else f0["bpfo"])
+    out = {"peak": float(np.max(np.abs(acc))), "rms": float(np.std(acc))}
+    try:
+        out["period"], _ = excitation_period(acc, fs, frequency_range=(0.9 * fexp, 1.1 * fexp))
+    except Exception:  # noqa: BLE001 - no line (e.g. a healthy record): no period
+        out["period"] = math.nan
+    try:
+        imp = impulses(acc, fs, min_separation=0.5 / fexp)
+        out["duration"] = float(np.median(imp.duration)) if len(imp.duration) else math.nan
+    except Exception:  # noqa: BLE001
+        out["duration"] = math.nan
+    return out
+
+
+def _timed(asm, method, rtol, step, max_step):
+    t0 = time.perf_counter()
+    res = _run(asm, METHODS[method], float(rtol), progress=False, step=step, max_step=max_step)
+    return res, (time.perf_counter() - t0) / res["t_end"]
+
+
+def _scipy(asm, method, rtol, max_step=2.5e-5):
+    from scipy.integrate import solve_ivp
+    from .sim import _kernels as K
+    scene = asm.scene
+    fs = scene.fs_out
+    R = int(scene.data["output"]["oversample"])
+    taps = anti_alias_taps(fs, R)
+    half = len(taps) // 2
+    dt_f = 1 / (fs * R)
+    n_out = int(round(scene.duration * fs))
+    m_pad = half + 2
+    n_fine = m_pad + (n_out - 1) * R + m_pad + 1
+    fine_t = scene.settle - m_pad * dt_f + (np.arange(n_fine + 1) - 0.5) * dt_f
+    z = asm.n_balls
+    fi, fo = np.empty(z), np.empty(z)
+    args = (asm.p, asm.sp_t, asm.sp_w, asm.sp_th, asm.dint, asm.dflt, asm.hbuf, asm.gbuf)
+
+    def f(t, y):
+        dy = np.empty_like(y)
+        K.rhs(t, y, *args, dy, fi, fo)
+        return dy
+    t_end = fine_t[-1] + 1e-9
+    tic = time.perf_counter()
+    sol = solve_ivp(f, (0.0, t_end), asm.y0.copy(), method=method, rtol=rtol,
+                    atol=asm.atol_scale * rtol, max_step=max_step, dense_output=True)
+    cost = (time.perf_counter() - tic) / t_end
+    if not sol.success:
+        return None, cost
+    v = sol.sol(fine_t)[[6, 7]].T
+    acc = _decimate_acc(dict(fine_out=v, dt_f=dt_f, taps=taps, m_pad=m_pad, R=R, n_out=n_out))
+    return acc[:, 1], cost
+
+
+def _err(a, b):
+    if not (math.isfinite(a) and math.isfinite(b)) or b == 0:
+        return math.nan
+    return abs(a - b) / abs(b)
+
+
+def run_bench(out_dir="reports/performance", *, duration=0.3, scipy_duration=0.03, scenes=None,
+              progress=True, scipy=True) -> xr.Dataset:
+    """Run the work-precision study; write HTML, PNG, netCDF and rules under ``out_dir``."""
+    from tqdm.auto import tqdm
+    _warm_up()
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    chosen = [s for s in SCENES if scenes is None or s[0] in scenes]
+    rows = []
+    notes = {}
+    for label, base, ov, kind in tqdm(chosen, desc="bench scenes", disable=not progress):
+        sc_ref = _scene(base, ov, duration, "multibody", "area" if kind != "healthy" else None)
+        asm = assemble(sc_ref)
+        fs = sc_ref.fs_out
+        ref, _ = _timed(asm, "dp54", 1e-9, None, 2e-6)
+        ref2, _ = _timed(asm, "dp54", 1e-10, None, 1e-6)
+        m_ref = _measures(ref["acc"][:, 1], fs, sc_ref)
+        m_ref2 = _measures(ref2["acc"][:, 1], fs, sc_ref)
+        notes[label] = {k: _err(m_ref2[k], m_ref[k]) for k in m_ref}
+        jobs = [("multibody", "area", *s) for s in MB_SETTINGS]
+        jobs += [("quasi-static", "area", *s) for s in QS_SETTINGS]
+        if kind != "healthy":
+            jobs += [("multibody", m, "dp54", 1e-5, None, None) for m in ("drop", "profile")]
+        for fid, model, method, rtol, step, mx in jobs:
+            sc = _scene(base, ov, duration, fid, model if kind != "healthy" else None)
+            asm_j = assemble(sc)
+            res, cost = _timed(asm_j, method, rtol, step, mx)
+            m = _measures(res["acc"][:, 1], fs, sc)
+            setting = (f"{method} " + (f"h={step:g}" if step else f"rtol={rtol:g}")
+                       + (f" max_step={mx:g}" if mx else ""))
+            rows.append(dict(scene=label, kind=kind, fidelity=fid, contact=model if kind != "healthy" else "none",
+                             setting=setting, method=method, rtol=rtol, step=step or 0.0, max_step=mx or 0.0,
+                             solver="bearing_lab", cost=cost,
+                             **{f"err_{k}": _err(m[k], m_ref[k]) for k in m_ref}))
+        if scipy:
+            sc_s = _scene(base, ov, scipy_duration, "multibody", "area" if kind != "healthy" else None)
+            asm_s = assemble(sc_s)
+            ref_s, _ = _timed(asm_s, "dp54", 1e-9, None, 2e-6)
+            pk = float(np.max(np.abs(ref_s["acc"][:, 1])))
+            rms = float(np.std(ref_s["acc"][:, 1]))
+            ours, cost_o = _timed(asm_s, "dp54", 1e-5, None, None)
+            for name, method, rtol, acc, cost in (
+                    ("bearing_lab dp54 rtol=1e-05", "dp54", 1e-5, ours["acc"][:, 1], cost_o),
+                    *[(f"scipy {mm} rtol={rr:g}", mm, rr, *_scipy(asm_s, mm, rr)) for mm, rr in
+                      (("LSODA", 1e-6), ("LSODA", 1e-8), ("Radau", 1e-8))]):
+                rows.append(dict(scene=label, kind=kind, fidelity="multibody",
+                                 contact="area" if kind != "healthy" else "none",
+                                 setting=f"{name} (short window)", method=method, rtol=rtol, step=0.0,
+                                 max_step=2.5e-5, solver="scipy" if name.startswith("scipy") else "bearing_lab-short",
+                                 cost=cost,
+                                 err_peak=_err(float(np.max(np.abs(acc))), pk) if acc is not None else math.nan,
+                                 err_rms=_err(float(np.std(acc)), rms) if acc is not None else math.nan,
+                                 err_period=math.nan, err_duration=math.nan))
+    keys = list(rows[0])
+    ds = xr.Dataset({k: ("row", [r[k] for r in rows]) for k in keys})
+    ds["cost"].attrs["units"] = "s per simulated s"
+    for k in ("err_peak", "err_rms", "err_period", "err_duration"):
+        ds[k].attrs["units"] = "1"
+    ds.attrs.update({"duration_s": duration, "scipy_duration_s": scipy_duration,
+                     "reference": "multibody + area contact, dp54 rtol 1e-9, max step 2e-6 s",
+                     "reference_self_check": repr(notes), "tolerance_peak": TOL_PEAK,
+                     "tolerance_period": TOL_PERIOD, "sampling_rate_hz": 0.0,
+                     "bearing_lab_version": __import__("bearing_lab").__version__})
+    from .io_netcdf import write_netcdf
+    write_netcdf(ds, out / "performance.nc")
+    rules = _rules(rows)
+    (out / "auto_rules.toml").write_text(rules)
+    _report(out, rows, notes)
+    return ds
+
+
+def _ok(r):
+    per_ok = not math.isfinite(r["err_period"]) or r["err_period"] <= TOL_PERIOD
+    return math.isfinite(r["err_peak"]) and r["err_peak"] <= TOL_PEAK and per_ok
+
+
+def fastest_within_tolerance(rows, scene):
+    cands = [r for r in rows if r["scene"] == scene and r["solver"] == "bearing_lab" and _ok(r)]
+    return min(cands, key=lambda r: r["cost"]) if cands else None
+
+
+def _rules(rows) -> str:
+    """Per kind of scene: the cheapest setting that met the tolerance on EVERY scene of that kind."""
+    lines = ["# written by `bearing-lab bench`: the cheapest setting within "
+             f"{TOL_PEAK:.0%} peak-acceleration and {TOL_PERIOD:.1%} period error on every bench scene of "
+             "the kind", ""]
+    kinds = sorted({r["kind"] for r in rows})
+    for kind in kinds:
+        scenes = sorted({r["scene"] for r in rows if r["kind"] == kind})
+        settings = {}
+        for r in rows:
+            if r["kind"] != kind or r["solver"] != "bearing_lab" or r["contact"] not in ("area", "none"):
+                continue
+            settings.setdefault((r["fidelity"], r["method"], r["rtol"], r["step"], r["max_step"]), []).append(r)
+        best = None
+        for key, rs in settings.items():
+            if len(rs) == len(scenes) and all(_ok(r) for r in rs):
+                cost = max(r["cost"] for r in rs)
+                worst = max(r["err_peak"] for r in rs)
+                if best is None or cost < best[1]:
+                    best = (key, cost, worst)
+        if best is None:
+            continue
+        (fid, method, rtol, step, mx), cost, worst = best
+        lines += [f"[{kind}]", f'fidelity = "{fid}"', f'method = "{method}"', f"rtol = {rtol!r}",
+                  f"step_s = {step!r}", f"max_step_s = {mx or 2.5e-5!r}",
+                  f"expected_peak_error = {worst!r}", f"cost_s_per_s = {cost!r}",
+                  f"scenes = {scenes!r}".replace("'", '"'), ""]
+    return "\n".join(lines)
+
+
+def _png(fig):
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=90)
+    return base64.b64encode(buf.getvalue()).decode()
+
+
+def _report(out, rows, notes):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    scenes = list(dict.fromkeys(r["scene"] for r in rows))
+    html = ["<!DOCTYPE html><html><head><meta charset='utf-8'><title>bearing_lab: speed against error"
+            "</title><style>body{font-family:sans-serif;max-width:1100px;margin:auto}table{border-collapse:"
+            "collapse;font-size:12px}td,th{border:1px solid #999;padding:2px 6px;text-align:right}</style>"
+            "</head><body><h1>Speed against error</h1>",
+            f"<p>{__doc__.split('Outputs')[0]}</p>",
+            f"<p>Tolerance: {TOL_PEAK:.0%} in peak acceleration, {TOL_PERIOD:.1%} in excitation period. "
+            "Cost: compute seconds per simulated second, one core, including the settling time.</p>"]
+    for sc in scenes:
+        rs = [r for r in rows if r["scene"] == sc]
+        fig, ax = plt.subplots(figsize=(6.5, 4.2))
+        for fid, mk in (("multibody", "o"), ("quasi-static", "s")):
+            for solver, col in (("bearing_lab", None), ("scipy", "k")):
+                sel = [r for r in rs if r["fidelity"] == fid and r["solver"] == solver
+                       and math.isfinite(r["err_peak"])]
+                if not sel:
+                    continue
+                ax.scatter([max(r["err_peak"], 1e-9) for r in sel], [r["cost"] for r in sel], marker=mk,
+                           c=col, label=f"{fid} ({solver})", alpha=0.8)
+                for r in sel:
+                    ax.annotate(r["setting"].replace(" (short window)", ""), (max(r["err_peak"], 1e-9), r["cost"]),
+                                fontsize=5, alpha=0.7)
+        ax.axvline(TOL_PEAK, color="r", ls="--", lw=0.8)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("relative error in peak acceleration")
+        ax.set_ylabel("compute s per simulated s")
+        ax.set_title(f"work-precision: {sc}")
+        ax.legend(fontsize=7)
+        ax.grid(alpha=0.3, which="both")
+        fig.tight_layout()
+        fig.savefig(out / f"work_precision_{sc.replace('/', '_').replace('=', '')}.png", dpi=100)
+        best = fastest_within_tolerance(rows, sc)
+        sp = [r for r in rs if r["solver"] == "scipy" and math.isfinite(r["err_peak"]) and r["err_peak"] <= TOL_PEAK]
+        html.append(f"<h2>{sc}</h2><p>reference self-check (rtol 1e-10 vs 1e-9): "
+                    + ", ".join(f"{k} {v:.1e}" for k, v in notes[sc].items()) + "</p>")
+        if best:
+            html.append(f"<p><b>Fastest within tolerance:</b> {best['fidelity']}, {best['contact']}, "
+                        f"{best['setting']}: {best['cost']:.4f} s/s, peak error {best['err_peak']:.2e}"
+                        + (f"; speed-up over scipy's best within tolerance ({min(sp, key=lambda r: r['cost'])['setting']}): "
+                           f"{min(r['cost'] for r in sp) / best['cost']:.0f}x" if sp else "") + "</p>")
+        html.append(f"<img src='data:image/png;base64,{_png(fig)}'>")
+        plt.close(fig)
+        html.append("<table><tr><th>fidelity</th><th>contact</th><th>setting</th><th>s/s</th><th>peak err</th>"
+                    "<th>RMS err</th><th>period err</th><th>duration err</th></tr>")
+        for r in sorted(rs, key=lambda r: r["cost"]):
+            def f(x):
+                return "-" if not math.isfinite(x) else f"{x:.1e}"
+            html.append(f"<tr><td>{r['fidelity']}</td><td>{r['contact']}</td><td>{r['setting']}</td>"
+                        f"<td>{r['cost']:.4f}</td><td>{f(r['err_peak'])}</td><td>{f(r['err_rms'])}</td>"
+                        f"<td>{f(r['err_period'])}</td><td>{f(r['err_duration'])}</td></tr>")
+        html.append("</table>")
+    html.append("</body></html>")
+    (out / "index.html").write_text("\n".join(html), encoding="utf-8")
+
+
+def summary_table(ds: xr.Dataset) -> str:
+    """Markdown: per scene, the fastest setting within tolerance and the speed-up over scipy."""
+    rows = [{k: ds[k].values[i].item() for k in ds.data_vars} for i in range(ds.sizes["row"])]
+    lines = ["| scene | fastest within tolerance | s / simulated s | peak error | scipy's best within tolerance | speed-up |",
+             "|---|---|---|---|---|---|"]
+    for sc in dict.fromkeys(r["scene"] for r in rows):
+        best = fastest_within_tolerance(rows, sc)
+        sp = [r for r in rows if r["scene"] == sc and r["solver"] == "scipy" and math.isfinite(r["err_peak"])
+              and r["err_peak"] <= TOL_PEAK]
+        spb = min(sp, key=lambda r: r["cost"]) if sp else None
+        if best:
+            lines.append(f"| {sc} | {best['fidelity']}, {best['contact']}, {best['setting']} | {best['cost']:.4f} | "
+                         f"{best['err_peak']:.1e} | {spb['setting'] if spb else '-'} "
+                         f"{'%.3f s/s' % spb['cost'] if spb else ''} | "
+                         f"{'%.0fx' % (spb['cost'] / best['cost']) if spb else '-'} |")
+        else:
+            lines.append(f"| {sc} | none within tolerance | | | | |")
+    return "\n".join(lines)

@@ -1,0 +1,27 @@
+"""`bearing-lab bench`: speed against error (reports/performance/)."""
+from __future__ import annotations
+
+
+def _bench(args) -> int:
+    from ..bench import SCENES, run_bench, summary_table
+    names = [s[0] for s in SCENES]
+    if args.scene:
+        bad = [s for s in args.scene if s not in names]
+        if bad:
+            from ..errors import BearingLabError
+            raise BearingLabError(f"--scene {bad[0]!r}: allowed values are " + ", ".join(names))
+    ds = run_bench(args.output, duration=args.duration, scenes=args.scene, progress=not args.quiet,
+                   scipy=not args.no_scipy)
+    print(summary_table(ds))
+    print(f"\nwrote {args.output}/index.html, performance.nc, auto_rules.toml and work-precision PNGs")
+    return 0
+
+
+def register(sub) -> None:
+    p = sub.add_parser("bench", help="speed against error for every solver setting, fidelity and contact model")
+    p.add_argument("-o", "--output", default="reports/performance", metavar="DIR")
+    p.add_argument("--duration", type=float, default=0.3, metavar="S", help="simulated seconds per run")
+    p.add_argument("--scene", action="append", metavar="NAME", help="only these bench scenes")
+    p.add_argument("--no-scipy", action="store_true", help="skip the scipy solve_ivp baseline")
+    p.add_argument("-q", "--quiet", action="store_true")
+    p.set_defaults(func=_bench)
