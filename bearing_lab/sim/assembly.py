@@ -164,7 +164,8 @@ def assemble(scene: Scene, *, fidelity: str | None = None) -> Assembly:
     b = scene.bearing
     fid = fidelity or scene.fidelity
     if fid == "auto":
-        fid = "multibody"
+        from .auto import resolve
+        fid = resolve(scene)["fidelity"]
     z = b.n_balls
     mat = d["material"]
     E, nu = mat["youngs_modulus_gpa"] * 1e9, mat["poisson_ratio"]

@@ -126,7 +126,7 @@ def _run(asm, method, rtol, *, progress, t_end_override=None, step=None, max_ste
     rtol = float(rtol)
     defect_steps = float(defect_steps)
     adaptive = bool(np.any(e != 0))
-    hmax = max_step if max_step is not None else d["solver"]["max_step_s"]
+    hmax = max_step if max_step is not None else (d["solver"]["max_step_s"] or 2.5e-5)
     if not adaptive:
         h = float(step if step is not None else d["solver"]["step_s"])
         hmax = h
@@ -168,7 +168,7 @@ def _run(asm, method, rtol, *, progress, t_end_override=None, step=None, max_ste
             if status != 0:
                 what = "the state became NaN/Inf" if status == 1 else "the step size underflowed"
                 raise SolverError(f"scene {scene.name!r}: integration failed at t = {t_new:.6g} s: {what} "
-                                  f"(method {d['solver']['method']}, rtol {rtol:g}); the scene may be "
+                                  f"(rtol {rtol:g}); the scene may be "
                                   "unphysical, or try solver.method='dp54' with a smaller solver.max_step_s")
             # states at the output samples of this chunk: displacements and ball loads
             if out_t.size:
@@ -254,7 +254,18 @@ def simulate(scene, *, fidelity: str | None = None, duration: float | None = Non
     t_start = _time.perf_counter()
     asm = assemble(sc)
     d = sc.data
-    res = _run(asm, METHODS[d["solver"]["method"]], d["solver"]["rtol"], progress=progress,
+    from .auto import resolve
+    choice = resolve(sc)
+    method_name = d["solver"]["method"]
+    max_step = d["solver"]["max_step_s"]
+    rtol_ = d["solver"]["rtol"]
+    if method_name == "auto":
+        method_name = choice["method"]
+        max_step = max_step if max_step is not None else choice["max_step_s"]
+        rtol_ = rtol_ if rtol_ is not None else choice["rtol"]
+    rtol_ = rtol_ if rtol_ is not None else 1e-5
+    max_step = max_step if max_step is not None else 2.5e-5
+    res = _run(asm, METHODS[method_name], rtol_, progress=progress, max_step=max_step,
                defect_steps=d["solver"]["defect_steps"], loads=d["output"]["ball_loads"])
     acc = res["acc"]
     if d["sensor"]["enabled"]:
@@ -300,8 +311,12 @@ def simulate(scene, *, fidelity: str | None = None, duration: float | None = Non
         "defect_contact_models": ",".join(asm.contact_models) if asm.contact_models else "none",
         "wall_time_s": float(wall),
         "compile_time_s": float(compile_s),
-        "solver_method": d["solver"]["method"],
-        "solver_rtol": float(d["solver"]["rtol"]),
+        "solver_method": method_name,
+        "solver_rtol": float(rtol_),
+        "solver_max_step_s": float(max_step),
+        "fidelity_requested": sc.fidelity,
+        "auto_choice": (choice["reason"] + f"; kind {choice['kind']}; expected peak-acceleration error "
+                        f"{choice['expected_peak_error']}") if "auto" in (sc.fidelity, d["solver"]["method"]) else "",
         "solver_steps": int(stats[0]),
         "solver_rejected_steps": int(stats[1]),
         "settle_time_s": float(sc.settle),

@@ -115,8 +115,9 @@ SCHEMA: dict[str, dict[str, tuple]] = {
         "name": ("custom", str, None, "scene name"),
         "description": ("", str, None, "one line shown by `bearing-lab scenes`"),
         "bearing": ("6308", str, None, "catalog bearing (6308, 6205, 6203) or see [bearing_geometry]"),
-        "fidelity": ("multibody", str, ("multibody", "quasi-static", "auto"),
-                     "multibody: each ball a body with radial inertia; quasi-static: massless balls"),
+        "fidelity": ("auto", str, ("multibody", "quasi-static", "auto"),
+                     "multibody: each ball a body with radial inertia; quasi-static: massless balls; "
+                     "auto: the cheapest within 1 % peak acceleration (sim/auto.py)"),
     },
     "bearing_geometry": {
         "n_balls": (None, int, "pos", "override Z"),
@@ -191,10 +192,11 @@ SCHEMA: dict[str, dict[str, tuple]] = {
         "ball_loads": (True, bool, None, "store per-ball contact loads"),
     },
     "solver": {
-        "method": ("dp54", str, ("dp54", "bs32", "rk4"), "dp54/bs32: adaptive embedded RK; rk4: fixed step"),
-        "rtol": (1e-5, _NUM, "pos", "relative tolerance of the adaptive methods"),
+        "method": ("auto", str, ("auto", "dp54", "bs32", "rk4"),
+                   "dp54/bs32: adaptive embedded RK; rk4: fixed step; auto: from the measured rules"),
+        "rtol": (None, _NUM, "pos", "relative tolerance of the adaptive methods (default: the rule's, or 1e-5)"),
         "step_s": (2e-6, _NUM, "pos", "fixed step (rk4)"),
-        "max_step_s": (2.5e-5, _NUM, "pos", "largest step of the adaptive methods"),
+        "max_step_s": (None, _NUM, "pos", "largest step of the adaptive methods (default: the rule's, or 25 µs)"),
         "defect_steps": (40, int, "pos", "at least this many steps while a ball crosses a defect"),
     },
 }
