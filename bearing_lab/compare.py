@@ -312,7 +312,7 @@ class CalibrationResult:
     damping_ratio: float
     gain: float
     fit_error_db: float          # RMS of the residuals at the optimum, dB
-    initial_error_db: float      # same residuals without the resonator (gain 1, flat)
+    initial_error_db: float      # the same residuals for the uncalibrated simulation
     n_impacts_experiment: int
     n_impacts_simulation: int
     bounds: dict = field(default_factory=dict)
@@ -411,8 +411,10 @@ class _CalibrationProblem:
         return np.roll(env, self.pk - int(np.argmax(env)))
 
     def residuals(self, params, parts=False):
+        return self.residuals_of(self.model(params), parts=parts)
+
+    def residuals_of(self, y, parts=False):
         fs, pk = self.fs, self.pk
-        y = self.model(params)
         env_m = self.envelope(y)
         r1 = np.log(env_m[pk:] / np.maximum(self.env_e[pk:], 1e-30))
         _, Pm = _segment_spectrum(y, fs, self.ts, self.pre, self.post)
@@ -463,7 +465,6 @@ def calibrate_sensor(experiment, simulation, fs, period, *, band=None,
     f_lo, f_hi = max(frequency_bounds[0], 0.7 * f_peak), min(fmax_b, 1.3 * f_peak)
     lo = np.log([f_lo, damping_bounds[0], gain_bounds[0]])
     hi = np.log([f_hi, damping_bounds[1], gain_bounds[1]])
-    env1 = _mean_envelope(s, fs, ts, prob.pre, prob.post)
     best = None
     for fn0 in (0.9 * f_peak, f_peak, 1.1 * f_peak):
         for z0 in (0.03, 0.1):
@@ -485,10 +486,9 @@ def calibrate_sensor(experiment, simulation, fs, period, *, band=None,
 
     _, parts = residuals(best.x, parts=True)
     allr = np.concatenate(parts)
-    # "before": no resonator, unit gain
-    env_b = np.sqrt(env1 ** 2 + floor ** 2)
-    env_b = np.roll(env_b, pk - int(np.argmax(env_b)))
-    r1b = np.log(env_b[pk:] / np.maximum(env_e[pk:], 1e-30))
+    # "before": the same residuals for the simulation as it is (no resonator, unit gain)
+    _, parts0 = prob.residuals_of(s, parts=True)
+    env_b = prob.envelope(s)
     fn, zeta, g = (float(v) for v in np.exp(best.x))
     env_a = prob.envelope(model(best.x))
     at_bound = [name for name, v, a, b in zip(("frequency", "damping", "gain"), best.x, lo, hi)
@@ -498,7 +498,7 @@ def calibrate_sensor(experiment, simulation, fs, period, *, band=None,
     if at_bound:
         limits += f"; the fit ended at a bound for: {', '.join(at_bound)}"
     return CalibrationResult(
-        frequency_hz=fn, damping_ratio=zeta, gain=g, fit_error_db=rms_db(allr), initial_error_db=rms_db(r1b),
+        frequency_hz=fn, damping_ratio=zeta, gain=g, fit_error_db=rms_db(allr), initial_error_db=rms_db(np.concatenate(parts0)),
         n_impacts_experiment=int(te.size), n_impacts_simulation=int(ts.size),
         bounds={"frequency_hz": (float(f_lo), float(f_hi)),
                 "damping_ratio": tuple(map(float, damping_bounds)), "gain": tuple(map(float, gain_bounds))},

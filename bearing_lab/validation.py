@@ -878,7 +878,7 @@ def _run_recording(case: ValidationCase, out: Path, steps: _Steps, report, mirro
                            "bounds": str(cal.bounds["damping_ratio"])},
                           {"parameter": "gain", "fitted": cal.gain, "bounds": str(cal.bounds["gain"])},
                           {"parameter": "fit error, RMS of log-amplitude residuals (dB)", "fitted": cal.fit_error_db,
-                           "bounds": f"ringing-envelope error before: {cal.initial_error_db:.1f} dB"},
+                           "bounds": f"before calibration: {cal.initial_error_db:.1f} dB"},
                           {"parameter": "impacts used (recording / simulation)",
                            "fitted": f"{cal.n_impacts_experiment} / {cal.n_impacts_simulation}", "bounds": ""}],
                          "Calibration: fitted values",
