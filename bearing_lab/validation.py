@@ -497,20 +497,23 @@ def _run_paper(case: ValidationCase, out: Path, steps: _Steps, report):
     result.plot_envelope(ax=ax, fmax=600)
     ax.set_title("squared envelope spectra (whole band), kinematic fault frequencies and harmonics", fontsize=10)
     figs.append((fig, "SES of both simulations with kinematic BPFO (red), BPFI (green) and shaft (grey) markers."))
-    report.add_comparison(result, "Comparison table", figures=False, show_paper=True,
-                          intro=("Experiment column: the kinematic value (frequencies) or the paper's measured "
-                                 "figure (period, amplitude). The paper's own Table 2 numbers are shown beside."))
-    report.add_figures(figs, "Waveforms, spectra and SES (Figs 8-11)")
     # ---- HOOK: section-5 trends (2-D defect studies) ---------------------------------
     # `bearing-lab study paper` lives in bearing_lab/studies.py: run_paper_studies(out_dir) returns an
     # xarray Dataset or a dict of tables (the size, offset, skew and speed studies of section 5).
     # When it is importable and the case's [studies] table says enabled = true, its tables are
     # included here; rows it returns in the validation-row format are added to the case table.
-    studies = _paper_studies(case, out, ref, report)
+    from .report import Report
+    side = Report("studies")
+    studies = _paper_studies(case, out, ref, side)
     if studies.get("rows"):
         rows.extend(studies["rows"])
         result = compare(signals, fs, rows, n=n, ses_fmax=1000.0, attrs=dict(result.dataset.attrs))
     steps.step("studies")
+    report.add_comparison(result, "Comparison table", figures=False, show_paper=True,
+                          intro=("Experiment column: the kinematic value (frequencies) or the paper's measured "
+                                 "figure (period, amplitude). The paper's own Table 2 numbers are shown beside."))
+    report.add_figures(figs, "Waveforms, spectra and SES (Figs 8-11)")
+    report.sections.extend(side.sections)
     extra = {"numerical_error": errs,
              "compute": {k: {"wall_time_s": float(v.attrs["wall_time_s"]),
                              "compile_time_s": float(v.attrs.get("compile_time_s", 0.0)),
