@@ -38,7 +38,9 @@ placed by index, so a Dask sweep is bit for bit equal to a serial one.
 
 Cache: a finished scene is written to ``cache_dir/<hash>.nc`` (netCDF4,
 uncompressed, float64 kept exactly) where the hash is the sha256 of the resolved scene TOML
-(:meth:`Scene.to_toml`), the bearing_lab version and the simulate keywords.  A
+(:meth:`Scene.to_toml`), the bearing_lab version (with a fingerprint of the
+simulator's source, so a development install never reuses results of older
+code) and the simulate keywords.  A
 sweep that was stopped resumes: cached scenes are read, not recomputed.
 ``cache_dir`` defaults to ``$BEARING_LAB_CACHE`` or ``~/.cache/bearing_lab/sweeps``;
 ``cache_dir=False`` turns caching off.
@@ -61,7 +63,7 @@ import numpy as np
 from . import __version__
 from .errors import BearingLabError, SceneError
 
-__all__ = ["sweep", "scene_hash", "default_cache_dir", "dim_name", "key_units"]
+__all__ = ["sweep", "scene_hash", "code_fingerprint", "default_cache_dir", "dim_name", "key_units"]
 
 # units of the --set key suffixes (scene.py's _SUFFIX), as CF/UDUNITS strings
 _UNIT_STRINGS = {
@@ -101,11 +103,32 @@ def _canonical(key: str) -> str:
     return _ALIASES.get(key, key)
 
 
+_FINGERPRINT: list = []
+
+
+def code_fingerprint() -> str:
+    """sha256 of the simulator's source (bearing_lab/sim/**/*.py and bearings.py).
+
+    Part of the scene hash besides the version: in a development (editable) install
+    the physics changes while ``__version__`` stays put, and a cache keyed on the
+    version alone would hand back results of older code.
+    """
+    if not _FINGERPRINT:
+        root = Path(__file__).resolve().parent
+        h = hashlib.sha256()
+        for f in sorted([root / "bearings.py", *(root / "sim").rglob("*.py")]):
+            if f.is_file():
+                h.update(str(f.relative_to(root)).encode() + b"\0" + f.read_bytes() + b"\0")
+        _FINGERPRINT.append(h.hexdigest())
+    return _FINGERPRINT[0]
+
+
 def scene_hash(scene_toml: str, simulate_kwargs: dict | None = None) -> str:
-    """sha256 of the resolved scene TOML, the bearing_lab version and the simulate keywords."""
+    """sha256 of the resolved scene TOML, the bearing_lab version (and simulator source
+    fingerprint) and the simulate keywords: the cache key of one scene."""
     h = hashlib.sha256()
     h.update(scene_toml.encode())
-    h.update(b"\0bearing_lab " + __version__.encode())
+    h.update(b"\0bearing_lab " + __version__.encode() + b" " + code_fingerprint().encode())
     h.update(b"\0" + json.dumps(simulate_kwargs or {}, sort_keys=True, default=repr).encode())
     return h.hexdigest()
 
