@@ -187,10 +187,10 @@ def _run(asm, method, rtol, *, progress, t_end_override=None, step=None, max_ste
                 seg = a_fine[cm - half - v_start: cm + half + 1 - v_start]
                 acc[k_acc] = taps_rev @ seg
                 k_acc += 1
-            keep_from = max(m_pad + k_acc * R - half, 0)
-            if keep_from > v_start:
-                v_buf = v_buf[keep_from - v_start:]
-                v_start = keep_from
+            # drop the velocities no later output needs; v_buf[0] is always fine index v_start
+            drop = min(max(m_pad + k_acc * R - half - v_start, 0), v_buf.shape[0])
+            v_buf = v_buf[drop:]
+            v_start += drop
             if bar is not None:
                 bar.update(round(t_new - t, 6))
             t = t_new
