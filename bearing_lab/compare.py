@@ -55,6 +55,9 @@ QUANTITIES = {
 }
 
 
+#: quantities that are spectral lines: absent from both signals counts as agreement
+LINE_QUANTITIES = ("shaft_hz", "bpfo", "bpfi")
+
 # ------------------------------------------------------------------ tolerances and rows
 @dataclass(frozen=True)
 class Tolerance:
@@ -119,6 +122,11 @@ def make_row(quantity: str, simulation, experiment, tolerance: Tolerance, *, lab
              group="") -> dict:
     """One table row: simulation, experiment, difference, % difference, tolerance, pass."""
     s, e = _f(simulation), _f(experiment)
+    ok = bool(tolerance.check(s, e))
+    if quantity in LINE_QUANTITIES and np.isnan(s) and np.isnan(e):
+        # a spectral line neither signal shows: the model agrees with the recording (no such line)
+        ok = True
+        note = ("neither shows this line: agreement. " + note).strip()
     diff = s - e
     pct = 100.0 * diff / abs(e) if (np.isfinite(diff) and e != 0) else float("nan")
     lab, un = QUANTITIES.get(quantity, (quantity, "1"))
@@ -128,7 +136,7 @@ def make_row(quantity: str, simulation, experiment, tolerance: Tolerance, *, lab
         "units": units or un,
         "simulation": s, "experiment": e, "difference": diff, "difference_pct": pct,
         "tolerance_pct": tolerance.pct, "tolerance": tolerance.text(), "rule": tolerance.kind,
-        "pass": bool(tolerance.check(s, e)), "reason": tolerance.reason, "reference": reference,
+        "pass": ok, "reason": tolerance.reason, "reference": reference,
         "note": note, "paper_experiment": _f(paper_experiment), "paper_simulation": _f(paper_simulation),
     }
 
@@ -362,6 +370,9 @@ def _segment_spectrum(x, fs, times, pre, post):
 class _CalibrationProblem:
     """Residuals of the resonator fit (see :func:`calibrate_sensor`)."""
 
+    #: weight of the impact-peak residual against the three shape views (each normalised to 1)
+    PEAK_WEIGHT = 3.0
+
     def __init__(self, experiment, simulation, fs, period, *, band=None, pre=0.5e-3, post=None):
         from scipy.signal import hilbert
         from . import analysis as A
@@ -393,10 +404,12 @@ class _CalibrationProblem:
         self.peak_e = self.impact_peak(e, te)
 
     def impact_peak(self, y, times):
-        """Median over impacts of max |y| within +-20 % of a period around each impact."""
+        """90th percentile over impacts of max |y| within +-20 % of a period around each impact
+        (a high percentile: inner-race impacts outside the load zone are weak, and the median
+        of a strongly modulated train says little about its strong impacts)."""
         w = max(1, int(0.2 * self.period * self.fs))
         idx = (np.asarray(times) * self.fs).astype(int)
-        return float(np.median([np.max(np.abs(y[max(0, i - w): i + w + 1])) for i in idx]))
+        return float(np.percentile([np.max(np.abs(y[max(0, i - w): i + w + 1])) for i in idx], 90))
 
     @staticmethod
     def _ses_at(ses, k):
@@ -421,7 +434,7 @@ class _CalibrationProblem:
         r2 = np.array([0.5 * np.log((Pm[b].mean() + 1e-30) / (self.Pe[b].mean() + 1e-30)) for b in self.bins])
         _, ses_m = self.A.squared_envelope_spectrum(y, fs, window="hann", fmax=6.0 / self.period)
         r3 = np.array([0.25 * np.log(self._ses_at(ses_m, k) / self._ses_at(self.ses_e, k)) for k in self.kh])
-        r0 = np.array([np.log(max(self.impact_peak(y, self.ts), 1e-30) / max(self.peak_e, 1e-30))])
+        r0 = np.array([self.PEAK_WEIGHT * np.log(max(self.impact_peak(y, self.ts), 1e-30) / max(self.peak_e, 1e-30))])
         r = np.concatenate([r0, r1 / math.sqrt(len(r1)), r2 / math.sqrt(len(r2)), r3 / math.sqrt(len(r3))])
         return (r, (r0, r1, r2, r3)) if parts else r
 
@@ -433,7 +446,8 @@ def calibrate_sensor(experiment, simulation, fs, period, *, band=None,
 
     Least squares, in log amplitude, on four views of the impacts:
 
-    0. the median impact peak (max |a| around each impact), which mostly sets the gain;
+    0. the 90th percentile of the impact peaks (max |a| around each impact), weighted 3:
+       it mostly sets the gain;
     1. the measured *impulse ringing*: the mean Hilbert envelope of the segments that
        start ``pre`` before each impact and last ``post`` (default 60 % of a period),
        experiment against the filtered simulation, peaks aligned;

@@ -102,3 +102,12 @@ def test_comparison_round_trip(tmp_path):
     assert back.plot_waveforms(ax=axes[0]) is axes[0]
     assert back.plot_spectra(ax=axes[1]) is axes[1]
     assert back.plot_envelope(ax=axes[2], fmax=600) is axes[2]
+
+
+def test_a_line_absent_from_both_signals_agrees_but_one_sided_fails():
+    t = Tolerance("pct", 1.0, "r")
+    nan = float("nan")
+    assert make_row("bpfi", nan, nan, t)["pass"] and "agreement" in make_row("bpfi", nan, nan, t)["note"]
+    assert not make_row("bpfi", nan, 161.7, t)["pass"]
+    assert not make_row("bpfi", 162.0, nan, t)["pass"]
+    assert not make_row("rms", nan, nan, t)["pass"]  # not a line: a missing number fails
