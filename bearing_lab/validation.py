@@ -34,6 +34,7 @@ import math
 import os
 import platform
 import subprocess
+import sys
 import time
 import tomllib
 from dataclasses import dataclass, field
@@ -252,8 +253,10 @@ def check_case(case: ValidationCase, mirror=None) -> None:
     for rec in case.recording_names:
         if _locate(rec, mirror) is None:
             m = mirror or os.environ.get("BEARING_LAB_MIRROR")
-            where = f"the mirror {m}" if m else "no mirror (set BEARING_LAB_MIRROR or run `bearing-lab data fetch`)"
-            raise _err(case.name, f"recording {rec!r} not found in {where}")
+            where = (f"not found in the mirror {m} nor the data directory" if m else
+                     f"not found: BEARING_LAB_MIRROR is not set (set it to the public recordings' directory, "
+                     f"or run `bearing-lab data fetch {rec}`)")
+            raise _err(case.name, f"recording {rec!r} {where}")
 
 
 def default_set(mirror=None):
@@ -468,7 +471,8 @@ def _run_paper(case: ValidationCase, out: Path, steps: _Steps, report):
         a1.set_ylabel("acceleration (g)")
         a1.legend(loc="upper right", fontsize=8)
         a1.set_title(f"{label}: outer-ring acceleration, first 0.1 s (cf. the paper's "
-                     f"{'Fig. 8' if label == 'healthy' else 'Fig. 10'})", fontsize=10)
+                     f"{'Fig. 8' if label == 'healthy' else 'Fig. 10'}); simulated max |a| = "
+                     f"{np.max(np.abs(x)):.3g} g", fontsize=10)
         f, a = A.amplitude_spectrum(x - x.mean(), fs, window="hann")
         s2 = f <= 1000
         a2.semilogy(f[s2], a[s2], lw=0.6, color="tab:blue", label="bearing_lab simulation")
@@ -946,6 +950,9 @@ def run_case(case: ValidationCase, out_dir, *, progress=True, mirror=None, posit
             "date": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
             "host": f"{platform.system()} {platform.machine()}, {os.cpu_count()} cores"}
     report.add_provenance(info)
+    report.add_html('<p>Data of this page: <a href="comparison.nc">comparison.nc</a> (waveforms on one time '
+                    'base, spectra, SES and the table; <code>bearing_lab.compare.ComparisonResult.load</code>) and '
+                    '<a href="summary.json">summary.json</a>.</p>', "Files")
     result.dataset.attrs["provenance"] = json.dumps(_clean({k: v for k, v in info.items() if k != "case TOML"}),
                                                     default=str)
     result.to_netcdf(out / "comparison.nc")
@@ -999,8 +1006,11 @@ def run_validation(specs=None, out_dir="reports", *, strict=False, progress=True
             oc = run_case(c, out_dir, progress=progress, mirror=mirror)
         except ValidationCaseError:
             raise
-        except BearingLabError as exc:
-            oc = CaseOutcome(c.name, c.title, "error", reason=f"{type(exc).__name__}: {exc}")
+        except Exception as exc:  # one broken case must not lose the others' reports: listed as "error"
+            msg = f"{type(exc).__name__}: {exc}".splitlines()[0]
+            if not isinstance(exc, BearingLabError):
+                print(f"bearing-lab validate: case {c.name!r} failed to run: {msg}", file=sys.stderr)
+            oc = CaseOutcome(c.name, c.title, "error", reason=msg)
         outcomes.append(oc)
         if bar is not None:
             bar.update(1)
