@@ -41,7 +41,12 @@ P_FID = 34
 P_TSTEP, P_FIX2, P_FIY2, P_FOX2, P_FOY2 = 35, 36, 37, 38, 39
 P_NDEF = 40
 P_SPIN = 41
-P_SIZE = 42
+# dynamic cage: flag, traction coefficient, slip speed of full traction, pocket stiffness,
+# pocket clearance (arc, each side), pocket damping, cage polar inertia, ball polar inertia,
+# ball radius, sensor state offset
+P_CAGE, P_MU, P_VREF, P_KPOCK, P_CPOCK, P_DPOCK, P_IC, P_IB, P_RB, P_SENSOFF = 42, 43, 44, 45, 46, 47, 48, 49, 50, 51
+P_CDRAG = 52
+P_SIZE = 53
 
 # ---- defect table layout: dint[k] = race, kind, npsi, ndelta, h_off, g_off, ball
 #   race 0: outer race, 1: inner race, 2: ball defect meeting the outer race,
@@ -255,21 +260,30 @@ def rhs(t, y, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, dy, fi_out, fo_out):
     has_def = ndef > 0
     spin = p[P_SPIN]
     base = 8
+    dyn = p[P_CAGE] > 0.5
     c0 = math.cos(phic)
     s0 = math.sin(phic)
     dc = math.cos(TWO_PI / z)
     ds = math.sin(TWO_PI / z)
     c = c0
     s = s0
+    pocket_torque = 0.0
     for j in range(z):
-        if j > 0:
-            # rotate by 2π/Z; re-anchor every 4 balls to keep rounding at 1e-16
-            if j % 4 == 0:
-                c = math.cos(phic + TWO_PI * j / z)
-                s = math.sin(phic + TWO_PI * j / z)
-            else:
-                c, s = c * dc - s * ds, s * dc + c * ds
-        phi = phic + TWO_PI * j / z
+        if dyn:
+            # dynamic cage: each ball's own orbital angle and speed are states
+            phi = y[base + 2 * z + j]
+            phidot = y[base + 3 * z + j]
+            c = math.cos(phi)
+            s = math.sin(phi)
+        else:
+            if j > 0:
+                # rotate by 2π/Z; re-anchor every 4 balls to keep rounding at 1e-16
+                if j % 4 == 0:
+                    c = math.cos(phic + TWO_PI * j / z)
+                    s = math.sin(phic + TWO_PI * j / z)
+                else:
+                    c, s = c * dc - s * ds, s * dc + c * ds
+            phi = phic + TWO_PI * j / z
         if qs:
             dtot = (xi - xo) * c + (yi - yo) * s - 2.0 * pd4
             drate = (vxi - vxo) * c + (vyi - vyo) * s + ((xi - xo) * (-s) + (yi - yo) * c) * phidot
@@ -306,6 +320,38 @@ def rhs(t, y, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, dy, fi_out, fo_out):
                 fi = impact(d_i, d_ir, p[P_KI], p[P_EXP], p[P_CMAX], p[P_DPEN])
             dy[base + j] = qd
             dy[base + z + j] = (fi - fo) / mb + (p[P_RP] + qj) * phidot * phidot - p[P_G] * s
+            if dyn:
+                # traction at both contacts (regularised Coulomb), cage pocket, spin
+                r = p[P_RP] + qj
+                om_b = y[base + 4 * z + j]
+                rb = p[P_RB]
+                vt_o = r * phidot - (vxo * (-s) + vyo * c)
+                vt_i = r * phidot - (vxi * (-s) + vyi * c)
+                slip_o = vt_o + rb * om_b
+                slip_i = vt_i - rb * om_b - omega_s * (p[P_RP] - rb)
+                ft_o = -p[P_MU] * fo * math.tanh(slip_o / p[P_VREF])
+                ft_i = -p[P_MU] * fi * math.tanh(slip_i / p[P_VREF])
+                gap = r * wrap(phi - y[base + 5 * z] - TWO_PI * j / z)
+                gap_rate = r * (phidot - y[base + 5 * z + 1])
+                fp = 0.0
+                cp = p[P_CPOCK]
+                if gap > cp:
+                    fp = -(p[P_KPOCK] * (gap - cp) + p[P_DPOCK] * gap_rate)
+                    if fp > 0.0:
+                        fp = 0.0
+                elif gap < -cp:
+                    fp = -(p[P_KPOCK] * (gap + cp) + p[P_DPOCK] * gap_rate)
+                    if fp < 0.0:
+                        fp = 0.0
+                pocket_torque -= fp * r
+                dy[base + 2 * z + j] = phidot
+                dy[base + 3 * z + j] = (ft_o + ft_i + fp - mb * p[P_G] * c - 2.0 * mb * qd * phidot) / (mb * r)
+                dy[base + 4 * z + j] = rb * (ft_o - ft_i) / p[P_IB]
+                # reactions of the traction on the rings (tangential direction -s, c)
+                fix += -ft_i * (-s)
+                fiy += -ft_i * c
+                fox += -ft_o * (-s)
+                foy += -ft_o * c
         fix -= fi * c
         fiy -= fi * s
         fox += fo * c
@@ -328,8 +374,11 @@ def rhs(t, y, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, dy, fi_out, fo_out):
     dy[5] = vyo
     dy[6] = axo
     dy[7] = ayo
+    if dyn and not qs:
+        dy[base + 5 * z] = y[base + 5 * z + 1]
+        dy[base + 5 * z + 1] = (pocket_torque - p[P_CDRAG] * y[base + 5 * z + 1]) / p[P_IC]
     if p[P_SENS] > 0.5:
-        sb = 8 if qs else 8 + 2 * z
+        sb = int(p[P_SENSOFF])
         w = p[P_SW]
         zt = p[P_SZ]
         dy[sb] = y[sb + 2]
@@ -339,7 +388,7 @@ def rhs(t, y, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, dy, fi_out, fo_out):
 
 
 @njit(cache=True, error_model="numpy")
-def _step_limit(t, h, p, sp_t, sp_w, sp_th, dint, dflt, nsteps_def, hmax):
+def _step_limit(t, y, h, p, sp_t, sp_w, sp_th, dint, dflt, nsteps_def, hmax):
     """Bound the step near defects: land on zone entry, then take >= nsteps_def steps inside."""
     ndef = int(p[P_NDEF])
     if ndef == 0:
@@ -354,7 +403,11 @@ def _step_limit(t, h, p, sp_t, sp_w, sp_th, dint, dflt, nsteps_def, hmax):
         zlo = dflt[kk, F_ZLO]
         zhi = dflt[kk, F_ZHI]
         for j in range(z):
-            rel, reld = rel_angle(kk, j, phic + TWO_PI * j / z, phidot, theta_s, omega_s, spin, dint, dflt)
+            if p[P_CAGE] > 0.5:
+                rel, reld = rel_angle(kk, j, y[8 + 2 * z + j], y[8 + 3 * z + j], theta_s, omega_s, spin,
+                                      dint, dflt)
+            else:
+                rel, reld = rel_angle(kk, j, phic + TWO_PI * j / z, phidot, theta_s, omega_s, spin, dint, dflt)
             if rel > 5.0 or abs(reld) < 1e-12:
                 continue
             if zlo <= rel <= zhi:
@@ -408,7 +461,7 @@ def integrate(y, t, t_stop, h, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf,
             hstep = hmax
         if t + hstep > t_stop:
             hstep = t_stop - t
-        hstep = _step_limit(t, hstep, p, sp_t, sp_w, sp_th, dint, dflt, nsteps_def, hstep)
+        hstep = _step_limit(t, y, hstep, p, sp_t, sp_w, sp_th, dint, dflt, nsteps_def, hstep)
         if hstep < 1e-14:
             hstep = 1e-14
         for i in range(1, s):

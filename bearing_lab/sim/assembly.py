@@ -42,7 +42,7 @@ class Assembly:
 
     @property
     def sensor_index(self) -> int:
-        return 8 if self.fidelity == "quasi-static" else 8 + 2 * self.n_balls
+        return int(self.p[K.P_SENSOFF])
 
 
 def _unit(angle):
@@ -274,12 +274,29 @@ def assemble(scene: Scene, *, fidelity: str | None = None) -> Assembly:
     p[K.P_SW] = 2 * math.pi * sens["frequency_hz"]
     p[K.P_SZ] = sens["damping_ratio"]
     p[K.P_FID] = 1.0 if fid == "quasi-static" else 0.0
+    dyn = d["cage"]["model"] == "dynamic"
+    if dyn and fid == "quasi-static":
+        raise SceneError("cage.model='dynamic' needs fidelity='multibody' (massless balls have no "
+                         "orbital dynamics)")
+    p[K.P_CAGE] = 1.0 if dyn else 0.0
+    cg = d["cage"]
+    p[K.P_MU] = cg["traction_coefficient"]
+    p[K.P_VREF] = cg["traction_slip_m_s"]
+    p[K.P_KPOCK] = cg["pocket_stiffness_n_m"]
+    p[K.P_CPOCK] = cg["pocket_clearance_mm"] * 1e-3
+    p[K.P_DPOCK] = cg["pocket_damping_n_s_m"]
+    m_cage = cg["mass_kg"] or 0.15 * z * m_b
+    p[K.P_IC] = m_cage * (b.pitch_diameter / 2) ** 2
+    p[K.P_RB] = b.ball_diameter / 2
+    p[K.P_CDRAG] = cg["drag_n_m_s"]
+    p[K.P_IB] = 0.4 * m_b * (b.ball_diameter / 2) ** 2
     p[K.P_NDEF] = len(entries)
     p[K.P_SPIN] = b.frequency_factors()["bsf"]
 
     # initial state
-    n_ball_states = 0 if fid == "quasi-static" else 2 * z
+    n_ball_states = 0 if fid == "quasi-static" else (5 * z + 2 if dyn else 2 * z)
     n = 8 + n_ball_states + (4 if sens["enabled"] else 0)
+    p[K.P_SENSOFF] = 8 + n_ball_states
     y0 = np.zeros(n)
     y0[0:2] = st["xi"]
     y0[4:6] = st["xo"]
@@ -299,13 +316,29 @@ def assemble(scene: Scene, *, fidelity: str | None = None) -> Assembly:
                 return (hi.stiffness * max(di, 0) ** 1.5 - ho.stiffness * max(do, 0) ** 1.5 + fc)
             lo_q, hi_q = ou + pd4 - 1e-4, iu - pd4 + 1e-4
             y0[8 + j] = brentq(gq, lo_q, hi_q, xtol=1e-16, rtol=1e-14)
+        if dyn:
+            # balls at the kinematic positions and speeds, rolling without slip; cage alike
+            v_c = b.pitch_diameter / 2 * omega_c
+            for j, phi in enumerate(st["phis"]):
+                y0[8 + 2 * z + j] = phi
+                y0[8 + 3 * z + j] = omega_c
+                y0[8 + 4 * z + j] = -v_c / (b.ball_diameter / 2)
+            y0[8 + 5 * z] = phi_c0
+            y0[8 + 5 * z + 1] = omega_c
     # error-control scales: displacement ~ the static deflection, velocity ~ that x 2π·2 kHz
     x_scale = max((max(static_max, 10.0) / k_eff) ** (2 / 3), 1e-7)
     v_scale = x_scale * 2 * math.pi * 2000.0
     atol = np.empty(n)
-    pos_idx = [0, 1, 4, 5, *range(8, 8 + n_ball_states // 2)]
+    pos_idx = [0, 1, 4, 5, *range(8, 8 + z if fid != "quasi-static" else 8)]
     atol[:] = v_scale
     atol[pos_idx] = x_scale
+    if dyn:
+        # angles: the static deflection over the pitch radius; angular rates: 1 % of the cage speed
+        atol[8 + 2 * z:8 + 3 * z] = x_scale / (b.pitch_diameter / 2)
+        atol[8 + 3 * z:8 + 4 * z] = 0.01 * max(omega_c, 1.0)
+        atol[8 + 4 * z:8 + 5 * z] = 0.01 * max(omega_c, 1.0) * b.pitch_diameter / b.ball_diameter
+        atol[8 + 5 * z] = x_scale / (b.pitch_diameter / 2)
+        atol[8 + 5 * z + 1] = 0.01 * max(omega_c, 1.0)
     if sens["enabled"]:
         sb = 8 + n_ball_states
         atol[sb:sb + 2] = x_scale

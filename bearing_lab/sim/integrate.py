@@ -120,6 +120,9 @@ def _run(asm, method, rtol, *, progress, t_end_override=None, step=None, max_ste
     out_t_all = t0 + np.arange(n_out) / fs
     acc = np.zeros((n_out, 2))
     disp = np.zeros((n_out, 4))
+    dyn = d["cage"]["model"] == "dynamic"
+    cage_idx = 8 + 5 * z + 1
+    cage_speed = np.zeros(n_out) if dyn else None
     fi_all = np.zeros((z, n_out)) if loads else None
     fo_all = np.zeros((z, n_out)) if loads else None
     A, b, e, c, order, fsal = method
@@ -173,6 +176,8 @@ def _run(asm, method, rtol, *, progress, t_end_override=None, step=None, max_ste
             # states at the output samples of this chunk: displacements and ball loads
             if out_t.size:
                 disp[o_next:o_hi] = out_state[:, [0, 1, 4, 5]]
+                if dyn:
+                    cage_speed[o_next:o_hi] = out_state[:, cage_idx]
                 if loads:
                     K.loads_at(out_t, out_state, *args, fi_all[:, o_next:o_hi], fo_all[:, o_next:o_hi])
                 o_next = o_hi
@@ -199,7 +204,7 @@ def _run(asm, method, rtol, *, progress, t_end_override=None, step=None, max_ste
             bar.close()
     if t_end_override is None and (k_acc != n_out or o_next != n_out):
         raise SolverError(f"scene {scene.name!r}: output incomplete ({k_acc}/{o_next} of {n_out} samples)")
-    return dict(acc=acc, disp=disp, fi=fi_all, fo=fo_all, out_t=out_t_all, taps=taps, R=R,
+    return dict(acc=acc, disp=disp, fi=fi_all, fo=fo_all, out_t=out_t_all, cage_speed=cage_speed, taps=taps, R=R,
                 m_pad=m_pad, n_out=n_out, stats=stats, dt_f=dt_f, t0=t0, t_end=t_end)
 
 
@@ -295,6 +300,8 @@ def simulate(scene, *, fidelity: str | None = None, duration: float | None = Non
         },
         coords=coords,
     )
+    if res["cage_speed"] is not None:
+        ds["cage_speed"] = (("time",), res["cage_speed"], {"units": "rad s-1", "long_name": "cage angular speed"})
     if d["output"]["ball_loads"]:
         ds["ball_load_outer"] = (("ball", "time"), fo, {"units": "N", "long_name": "ball-outer race normal load"})
         ds["ball_load_inner"] = (("ball", "time"), fi, {"units": "N", "long_name": "ball-inner race normal load"})
@@ -324,6 +331,7 @@ def simulate(scene, *, fidelity: str | None = None, duration: float | None = Non
         "load_path": d["load"]["path"],
         "anti_alias": f"Kaiser FIR {len(res['taps'])} taps at {d['output']['oversample']}x, -6 dB at fs/2",
         "sensor_resonator": "on" if d["sensor"]["enabled"] else "off",
+        "cage_model": d["cage"]["model"],
         "Conventions": "CF-1.8",
     })
     return ds

@@ -176,7 +176,17 @@ SCHEMA: dict[str, dict[str, tuple]] = {
         "exponent": (1.5, _NUM, "pos", "IMPACT exponent e (Hertz point contact: 1.5)"),
     },
     "cage": {
-        "model": ("kinematic", str, ("kinematic",), "kinematic: balls spaced at the cage speed (FTF)"),
+        "model": ("kinematic", str, ("kinematic", "dynamic"),
+                  "kinematic: balls spaced at the cage speed (FTF); dynamic: cage and ball orbital/spin "
+                  "motion from traction and pocket contact (slip possible)"),
+        "mass_kg": (None, _NUM, "pos", "cage mass (default: 15 % of the balls' mass, a pressed-steel cage)"),
+        "pocket_clearance_mm": (0.15, _NUM, "nonneg", "circumferential ball-pocket play, each side"),
+        "pocket_stiffness_n_m": (1e7, _NUM, "pos", "ball-pocket contact stiffness (steel cage web)"),
+        "pocket_damping_n_s_m": (20.0, _NUM, "nonneg", "ball-pocket contact damping"),
+        "traction_coefficient": (0.08, _NUM, "pos", "ball-race traction coefficient at full slip (EHL: 0.05-0.1)"),
+        "traction_slip_m_s": (0.05, _NUM, "pos", "slip speed at which traction saturates (regularised Coulomb)"),
+        "drag_n_m_s": (1e-5, _NUM, "nonneg", "viscous drag on the cage (torque / angular speed): ~1e-3 N m at a "
+                       "6308's cage speed at 1800 r/min, the order of a lubricated cage's churning loss"),
     },
     "sensor": {
         "enabled": (False, bool, None, "accelerometer/housing resonator between outer ring and sensor"),
