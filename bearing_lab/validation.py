@@ -345,6 +345,10 @@ def _numerical_error(scene, base_ds, overrides, duration=0.25):
             "peak_difference_pct_of_peak": 100.0 * d / pk, "wall_time_fine_s": float(fine.attrs["wall_time_s"])}
 
 
+def _bounds(b) -> str:
+    return f"{b[0]:.4g} to {b[1]:.4g}"
+
+
 def _clean(v):
     """JSON-safe: NaN/inf -> None, numpy scalars -> Python."""
     if isinstance(v, dict):
@@ -880,10 +884,10 @@ def _run_recording(case: ValidationCase, out: Path, steps: _Steps, report, mirro
         report.add_figure(fig, "Calibration of the structural path",
                           caption="Mean envelope of the impacts before and after fitting the sensor resonator.")
         report.add_table([{"parameter": "resonance frequency (Hz)", "fitted": cal.frequency_hz,
-                           "bounds": str(cal.bounds["frequency_hz"])},
+                           "bounds": _bounds(cal.bounds["frequency_hz"])},
                           {"parameter": "damping ratio", "fitted": cal.damping_ratio,
-                           "bounds": str(cal.bounds["damping_ratio"])},
-                          {"parameter": "gain", "fitted": cal.gain, "bounds": str(cal.bounds["gain"])},
+                           "bounds": _bounds(cal.bounds["damping_ratio"])},
+                          {"parameter": "gain", "fitted": cal.gain, "bounds": _bounds(cal.bounds["gain"])},
                           {"parameter": "fit error, RMS of log-amplitude residuals (dB)", "fitted": cal.fit_error_db,
                            "bounds": f"before calibration: {cal.initial_error_db:.1f} dB"},
                           {"parameter": "impacts used (recording / simulation)",
