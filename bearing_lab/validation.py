@@ -717,9 +717,11 @@ def _run_recording(case: ValidationCase, out: Path, steps: _Steps, report, mirro
     if n > x_full.size:
         raise _err(case.name, f"the recording ({x_full.size / fs:.2f} s) is shorter than scene.duration_s={dur:g}")
     xe = x_full[:n]
-    # frequencies from the full record (finer lines), amplitudes from the same length as the simulation
+    # frequencies from the full record (finer lines), amplitudes from the same length as the simulation;
+    # the simulation's shaft speed is its input (analysis.shaft_frequency can lock onto BPFO/3 on a
+    # signal without a shaft line), so its fault lines are searched around that speed
     m_seg = measure(xe, fs, bearing=bearing, rpm=rpm_file, fault=m_full["extras"]["fault"])
-    m_sim = measure(xs, fs, bearing=bearing, rpm=rpm, fault=m_full["extras"]["fault"])
+    m_sim = measure(xs, fs, bearing=bearing, rpm=rpm, shaft_hz=rpm / 60.0, fault=m_full["extras"]["fault"])
     steps.step("measure")
     err = _numerical_error(sc["scene"], ds_s, {k: v for k, v in ov.items()})
     steps.step("error estimate")
@@ -736,7 +738,7 @@ def _run_recording(case: ValidationCase, out: Path, steps: _Steps, report, mirro
                                    gain_bounds=tuple(cal_cfg.get("gain", (1e-3, 1e3))))
             ds_c = _simulate(sc["scene"], duration=dur, fs=fs, **{**ov, **cal.overrides()})
             xc = ds_c["outer_ring_acc_y"].values
-            m_cal = measure(xc, fs, bearing=bearing, rpm=rpm, fault=m_full["extras"]["fault"])
+            m_cal = measure(xc, fs, bearing=bearing, rpm=rpm, shaft_hz=rpm / 60.0, fault=m_full["extras"]["fault"])
         except ValidationCaseError as exc:
             cal_note = f"calibration not possible: {exc}"
     elif calibrate:
