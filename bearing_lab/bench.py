@@ -209,7 +209,12 @@ def fastest_within_tolerance(rows, scene):
 
 
 def _rules(rows) -> str:
-    """Per kind of scene: the cheapest setting that met the tolerance on EVERY scene of that kind."""
+    """Per kind of scene: the cheapest setting that met the tolerance on EVERY scene of that kind.
+
+    Only adaptive settings are candidates: a fixed step that held on the bench scenes is no
+    safe default for scenes the bench did not cover (a 1e12 N/m mount rings at 300 kHz).
+    Cost is the mean over the kind's scenes (single timings on a shared machine are noisy).
+    """
     lines = ["# written by `bearing-lab bench`: the cheapest setting within "
              f"{TOL_PEAK:.0%} peak-acceleration and {TOL_PERIOD:.1%} period error on every bench scene of "
              "the kind", ""]
@@ -218,13 +223,14 @@ def _rules(rows) -> str:
         scenes = sorted({r["scene"] for r in rows if r["kind"] == kind})
         settings = {}
         for r in rows:
-            if r["kind"] != kind or r["solver"] != "bearing_lab" or r["contact"] not in ("area", "none"):
+            if (r["kind"] != kind or r["solver"] != "bearing_lab" or r["contact"] not in ("area", "none")
+                    or r["method"] == "rk4"):
                 continue
             settings.setdefault((r["fidelity"], r["method"], r["rtol"], r["step"], r["max_step"]), []).append(r)
         best = None
         for key, rs in settings.items():
             if len(rs) == len(scenes) and all(_ok(r) for r in rs):
-                cost = max(r["cost"] for r in rs)
+                cost = float(np.mean([r["cost"] for r in rs]))
                 worst = max(r["err_peak"] for r in rs)
                 if best is None or cost < best[1]:
                     best = (key, cost, worst)
@@ -304,9 +310,13 @@ def _report(out, rows, notes):
     (out / "index.html").write_text("\n".join(html), encoding="utf-8")
 
 
+def rows_of(ds: xr.Dataset) -> list:
+    return [{k: ds[k].values[i].item() for k in ds.data_vars} for i in range(ds.sizes["row"])]
+
+
 def summary_table(ds: xr.Dataset) -> str:
     """Markdown: per scene, the fastest setting within tolerance and the speed-up over scipy."""
-    rows = [{k: ds[k].values[i].item() for k in ds.data_vars} for i in range(ds.sizes["row"])]
+    rows = rows_of(ds)
     lines = ["| scene | fastest within tolerance | s / simulated s | peak error | scipy's best within tolerance | speed-up |",
              "|---|---|---|---|---|---|"]
     for sc in dict.fromkeys(r["scene"] for r in rows):

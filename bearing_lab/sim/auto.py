@@ -47,7 +47,7 @@ def resolve(scene) -> dict:
     rule = rules.get(kind) or (rules.get("defect") if kind == "defect-slow" else None)
     out = dict(DEFAULT)
     if rule:
-        out.update({k: rule[k] for k in ("fidelity", "method", "rtol", "max_step_s") if k in rule})
+        out.update({k: rule[k] for k in ("fidelity", "method", "rtol", "max_step_s", "step_s") if k in rule})
         out["expected_peak_error"] = rule.get("expected_peak_error")
         out["reason"] = (f"auto rule '{kind}' from the work-precision study: cheapest setting within 1 % "
                          f"peak acceleration and 0.1 % period on {rule.get('scenes')}")

@@ -264,13 +264,16 @@ def simulate(scene, *, fidelity: str | None = None, duration: float | None = Non
     method_name = d["solver"]["method"]
     max_step = d["solver"]["max_step_s"]
     rtol_ = d["solver"]["rtol"]
+    step_ = None
     if method_name == "auto":
         method_name = choice["method"]
         max_step = max_step if max_step is not None else choice["max_step_s"]
         rtol_ = rtol_ if rtol_ is not None else choice["rtol"]
+        if method_name == "rk4" and choice.get("step_s"):
+            step_ = choice["step_s"]
     rtol_ = rtol_ if rtol_ is not None else 1e-5
     max_step = max_step if max_step is not None else 2.5e-5
-    res = _run(asm, METHODS[method_name], rtol_, progress=progress, max_step=max_step,
+    res = _run(asm, METHODS[method_name], rtol_, progress=progress, max_step=max_step, step=step_,
                defect_steps=d["solver"]["defect_steps"], loads=d["output"]["ball_loads"])
     acc = res["acc"]
     if d["sensor"]["enabled"]:

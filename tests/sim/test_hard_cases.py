@@ -31,9 +31,14 @@ CASES = {
                     "1e12 N/m mount: a 300 kHz ring mode the adaptive step must follow"),
     "soft_mount": ("paper-slot", {"mount.stiffness_x_n_m": 1e5, "mount.stiffness_y_n_m": 1e5}, 0.05,
                    "1e5 N/m mount: the outer ring floats on the bearing"),
-    "zero_damping": ("paper-slot", {"contact.damping_n_s_m": 0.0, "mount.damping_x_n_s_m": 0.0,
-                                    "mount.damping_y_n_s_m": 0.0, "shaft.damping_x_n_s_m": 0.0,
-                                    "shaft.damping_y_n_s_m": 0.0}, 0.05, "no damping anywhere: stays bounded"),
+    # no damping anywhere: the healthy bearing rings for ever but converges.  With a slot and no
+    # contact damping (support damping kept or not), every passage kicks the balls and the
+    # rattling becomes chaotic: finite, but not convergent point by point (paper-slot, 0.05 s,
+    # peak |a| at rtol 1e-6, 1e-7, 1e-8, 1e-9: 915, 684, 653, 1143 m/s2).  The IMPACT damping is
+    # what makes defect impacts a well-posed problem; it is not tested as converging here.
+    "zero_damping": ("paper-healthy", {"contact.damping_n_s_m": 0.0, "mount.damping_x_n_s_m": 0.0,
+                                       "mount.damping_y_n_s_m": 0.0, "shaft.damping_x_n_s_m": 0.0,
+                                       "shaft.damping_y_n_s_m": 0.0}, 0.05, "no damping anywhere: stays bounded"),
     "load_step": ("paper-slot", {"load.step_time_s": 0.02, "load.step_radial_n": 480.0}, 0.05,
                   "150 -> 480 N at 20 ms: the ring moves to the new equilibrium"),
 }
@@ -50,10 +55,11 @@ def _check(ds, name):
 @pytest.mark.parametrize("name", list(CASES))
 def test_hard_case(name):
     scene, ov, duration, what = CASES[name]
-    # without any damping the unloaded balls rattle between the races for ever and the
-    # trajectory is chaotic: it cannot converge point by point, its statistics do
-    chaotic = name == "zero_damping"
-    r1, r2 = (1e-7, 1e-8) if chaotic else (1e-5, 1e-6)
+    chaotic = False
+    # a 1e12 N/m mount moves the outer ring by ~1e-10 m, a thousandth of the static deflection
+    # that scales the error control: its tiny acceleration needs rtol 1e-7 to be resolved
+    tight = name in ("zero_damping", "stiff_mount")
+    r1, r2 = (1e-7, 1e-8) if tight else (1e-5, 1e-6)
     ds = simulate(scene, duration=duration, progress=False, rtol=r1, **ov)
     _check(ds, name)
     fine = simulate(scene, duration=duration, progress=False, rtol=r2, **ov)
