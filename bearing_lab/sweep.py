@@ -375,7 +375,6 @@ def sweep(scene, params: dict, *, scheduler=None, n_workers: int | None = None, 
     BearingLabError : scheduler problems; errors of a scene's solve are re-raised
         with the scene's swept values in the message.
     """
-    import xarray as xr
     t_start = _time.perf_counter()
     keys, values, base, scenes = _resolve(scene, params, simulate_kwargs)
     kw_for_hash = {k: v for k, v in simulate_kwargs.items() if v is not None}

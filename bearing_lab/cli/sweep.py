@@ -45,8 +45,8 @@ def _sweep(args) -> int:
     write_netcdf(ds, out)
     dims = " x ".join(f"{d}={ds.sizes[d]}" for d in ds.attrs["sweep_dims"].split())
     print(f"wrote {out}: {ds.attrs['sweep_n_scenes']} scenes ({dims}), {ds.attrs['sweep_computed']} computed, "
-          f"{ds.attrs['sweep_cache_hits']} from the cache, {ds.attrs['sweep_wall_time_s']:.1f} s "
-          f"({ds.attrs['sweep_scheduler']})", file=sys.stderr)
+          f"{ds.attrs['sweep_cache_hits']} from the cache, {ds.attrs['sweep_wall_time_s']:.1f} s; "
+          f"scheduler: {ds.attrs['sweep_scheduler']}", file=sys.stderr)
     return 0
 
 
