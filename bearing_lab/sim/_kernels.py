@@ -46,7 +46,8 @@ P_SPIN = 41
 # ball radius, sensor state offset
 P_CAGE, P_MU, P_VREF, P_KPOCK, P_CPOCK, P_DPOCK, P_IC, P_IB, P_RB, P_SENSOFF = 42, 43, 44, 45, 46, 47, 48, 49, 50, 51
 P_CDRAG = 52
-P_SIZE = 53
+P_UNB = 53      # shaft unbalance U = m e (kg m): a force U omega^2 turning with the shaft on the inner ring
+P_SIZE = 54
 
 # ---- defect table layout: dint[k] = race, kind, npsi, ndelta, h_off, g_off, ball
 #   race 0: outer race, 1: inner race, 2: ball defect meeting the outer race,
@@ -362,6 +363,10 @@ def rhs(t, y, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, dy, fi_out, fo_out):
         lix, liy, lox, loy = p[P_FIX2], p[P_FIY2], p[P_FOX2], p[P_FOY2]
     else:
         lix, liy, lox, loy = p[P_FIX], p[P_FIY], p[P_FOX], p[P_FOY]
+    if p[P_UNB] > 0.0:
+        fu = p[P_UNB] * omega_s * omega_s
+        lix += fu * math.cos(theta_s)
+        liy += fu * math.sin(theta_s)
     axi = (fix - p[P_KSX] * (xi - p[P_XIR]) - p[P_CSX] * vxi + lix) / p[P_MI]
     ayi = (fiy - p[P_KSY] * (yi - p[P_YIR]) - p[P_CSY] * vyi + liy) / p[P_MI]
     axo = (fox - p[P_KMX] * (xo - p[P_XOR]) - p[P_CMX] * vxo + lox) / p[P_MO]

@@ -289,6 +289,7 @@ def assemble(scene: Scene, *, fidelity: str | None = None) -> Assembly:
     p[K.P_IC] = m_cage * (b.pitch_diameter / 2) ** 2
     p[K.P_RB] = b.ball_diameter / 2
     p[K.P_CDRAG] = cg["drag_n_m_s"]
+    p[K.P_UNB] = d["shaft"]["unbalance_g_mm"] * 1e-6
     p[K.P_IB] = 0.4 * m_b * (b.ball_diameter / 2) ** 2
     p[K.P_NDEF] = len(entries)
     p[K.P_SPIN] = b.frequency_factors()["bsf"]

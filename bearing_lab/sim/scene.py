@@ -147,6 +147,10 @@ SCHEMA: dict[str, dict[str, tuple]] = {
         "stiffness_y_n_m": (1e8, _NUM, "pos", "inner ring to ground, Y"),
         "damping_x_n_s_m": (1e3, _NUM, "nonneg", "inner ring to ground, X"),
         "damping_y_n_s_m": (1e3, _NUM, "nonneg", "inner ring to ground, Y"),
+        "unbalance_g_mm": (130.0, _NUM, "nonneg",
+                           "residual unbalance U = m e turning with the shaft (a force U omega^2 on the inner "
+                           "ring): 130 g mm is ISO 21940-11 grade G2.5 for a 10 kg rotor share at 1800 r/min "
+                           "(4.6 N); it gives the shaft-frequency line every rig shows, and BPFI sidebands"),
     },
     "mount": {
         "stiffness_x_n_m": (1e8, _NUM, "pos", "outer-ring bushing to ground, X"),
