@@ -86,8 +86,7 @@ def _passage(ds, scene):
     if not np.any(ok):
         raise RuntimeError("record too short for one full defect passage")
     kk = k[ok][-1]
-    ball = int((-(kk)) % z)  # the ball that reaches the defect at passage kk
-    ball = (z - kk % z) % z
+    ball = (z - kk % z) % z  # the ball that reaches the defect at passage kk
     return float(t_c[ok][-1]), half, ball, (s1 - s0) / v
 
 
@@ -115,7 +114,6 @@ def _one(scene_name, overrides):
     load = ds.ball_load_outer.values[ball, w]
     # intact share of the contact along the passage, at the static approach (geometry only)
     from .sim.assembly import assemble
-    from .sim.hertz import race_contact
     asm = assemble(sc)
     tab = asm.tables[0]
     q_static = float(np.max(asm.static["ball_loads"]))

@@ -351,9 +351,10 @@ class Scene:
                 raise SceneError("speed.profile: speeds must be finite and not negative")
         pd = self.clearance
         b = self.bearing
-        if pd < -0.05 * b.ball_diameter * 1e-1:
+        max_preload = 0.005 * b.ball_diameter  # interference of 0.5 % of D_b: ~1 GPa-class overload
+        if pd < -max_preload:
             raise SceneError(f"clearance.radial_um={pd*1e6:g}: a preload this large "
-                             f"(> {0.005*b.ball_diameter*1e6:.0f} µm) crushes the balls")
+                             f"(> {max_preload*1e6:.0f} µm) crushes the balls")
         if pd > 0.02 * b.ball_diameter:
             raise SceneError(f"clearance.radial_um={pd*1e6:g} is larger than 2 % of the ball diameter: "
                              "not a bearing")
@@ -406,7 +407,7 @@ class Scene:
         rho = self.data["material"]["density_kg_m3"]
         m = self.data["mass"]
         ball = m["ball_kg"] or rho * math.pi / 6 * b.ball_diameter ** 3
-        width = b.width or 0.4 * b.ball_diameter / 0.4 * 1.5
+        width = b.width or 1.5 * b.ball_diameter
         bore = b.bore or (b.pitch_diameter - 2.2 * b.ball_diameter)
         od = b.outer_diameter or (b.pitch_diameter + 2.2 * b.ball_diameter)
         # shoulders at 60 % of the ball radius beyond the raceway bottoms (typical 6xxx)
