@@ -86,7 +86,8 @@ def _passage(ds, scene):
     if not np.any(ok):
         raise RuntimeError("record too short for one full defect passage")
     kk = k[ok][-1]
-    ball = (z - kk % z) % z  # the ball that reaches the defect at passage kk
+    # the ball that reaches the defect at passage kk: omega_c t_k + 2 pi j / Z = d.angle (mod 2 pi)
+    ball = int(round((d.angle - ang) / (2 * math.pi / z)) - kk) % z
     return float(t_c[ok][-1]), half, ball, (s1 - s0) / v
 
 
