@@ -84,8 +84,10 @@ def _end_to_end(scene, params, n, duration):
 def _steady(scene, params, n, duration):
     import bearing_lab
     from dask.distributed import Client, LocalCluster
-    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
-                           silence_logs=logging.ERROR)
+    import dask
+    with dask.config.set({"distributed.worker.profile.enabled": False}):  # as bearing_lab.sweep's own cluster
+        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+                               silence_logs=logging.ERROR)
     client = Client(cluster)
     cache = tempfile.mkdtemp(prefix="sweep-bench-")
     try:
