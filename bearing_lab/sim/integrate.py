@@ -185,13 +185,14 @@ def _run(asm, method, rtol, *, progress, t_end_override=None, step=None, max_ste
             m_next += fine_t.size
             v_buf = np.concatenate([v_buf, fine_out])
             a_fine = np.diff(v_buf, axis=0) / dt_f          # fine index v_start + i
-            while k_acc < n_out:
-                cm = m_pad + k_acc * R
-                if cm + half > v_start + a_fine.shape[0] - 1:
-                    break
-                seg = a_fine[cm - half - v_start: cm + half + 1 - v_start]
-                acc[k_acc] = taps_rev @ seg
-                k_acc += 1
+            # outputs whose whole FIR window is available: centre m_pad + k R + half <= last index
+            last = v_start + a_fine.shape[0] - 1
+            k_hi = min(n_out, (last - half - m_pad) // R + 1) if last - half - m_pad >= 0 else k_acc
+            if k_hi > k_acc:
+                starts = m_pad + np.arange(k_acc, k_hi) * R - half - v_start
+                win = np.lib.stride_tricks.sliding_window_view(a_fine, len(taps), axis=0)
+                acc[k_acc:k_hi] = win[starts] @ taps_rev
+                k_acc = k_hi
             # drop the velocities no later output needs; v_buf[0] is always fine index v_start
             drop = min(max(m_pad + k_acc * R - half - v_start, 0), v_buf.shape[0])
             v_buf = v_buf[drop:]
