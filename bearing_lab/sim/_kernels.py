@@ -227,16 +227,36 @@ def _qs_ball(kk, rel, reld, dtot, dtot_rate, p, dint, dflt, hbuf, gbuf):
     outer = dint[kk, D_RACE] % 2 == 0
     k_def = p[P_KO] if outer else p[P_KI]
     k_oth = p[P_KI] if outer else p[P_KO]
+    # split the approach: f(x) = K_def G(x) - K_oth (dtot - x)^1.5 rises from f(0) <= 0 to
+    # f(dtot) >= 0; Illinois (regula falsi with halving) converges in a few iterations
     lo = 0.0
     hi = dtot
-    for _ in range(40):
-        mid = 0.5 * (lo + hi)
-        r = k_def * _interp_g(kk, rel, mid, dint, dflt, gbuf) - k_oth * (dtot - mid) ** 1.5
-        if r > 0.0:
-            hi = mid
+    f_lo = -k_oth * dtot * math.sqrt(dtot)
+    f_hi = k_def * _interp_g(kk, rel, dtot, dint, dflt, gbuf)
+    x = 0.5 * dtot
+    side = 0
+    for _ in range(60):
+        if f_hi - f_lo == 0.0:
+            break
+        x = (lo * f_hi - hi * f_lo) / (f_hi - f_lo)
+        rem = dtot - x
+        fx = k_def * _interp_g(kk, rel, x, dint, dflt, gbuf) - k_oth * rem * math.sqrt(rem)
+        if fx > 0.0:
+            hi = x
+            f_hi = fx
+            if side == 1:
+                f_lo *= 0.5
+            side = 1
         else:
-            lo = mid
-    q = k_oth * (dtot - 0.5 * (lo + hi)) ** 1.5
+            lo = x
+            f_lo = fx
+            if side == -1:
+                f_hi *= 0.5
+            side = -1
+        if hi - lo < 1e-7 * dtot or abs(fx) < 1e-9 * k_oth * dtot * math.sqrt(dtot):
+            break
+    rem = dtot - x
+    q = k_oth * rem * math.sqrt(rem)
     f = q + step_fn(pen, 0.0, 0.0, dpen, cser) * pen_rate
     return f if f > 0.0 else 0.0
 
