@@ -492,6 +492,17 @@ def sweep(scene, params: dict, *, scheduler=None, n_workers: int | None = None, 
                          {"long_name": "sha256 of the resolved scene TOML, version and simulate options "
                                        "(the cache file name)"})
     out.attrs.update(acc.common_attrs)
+    # attributes that differ between scenes (e.g. the fidelity "auto" picked) become variables
+    for name, vals in acc.scene_attrs.items():
+        if name in acc.common_attrs or any(v is None for v in vals):
+            continue
+        var = name if name not in out.variables else f"scene_{name}"
+        kinds = {type(v) for v in vals}
+        arr = (np.asarray(vals, dtype=float) if kinds <= {int, float} and kinds != {int}
+               else np.asarray(vals, dtype=np.int64) if kinds == {int}
+               else np.asarray([str(v) for v in vals], dtype=object))
+        out[var] = (sdims, arr.reshape(shape), {"long_name": f"simulation attribute {name!r} of each scene "
+                                                             "(it differs across the sweep)"})
     out.attrs.update({
         "title": f"bearing_lab sweep of scene {base.name!r}",
         "scene_name": base.name,
@@ -528,6 +539,7 @@ class _Stack:
         self.steps = np.zeros(n, dtype=np.int64)
         self.cached = np.zeros(n, dtype=bool)
         self.common_attrs = None
+        self.scene_attrs = {}  # scalar per-scene attributes, name -> values by scene index
 
     def put(self, i, ds, *, cached):
         if self.arrays is None:
@@ -555,6 +567,9 @@ class _Stack:
         if _METRIC_SIGNAL in ds:
             for k, val in _metrics(np.asarray(ds[_METRIC_SIGNAL].values)).items():
                 self.metrics[k][i] = val
+        for k, v in ds.attrs.items():
+            if k not in _PER_SCENE_ATTRS and isinstance(v, (str, int, float, np.number)):
+                self.scene_attrs.setdefault(k, [None] * self.n)[i] = v.item() if isinstance(v, np.generic) else v
         self.wall[i] = float(ds.attrs.get("wall_time_s", np.nan))
         self.steps[i] = int(ds.attrs.get("solver_steps", 0))
         self.cached[i] = cached

@@ -161,3 +161,15 @@ def test_cli_errors_are_one_line_exit_2(argv, needle, tmp_path, capsys):
     err = capsys.readouterr().err.strip()
     assert rc == 2
     assert len(err.splitlines()) == 1 and needle in err and err.startswith("bearing-lab sweep: error:")
+
+
+def test_text_parameter_and_per_scene_attributes():
+    """A text key (fidelity) gives a text coordinate without units; attributes that
+    differ between scenes (the fidelity used) become per-scene variables."""
+    ds = bearing_lab.sweep(SCENE, {"fidelity": ["multibody", "quasi-static"]}, scheduler="serial",
+                           cache_dir=False, progress=False, duration=DUR)
+    assert ds["fidelity"].values.tolist() == ["multibody", "quasi-static"]
+    assert "units" not in ds["fidelity"].attrs
+    assert ds["scene_fidelity"].values.tolist() == ["multibody", "quasi-static"]
+    assert "fidelity" not in ds.attrs and ds.attrs["bearing"] == "6308"
+    assert not np.array_equal(ds.outer_ring_acc_y[0], ds.outer_ring_acc_y[1])
