@@ -189,9 +189,10 @@ def _run(asm, method, rtol, *, progress, t_end_override=None, step=None, max_ste
             last = v_start + a_fine.shape[0] - 1
             k_hi = min(n_out, (last - half - m_pad) // R + 1) if last - half - m_pad >= 0 else k_acc
             if k_hi > k_acc:
-                starts = m_pad + np.arange(k_acc, k_hi) * R - half - v_start
+                s0 = m_pad + k_acc * R - half - v_start
                 win = np.lib.stride_tricks.sliding_window_view(a_fine, len(taps), axis=0)
-                acc[k_acc:k_hi] = win[starts] @ taps_rev
+                # a strided view (no copy): every R-th window from s0
+                acc[k_acc:k_hi] = win[s0:s0 + R * (k_hi - k_acc - 1) + 1:R] @ taps_rev
                 k_acc = k_hi
             # drop the velocities no later output needs; v_buf[0] is always fine index v_start
             drop = min(max(m_pad + k_acc * R - half - v_start, 0), v_buf.shape[0])
@@ -216,9 +217,9 @@ def _decimate_acc(res):
     a_fine = np.diff(v, axis=0) / res["dt_f"]           # sample m at t0 - m_pad dt_f + m dt_f
     taps = res["taps"]
     half = len(taps) // 2
-    centres = res["m_pad"] + res["R"] * np.arange(res["n_out"])
+    s0 = res["m_pad"] - half
     win = np.lib.stride_tricks.sliding_window_view(a_fine, len(taps), axis=0)  # (M', ch, taps)
-    return win[centres - half] @ taps[::-1]
+    return win[s0:s0 + res["R"] * (res["n_out"] - 1) + 1:res["R"]] @ taps[::-1]
 
 
 def simulate(scene, *, fidelity: str | None = None, duration: float | None = None,
