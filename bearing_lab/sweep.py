@@ -16,7 +16,9 @@ simulates every combination of the swept values (a full grid) and returns one
   ``crest_factor``, Pearson ``kurtosis``; the definitions of
   :mod:`bearing_lab.analysis`), the compute time ``wall_time_s`` per scene,
   ``solver_steps``, ``cached`` (the scene came from the cache) and
-  ``scene_hash`` (the cache key);
+  ``scene_hash`` (the cache key); simulation attributes that differ between
+  scenes (``shaft_speed_rpm``, the fidelity ``"auto"`` chose, ...) become
+  per-scene variables of the same name (``scene_<name>`` if the name is taken);
 - attributes ``sweep_params`` (JSON), ``sweep_n_scenes``,
   ``sweep_cache_hits``, ``sweep_computed``, ``sweep_scheduler``,
   ``sweep_wall_time_s``, the base ``scene_toml`` and the per-scene attributes
