@@ -27,7 +27,7 @@ def __getattr__(name):
         from . import io
         return getattr(io, name)
     if name == "sweep":
-        from .sweep import sweep
+        from .sweeps import sweep
         return sweep
     raise AttributeError(f"module 'bearing_lab' has no attribute {name!r}")
 

@@ -96,7 +96,7 @@ def test_resume_from_cache(serial, cache):
 
 
 def test_hash_depends_on_scene_and_options():
-    from bearing_lab.sweep import scene_hash
+    from bearing_lab.sweeps import scene_hash
     toml = bearing_lab.load_scene(SCENE).to_toml()
     assert scene_hash(toml) == scene_hash(toml)
     assert scene_hash(toml) != scene_hash(toml.replace("1800.0", "1801.0"))
@@ -124,9 +124,9 @@ def test_bad_sweep_raises_scene_error_naming_the_key(params, needle, tmp_path):
 
 
 def test_units_in_values_and_callable_module(tmp_path):
-    import bearing_lab.sweep as mod
-    assert callable(bearing_lab.sweep) and callable(mod)
-    from bearing_lab.sweep import _resolve
+    import bearing_lab.sweeps  # noqa: F401  (importing the module must not shadow the function)
+    assert callable(bearing_lab.sweep)
+    from bearing_lab.sweeps import _resolve
     keys, values, base, scenes = _resolve(SCENE, {"defect.offset_mm": ["0 mm", "250 um"]}, {"duration": DUR})
     assert values == [[0.0, 0.25]]
     assert scenes[1].data["defect"][0]["offset_mm"] == 0.25

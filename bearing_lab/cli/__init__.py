@@ -21,7 +21,7 @@ COMMAND_MODULES = [
     "analyze",    # analyze
     "study",      # study
     "validate",   # validate
-    "bench",      # bench, sweep
+    "bench",      # bench
     "sweep",      # sweep (bearing_lab.sweep on Dask)
 ]
 

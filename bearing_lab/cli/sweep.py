@@ -29,7 +29,7 @@ def parse_params(items) -> dict:
 
 
 def _sweep(args) -> int:
-    from ..sweep import sweep
+    from ..sweeps import sweep
     from ..sim.scene import parse_set
     params = parse_params(args.param)
     overrides = parse_set(args.set)

@@ -55,9 +55,7 @@ import json
 import math
 import os
 from pathlib import Path
-import sys
 import time as _time
-import types
 import uuid
 
 import numpy as np
@@ -595,14 +593,3 @@ def _same(a, b) -> bool:
         return bool(np.array_equal(np.asarray(a), np.asarray(b)))
     except Exception:  # noqa: BLE001 - incomparable attributes are simply not common
         return False
-
-
-# ``bearing_lab.sweep`` is this module once it has been imported (Python binds a
-# submodule on its package), so make the module callable: bearing_lab.sweep(...)
-# then works whether the name resolves to the function or to the module.
-class _CallableModule(types.ModuleType):
-    def __call__(self, *args, **kwargs):
-        return sweep(*args, **kwargs)
-
-
-sys.modules[__name__].__class__ = _CallableModule
