@@ -1,7 +1,8 @@
 """Speed against error: the work-precision study behind ``bearing-lab bench``.
 
 For each benchmark scene every solver setting (fixed steps, adaptive tolerances),
-every fidelity (quasi-static balls, ball inertia) and every defect-contact model
+every fidelity (quasi-static balls, ball inertia, ball inertia with a dynamic
+cage) and every defect-contact model
 (along-track profile, rigid 2-D drop, 2-D with area loss) runs the same record; each
 is scored by its compute seconds per simulated second and its error in peak
 acceleration, RMS, excitation period and impulse duration against ONE converged
@@ -52,8 +53,8 @@ QS_SETTINGS = ([("dp54", r, None, m) for r in (1e-4, 1e-5) for m in (2.5e-5, 1e-
                + [("bs32", r, None, m) for r in (1e-3, 1e-4) for m in (2.5e-5, 1e-4)])
 
 
-def _scene(base, ov, duration, fidelity="multibody", model=None):
-    sc = load_scene(base, fidelity=fidelity, **ov, **{"output.duration_s": duration})
+def _scene(base, ov, duration, fidelity="multibody", model=None, cage="kinematic"):
+    sc = load_scene(base, fidelity=fidelity, **ov, **{"output.duration_s": duration, "cage.model": cage})
     if model is not None and sc.data["defect"]:
         raw = dict(sc.data)
         raw["defect"] = [dict(d, contact_model=model) for d in raw["defect"]]
@@ -148,10 +149,13 @@ def run_bench(out_dir="reports/performance", *, duration=0.3, scipy_duration=0.0
         notes[label] = {k: _err(m_ref2[k], m_ref[k]) for k in m_ref}
         jobs = [("multibody", "area", *s) for s in MB_SETTINGS]
         jobs += [("quasi-static", "area", *s) for s in QS_SETTINGS]
+        jobs += [("multibody+dynamic cage", "area", m, r, None, None)
+                 for m, r in (("dp54", 1e-5), ("bs32", 1e-4), ("bs32", 1e-3))]
         if kind != "healthy":
             jobs += [("multibody", m, "dp54", 1e-5, None, None) for m in ("drop", "profile")]
         for fid, model, method, rtol, step, mx in jobs:
-            sc = _scene(base, ov, duration, fid, model if kind != "healthy" else None)
+            cage = "dynamic" if fid.endswith("dynamic cage") else "kinematic"
+            sc = _scene(base, ov, duration, fid.split("+")[0], model if kind != "healthy" else None, cage)
             asm_j = assemble(sc)
             res, cost = _timed(asm_j, method, rtol, step, mx)
             m = _measures(res["acc"][:, 1], fs, sc)
@@ -224,7 +228,7 @@ def _rules(rows) -> str:
         settings = {}
         for r in rows:
             if (r["kind"] != kind or r["solver"] != "bearing_lab" or r["contact"] not in ("area", "none")
-                    or r["method"] == "rk4"):
+                    or r["method"] == "rk4" or "cage" in r["fidelity"]):
                 continue
             settings.setdefault((r["fidelity"], r["method"], r["rtol"], r["step"], r["max_step"]), []).append(r)
         best = None
@@ -265,7 +269,7 @@ def _report(out, rows, notes):
     for sc in scenes:
         rs = [r for r in rows if r["scene"] == sc]
         fig, ax = plt.subplots(figsize=(6.5, 4.2))
-        for fid, mk in (("multibody", "o"), ("quasi-static", "s")):
+        for fid, mk in (("multibody", "o"), ("quasi-static", "s"), ("multibody+dynamic cage", "^")):
             for solver, col in (("bearing_lab", None), ("scipy", "k")):
                 sel = [r for r in rs if r["fidelity"] == fid and r["solver"] == solver
                        and math.isfinite(r["err_peak"])]
