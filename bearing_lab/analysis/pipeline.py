@@ -93,8 +93,11 @@ def _run(x, fs, *, bearing, rpm=None, shaft_hz=None, tolerance=0.02, n_harmonics
         f1 = lines[key]["measured_hz"]
         try:
             period, _ = excitation_period(xx, fs, frequency_range=(0.99 * f1, 1.01 * f1), band=band)
-        except AnalysisError:
+        except AnalysisError as exc:  # too few clear harmonics for the refined estimate
             period = 1.0 / f1
+            import warnings
+            warnings.warn(f"excitation period from the {key.upper()} line alone (1/{f1:.4f} Hz), not the "
+                          f"harmonic fit: {exc}", stacklevel=2)
     result = {
         "channel": "",
         "sampling_rate_hz": fs,

@@ -26,21 +26,22 @@ COMMAND_MODULES = [
 ]
 
 
+class _Parser(argparse.ArgumentParser):
+    """argparse with the project's error form: one line on stderr, exit status 2."""
+
+    def error(self, message):
+        self.exit(2, f"{self.prog}: error: {message}\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="bearing-lab",
         description="Rolling-bearing toolkit: import, simulate, analyse, validate.")
     from .. import __version__
     parser.add_argument("--version", action="version", version=f"bearing_lab {__version__}")
-    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     for name in COMMAND_MODULES:
-        try:
-            mod = importlib.import_module(f".{name}", __name__)
-        except ModuleNotFoundError as exc:  # a command module not written yet
-            if exc.name and exc.name.endswith(f"cli.{name}"):
-                continue
-            raise
-        mod.register(sub)
+        importlib.import_module(f".{name}", __name__).register(sub)
     return parser
 
 
@@ -54,6 +55,10 @@ def main(argv=None) -> int:
         return int(args.func(args) or 0)
     except BearingLabError as exc:
         print(f"bearing-lab {args.command}: error: {exc}", file=sys.stderr)
+        return 2
+    except OSError as exc:  # an output path that cannot be written, a file that vanished
+        where = f"{exc.filename}: " if getattr(exc, "filename", None) else ""
+        print(f"bearing-lab {args.command}: error: {where}{exc.strerror or exc}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print("bearing-lab: interrupted", file=sys.stderr)

@@ -76,19 +76,23 @@ def guess_format(path) -> str:
     with open(path, "rb") as fh:
         head = fh.read(8192)
     corrupt = None
+    sniff_errors = []
     for name, cls in ENGINES.items():
         try:
             if cls().guess_can_open(path, head):
                 return name
         except RecordingError as exc:  # looks like the format but is damaged
             corrupt = corrupt or exc
-        except Exception:  # a sniffing accident is just "not mine"
+        except Exception as exc:  # noqa: BLE001 - a reader's sniffing failed: not its format,
+            sniff_errors.append(f"{name}: {type(exc).__name__}: {exc}")  # but say so below
             continue
     if corrupt is not None:
         raise corrupt
     msg = (f"{path}: no reader recognises this file (it starts with {head[:16]!r}); installed "
            f"engines: {_engine_list()}; if you know the format, pass format='<engine>' "
-           "(CLI --format)")
+           "(bearing-lab import --format)")
+    if sniff_errors:
+        msg += "; readers that failed while sniffing: " + " | ".join(sniff_errors)
     raise RecordingError(msg)
 
 

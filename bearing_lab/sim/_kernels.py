@@ -495,8 +495,6 @@ def integrate(y, t, t_stop, h, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf,
                 for jj in range(i):
                     acc += a_tab[i, jj] * k[jj, m]
                 ytmp[m] = y[m] + hstep * acc
-            if fsal and i == s - 1:
-                pass
             rhs(t + c_tab[i] * hstep, ytmp, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, k[i], fi, fo)
         for m in range(n):
             acc = 0.0

@@ -1,12 +1,14 @@
 """netCDF4 (compressed, bit for bit) and UFF 58b export round trips."""
 import numpy as np
 import pytest
+
+from tests.helpers import require
 import xarray as xr
 
 from bearing_lab import RecordingError, open_recording
 from bearing_lab.io import to_netcdf, to_uff58b
 
-pyuff = pytest.importorskip("pyuff")
+pyuff = require("pyuff")
 
 
 def test_netcdf_bit_for_bit_and_compressed(datafile, tmp_path):

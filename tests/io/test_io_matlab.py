@@ -1,6 +1,8 @@
 """Testlab MATLAB exports (v5 real file, v7.3 and grouped synthetic), CWRU and MFPT .mat files."""
 import numpy as np
 import pytest
+
+from tests.helpers import require
 import scipy.io
 import scipy.stats
 
@@ -61,7 +63,7 @@ def test_factor_not_matching_label_converted(tmp_path, sine):
 
 
 def test_v73_hdf5(tmp_path, sine):
-    h5py = pytest.importorskip("h5py")
+    h5py = require("h5py")
     p = tmp_path / "v73.mat"
     with h5py.File(p, "w", userblock_size=512) as f:
         g = f.create_group("Signal")

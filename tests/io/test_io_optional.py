@@ -2,12 +2,14 @@
 import numpy as np
 import pytest
 
+from tests.helpers import require
+
 from bearing_lab import RecordingError, open_recording
 from bearing_lab.io._testing import check_reader
 
 
 def test_tdms(tmp_path, sine):
-    nptdms = pytest.importorskip("nptdms")
+    nptdms = require("nptdms")
     p = tmp_path / "rig.tdms"
     props = {"wf_increment": 1e-3, "wf_start_offset": 0.5, "unit_string": "g"}
     with nptdms.TdmsWriter(p) as w:
@@ -20,7 +22,7 @@ def test_tdms(tmp_path, sine):
 
 
 def test_tdms_different_rates(tmp_path, sine):
-    nptdms = pytest.importorskip("nptdms")
+    nptdms = require("nptdms")
     p = tmp_path / "rates.tdms"
     with nptdms.TdmsWriter(p) as w:
         w.write_segment([
@@ -33,7 +35,7 @@ def test_tdms_different_rates(tmp_path, sine):
 
 
 def test_tdms_corrupt(tmp_path):
-    pytest.importorskip("nptdms")
+    require("nptdms")
     p = tmp_path / "bad.tdms"
     p.write_bytes(b"TDSm" + bytes(range(200)))
     with pytest.raises(RecordingError, match="bad.tdms"):
@@ -41,7 +43,7 @@ def test_tdms_corrupt(tmp_path):
 
 
 def test_mdf(tmp_path, sine):
-    asammdf = pytest.importorskip("asammdf")
+    asammdf = require("asammdf")
     p = tmp_path / "rig.mf4"
     t = np.arange(sine.size) / 1000.0
     m = asammdf.MDF(version="4.10")
@@ -53,7 +55,7 @@ def test_mdf(tmp_path, sine):
 
 
 def test_tdms_fuzz(tmp_path, sine):
-    nptdms = pytest.importorskip("nptdms")
+    nptdms = require("nptdms")
     from hypothesis import HealthCheck, given, settings, strategies as st
     src = tmp_path / "src.tdms"
     with nptdms.TdmsWriter(src) as w:
@@ -72,9 +74,12 @@ def test_tdms_fuzz(tmp_path, sine):
         p = tmp_path / "fz.tdms"
         p.write_bytes(bytes(b))
         try:
-            open_recording(p, format="tdms")
+            ds = open_recording(p, format="tdms")
         except RecordingError as exc:
             assert "fz.tdms" in str(exc)
+        else:  # what opens must still be a valid recording
+            from bearing_lab.schema import check_dataset
+            check_dataset(ds, kind="recording")
 
     run()
 
@@ -86,7 +91,7 @@ def test_engine_alias(datafile):
 
 @pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
 def test_mdf_two_rasters_and_corrupt(tmp_path, sine):
-    asammdf = pytest.importorskip("asammdf")
+    asammdf = require("asammdf")
     p = tmp_path / "rasters.mf4"
     m = asammdf.MDF(version="4.10")
     m.append([asammdf.Signal(sine, np.arange(sine.size) / 1000.0, name="DE", unit="g")])

@@ -2,12 +2,14 @@
 import numpy as np
 import pytest
 
+from tests.helpers import require
+
 from bearing_lab import RecordingError, open_recording
 from bearing_lab.io import RecordingWarning, get_warnings
 from bearing_lab.io._testing import check_reader
 from bearing_lab.io._testing import uff58_block
 
-pyuff = pytest.importorskip("pyuff")
+pyuff = require("pyuff")
 
 
 def _pyuff_sets(path):

@@ -1,9 +1,12 @@
-"""The notebooks run top to bottom (nbclient) against the public recordings, each in < 30 s."""
+"""The notebooks run top to bottom (nbclient) against the public recordings (~15 s each; the
+assertion allows 60 s for a loaded 2-core CI machine)."""
 import os
 import time
 from pathlib import Path
 
 import pytest
+
+from tests.helpers import require
 
 NB_DIR = Path(__file__).resolve().parents[2] / "notebooks"
 IN_CI = os.environ.get("CI", "").lower() in ("1", "true", "yes")
@@ -11,8 +14,8 @@ IN_CI = os.environ.get("CI", "").lower() in ("1", "true", "yes")
 
 @pytest.mark.parametrize("name", ["01_open_analyse_plot.ipynb", "02_offset_skew_study.ipynb"])
 def test_notebook_runs(name, mirror, monkeypatch):
-    nbformat = pytest.importorskip("nbformat")
-    nbclient = pytest.importorskip("nbclient")
+    nbformat = require("nbformat")
+    nbclient = require("nbclient")
     if mirror is None or not (Path(mirror) / "cwru" / "130_OR007@6_0.mat").is_file():
         if IN_CI:
             pytest.fail("BEARING_LAB_MIRROR with cwru/130_OR007@6_0.mat is required in CI")
@@ -27,4 +30,4 @@ def test_notebook_runs(name, mirror, monkeypatch):
     errors = [o for c in nb.cells if c.cell_type == "code" for o in c.get("outputs", [])
               if o.get("output_type") == "error"]
     assert not errors
-    assert took < 60, f"{name} took {took:.0f} s (budget 30 s on the 2-core machine)"
+    assert took < 60, f"{name} took {took:.0f} s (budget 60 s on a loaded 2-core machine)"
