@@ -274,17 +274,23 @@ def _report(out, rows, notes):
     for sc in scenes:
         rs = [r for r in rows if r["scene"] == sc]
         fig, ax = plt.subplots(figsize=(6.5, 4.2))
-        for fid, mk in (("multibody", "o"), ("quasi-static", "s"), ("multibody+dynamic cage", "^")):
-            for solver, col in (("bearing_lab", None), ("scipy", "k")):
-                sel = [r for r in rs if r["fidelity"] == fid and r["solver"] == solver
-                       and math.isfinite(r["err_peak"])]
-                if not sel:
-                    continue
+        groups = [(f"{fid} ({solver})", mk, col,
+                   lambda r, fid=fid, solver=solver: (r["fidelity"] == fid and r["solver"] == solver
+                                                      and r["contact"] in ("area", "none")))
+                  for fid, mk in (("multibody", "o"), ("quasi-static", "s"), ("multibody+dynamic cage", "^"))
+                  for solver, col in (("bearing_lab", None), ("scipy", "k"))]
+        groups.append(("multibody, cheaper contact (drop, profile)", "x", "r",
+                       lambda r: r["contact"] in ("drop", "profile")))
+        for label, mk, col, keep in groups:
+            sel = [r for r in rs if keep(r) and math.isfinite(r["err_peak"])]
+            if sel:
                 ax.scatter([max(r["err_peak"], 1e-9) for r in sel], [r["cost"] for r in sel], marker=mk,
-                           c=col, label=f"{fid} ({solver})", alpha=0.8)
+                           c=col, label=label, alpha=0.8)
                 for r in sel:
-                    ax.annotate(r["setting"].replace(" (short window)", ""), (max(r["err_peak"], 1e-9), r["cost"]),
-                                fontsize=5, alpha=0.7)
+                    text = r["setting"].replace(" (short window)", "")
+                    if r["contact"] in ("drop", "profile"):
+                        text = f"{r['contact']} contact"
+                    ax.annotate(text, (max(r["err_peak"], 1e-9), r["cost"]), fontsize=5, alpha=0.7)
         ax.axvline(TOL_PEAK, color="r", ls="--", lw=0.8)
         ax.set_xscale("log")
         ax.set_yscale("log")
