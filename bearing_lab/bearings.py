@@ -13,7 +13,7 @@ The paper prints BPFO/BPFI with the wrong form; these are the correct ones.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 import math
 
 from .errors import SceneError

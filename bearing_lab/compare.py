@@ -465,7 +465,7 @@ def calibrate_sensor(experiment, simulation, fs, period, *, band=None,
     """
     from scipy.optimize import least_squares
     prob = _CalibrationProblem(experiment, simulation, fs, period, band=band, pre=pre, post=post)
-    te, ts, env_e, pk, floor, s = prob.te, prob.ts, prob.env_e, prob.pk, prob.floor, prob.s
+    te, ts, env_e, pk, s = prob.te, prob.ts, prob.env_e, prob.pk, prob.s
     residuals, model = prob.residuals, prob.model
 
     fmax_b = frequency_bounds[1] or 0.45 * fs

@@ -37,7 +37,6 @@ def check_dataset(ds, *, kind: str | None = None) -> None:
     ds : xarray.Dataset
     kind : "simulation", "recording" or None (common checks only).
     """
-    from . import __version__  # noqa: F401
     problems = []
     if "time" not in ds.coords:
         problems.append("no 'time' coordinate")

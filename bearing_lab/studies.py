@@ -65,7 +65,6 @@ PAPER_OFFSET_RATIOS = (1.0, 22.48 / 28.82, 15.64 / 28.82)
 
 def _passage(ds, scene):
     """(centre time in the record, window half-width, ball index) of the last full passage."""
-    from .sim.assembly import load_zone_angle
     b = scene.bearing
     rpm = ds.attrs["shaft_speed_rpm"]
     omega = rpm / 60 * 2 * math.pi

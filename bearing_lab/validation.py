@@ -42,8 +42,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .compare import (G0, QUANTITIES, CalibrationResult, ComparisonResult, Tolerance, apply_sensor,
-                      calibrate_sensor, compare, impact_times, impulse_strength, make_row, measure)
+from .compare import (G0, QUANTITIES, CalibrationResult, Tolerance, calibrate_sensor, compare,
+                      impact_times, impulse_strength, make_row, measure)
 from .errors import BearingLabError, ValidationCaseError
 
 __all__ = ["CASE_DIR", "ValidationCase", "list_cases", "load_case", "default_set", "check_case",
@@ -567,7 +567,6 @@ def _paper_studies(case, out: Path, ref: dict, report) -> dict:
     import xarray as xr
     if isinstance(res, xr.Dataset) and {"study", "label", "peak_acceleration", "excitation_duration"} <= set(res.variables):
         rows, trends = _study_rows(case, res, ref)
-        from .report import rows_table
         html_parts.append("<h3>Trends the paper reports, and ours</h3>" + _trend_table(trends))
         tab = res.to_dataframe()
         html_parts.append("<h3>Study table</h3>" + tab.to_html(float_format=lambda v: f"{v:.5g}"))
@@ -607,7 +606,6 @@ def _study_rows(case, ds, ref):
         "a single short passage (reference.md)")
     s5 = ref.get("section5", {})
     pr = s5.get("offset_acceleration_ratios", [1.0, 0.78, 0.54])
-    pa = s5.get("offset_acceleration_peaks_g", [None, None, None])
     a, labs = vals("offset", acc)
     if len(a) >= 3 and a[0] > 0:
         for i, h in ((1, "B/3"), (2, "B/2")):

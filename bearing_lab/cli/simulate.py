@@ -1,10 +1,8 @@
 """`bearing-lab scenes` and `bearing-lab simulate`."""
 from __future__ import annotations
 
-from pathlib import Path
 import sys
 
-from ..errors import BearingLabError
 
 
 def _scenes(args) -> int:
@@ -20,11 +18,8 @@ def _simulate(args) -> int:
     from ..sim import simulate
     from ..sim.scene import parse_set
     overrides = parse_set(args.set)
-    out = Path(args.output)
-    if out.suffix not in (".nc", ".nc4"):
-        raise BearingLabError(f"-o {args.output}: the output must be a netCDF file ending in .nc")
-    if not out.parent.exists():
-        raise BearingLabError(f"-o {args.output}: directory {out.parent} does not exist")
+    from ..io_netcdf import check_output_path
+    out = check_output_path(args.output)
     ds = simulate(args.scene, duration=args.duration, fs=args.fs, progress=not args.quiet, **overrides)
     from ..io_netcdf import write_netcdf
     write_netcdf(ds, out)

@@ -1,10 +1,9 @@
 """`bearing-lab sweep`: a parameter sweep on Dask, written as one netCDF file."""
 from __future__ import annotations
 
-from pathlib import Path
 import sys
 
-from ..errors import BearingLabError, SceneError
+from ..errors import SceneError
 
 
 def parse_params(items) -> dict:
@@ -33,11 +32,8 @@ def _sweep(args) -> int:
     from ..sim.scene import parse_set
     params = parse_params(args.param)
     overrides = parse_set(args.set)
-    out = Path(args.output)
-    if out.suffix not in (".nc", ".nc4"):
-        raise BearingLabError(f"-o {args.output}: the output must be a netCDF file ending in .nc")
-    if not out.parent.exists():
-        raise BearingLabError(f"-o {args.output}: directory {out.parent} does not exist")
+    from ..io_netcdf import check_output_path
+    out = check_output_path(args.output)
     cache = False if args.no_cache else args.cache_dir
     ds = sweep(args.scene, params, scheduler=args.scheduler, n_workers=args.workers, cache_dir=cache,
                progress=not args.quiet, duration=args.duration, fs=args.fs, **overrides)

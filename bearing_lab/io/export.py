@@ -46,19 +46,8 @@ def to_netcdf(ds, path, *, complevel: int = 4):
     >>> xr.load_dataset("out.nc").identical(ds)   # doctest: +SKIP
     True
     """
-    path = Path(path)
-    enc = {}
-    for name, var in ds.variables.items():
-        e = {"zlib": True, "complevel": int(complevel), "shuffle": True}
-        if var.dtype.kind in "fc":
-            e["_FillValue"] = None
-        if var.dtype.kind in "iufc":
-            enc[name] = e
-    try:
-        ds.to_netcdf(path, engine="netcdf4", format="NETCDF4", encoding=enc)
-    except (OSError, ValueError, TypeError) as exc:
-        raise RecordingError(f"{path}: cannot write netCDF4 ({type(exc).__name__}: {exc})") from exc
-    return path
+    from ..io_netcdf import write_netcdf
+    return write_netcdf(ds, path, complevel=complevel, error=RecordingError)
 
 
 def _label_for(si: str, quantity: str) -> str:

@@ -28,10 +28,10 @@ import xarray as xr
 from scipy import signal
 
 from .. import __version__
-from ..errors import SceneError, SolverError
+from ..errors import SolverError
 from . import _kernels as K
 from .assembly import assemble
-from .scene import Scene, load_scene
+from .scene import load_scene
 
 # Butcher tableaus: (A, b, b - b_hat, c, order used for step control, FSAL)
 _DP54 = (
@@ -244,18 +244,11 @@ def simulate(scene, *, fidelity: str | None = None, duration: float | None = Non
     ``compile_time_s``, ``sampling_rate_hz``, ``shaft_speed_rpm``.
     """
     ov = dict(overrides)
-    if duration is not None:
-        ov["output.duration_s"] = duration
-    if fs is not None:
-        ov["output.sample_rate_hz"] = fs
-    if rtol is not None:
-        ov["solver.rtol"] = rtol
-    if method is not None:
-        ov["solver.method"] = method
-    if step is not None:
-        ov["solver.step_s"] = step
-    if fidelity is not None:
-        ov["fidelity"] = fidelity
+    for key, value in (("output.duration_s", duration), ("output.sample_rate_hz", fs),
+                       ("solver.rtol", rtol), ("solver.method", method), ("solver.step_s", step),
+                       ("fidelity", fidelity)):
+        if value is not None:
+            ov[key] = value
     sc = load_scene(scene, **ov)
     compile_s = _warm_up()
     t_start = _time.perf_counter()
