@@ -1,0 +1,117 @@
+"""File primitives shared by every writer and cache: atomic writes, checksums, cache folder.
+
+Why one module: a result file, a sweep-cache entry and a contact-table cache entry must
+all survive a crash, a kill or a second process writing the same name.  The rule is the
+same everywhere: write a temporary file in the target's directory, flush it to disk,
+then rename it over the target in one step (``os.replace`` is atomic on POSIX and on
+Windows within one volume).  On any failure the temporary file is removed and the old
+target, if any, is left exactly as it was.
+
+atomic_path(path)      -- context manager yielding a temporary path to write by name
+                          (netCDF4, savefig, ...); renamed over ``path`` on success
+atomic_open(path, mode) -- context manager yielding an open file object ("w", "wb", ...)
+sha256_file(path)      -- hex digest of a file, read in 1 MiB blocks
+sha256_bytes(data)     -- hex digest of bytes
+cache_dir(kind)        -- per-user cache folder for ``kind`` ("tables", ...), created on use;
+                          ``BEARING_LAB_CACHE`` overrides the root
+"""
+from __future__ import annotations
+
+from contextlib import contextmanager
+import hashlib
+import os
+from pathlib import Path
+import tempfile
+
+__all__ = ["atomic_path", "atomic_open", "sha256_file", "sha256_bytes", "cache_dir"]
+
+
+def _fsync_dir(directory: Path) -> None:
+    """Flush a directory entry (the rename) to disk where the platform allows it."""
+    try:
+        fd = os.open(directory, os.O_RDONLY)
+    except OSError:
+        return
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass
+    finally:
+        os.close(fd)
+
+
+@contextmanager
+def atomic_path(path, *, suffix: str | None = None):
+    """Yield a temporary path beside ``path``; on normal exit it replaces ``path`` atomically.
+
+    The temporary name keeps ``path``'s suffix (some writers choose the format by it) and
+    starts with a dot, so a directory listing does not show half-written files as results.
+    If the block raises, the temporary file is removed and ``path`` is untouched.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> d = pathlib.Path(tempfile.mkdtemp())
+    >>> with atomic_path(d / "a.txt") as tmp:
+    ...     _ = tmp.write_text("new")
+    >>> (d / "a.txt").read_text()
+    'new'
+    """
+    path = Path(path)
+    directory = path.parent if str(path.parent) else Path(".")
+    fd, tmp_name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix or path.suffix or ".tmp",
+                                    dir=directory)
+    os.close(fd)
+    tmp = Path(tmp_name)
+    try:
+        yield tmp
+        # flush the data before the rename, so a crash cannot leave a renamed empty file
+        with open(tmp, "rb+") as fh:
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            tmp.unlink()
+        except OSError:
+            pass
+        raise
+    _fsync_dir(directory)
+
+
+@contextmanager
+def atomic_open(path, mode: str = "w", **kwargs):
+    """Open a temporary file beside ``path`` for writing; it replaces ``path`` on normal exit."""
+    if not any(c in mode for c in "wx"):
+        raise ValueError(f"atomic_open is for writing; got {mode=}")
+    with atomic_path(path) as tmp:
+        with open(tmp, mode.replace("x", "w"), **kwargs) as fh:
+            yield fh
+
+
+def sha256_file(path, *, block: int = 1 << 20) -> str:
+    """Hex sha256 of the file at ``path``."""
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for chunk in iter(lambda: fh.read(block), b""):
+            h.update(chunk)
+    return h.hexdigest()
+
+
+def sha256_bytes(data: bytes) -> str:
+    """Hex sha256 of ``data``."""
+    return hashlib.sha256(data).hexdigest()
+
+
+def cache_dir(kind: str) -> Path:
+    """The per-user cache folder for ``kind`` (created if missing).
+
+    Root: ``$BEARING_LAB_CACHE`` if set, else ``$XDG_CACHE_HOME/bearing_lab`` or
+    ``~/.cache/bearing_lab``.  Everything in it can be deleted at any time; it is rebuilt.
+    """
+    root = os.environ.get("BEARING_LAB_CACHE")
+    if not root:
+        base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+        root = os.path.join(base, "bearing_lab")
+    d = Path(root) / kind
+    d.mkdir(parents=True, exist_ok=True)
+    return d
