@@ -358,7 +358,7 @@ def _check_arguments(defect, *, model, clearance, delta_max, n_psi, n_delta, aga
 
 
 def _build(defect, bearing, *, model, clearance, delta_max, n_psi, n_delta, against=None,
-           material=DEFAULT_MATERIAL) -> ContactTable:
+           material=DEFAULT_MATERIAL, halfspace_settings=None) -> ContactTable:
     t0 = time.perf_counter()
     c0 = time.process_time()
     _check_arguments(defect, model=model, clearance=clearance, delta_max=delta_max, n_psi=n_psi,
@@ -391,7 +391,7 @@ def _build(defect, bearing, *, model, clearance, delta_max, n_psi, n_delta, agai
     if model == "halfspace":
         E, nu = material
         G, info_hs = _halfspace_G(defect, geom, psi * R, delta, drop2, e_star=E / (2 * (1 - nu * nu)),
-                                  misses=misses)
+                                  misses=misses, settings=halfspace_settings)
         info.update(info_hs)
     elif model == "area":
         G = lat["G"]
@@ -463,25 +463,31 @@ def _lattice(defect, geom, psi, R, delta, *, cells, area_law):
     return res
 
 
-def _halfspace_G(defect, geom, s_tab, delta, drop, *, e_star, misses):
-    """G of the "halfspace" model on the table's (s, delta) grid, and diagnostics."""
+def _halfspace_G(defect, geom, s_tab, delta, drop, *, e_star, misses, settings=None):
+    """G of the "halfspace" model on the table's (s, delta) grid, and diagnostics.
+
+    ``settings`` (for convergence studies) overrides ``nodes`` (fractions of delta_max),
+    ``cells``, ``richardson`` and the keywords of :func:`.halfspace.ratio_curve`
+    (``tol``, ``refine_tol``, ``coarse_step``)."""
     from .halfspace import TABLE_CELLS, aligned_sides, ratio_curve
+    settings = dict(settings or {})
     n_psi, n_delta = s_tab.size, delta.size
-    nodes_d = np.array(HALFSPACE_NODES) * delta[-1]
-    info = {"halfspace_delta_nodes": nodes_d, "halfspace_cells": TABLE_CELLS}
+    nodes_d = np.array(settings.pop("nodes", HALFSPACE_NODES)) * delta[-1]
+    cells = tuple(settings.pop("cells", TABLE_CELLS))
+    richardson = settings.pop("richardson", True) and aligned_sides(defect) is not None
+    info = {"halfspace_delta_nodes": nodes_d, "halfspace_cells": cells}
     if misses:
         info["halfspace_ratio"] = np.ones((n_psi, nodes_d.size))
         return np.broadcast_to(delta ** 1.5, (n_psi, n_delta)).copy(), info
-    richardson = aligned_sides(defect) is not None
-    coarse = (TABLE_CELLS[0] // 2, TABLE_CELLS[1] // 2)
+    coarse = (cells[0] // 2, cells[1] // 2)
     ratios, forces, axes, solves = [], [], [], 0
     for dn in nodes_d:
-        s_f, r_f, inf_f = ratio_curve(defect, geom, dn, cells=TABLE_CELLS, e_star=e_star)
+        s_f, r_f, inf_f = ratio_curve(defect, geom, dn, cells=cells, e_star=e_star, **settings)
         r = np.interp(s_tab, s_f, r_f, left=1.0, right=1.0)
         solves += inf_f["solves"]
         if richardson:
             # first-order error in the cell size h: r = r_h + (r_h - r_2h) h / (h_2h - h)
-            s_c, r_c, inf_c = ratio_curve(defect, geom, dn, cells=coarse, e_star=e_star)
+            s_c, r_c, inf_c = ratio_curve(defect, geom, dn, cells=coarse, e_star=e_star, **settings)
             rc = np.interp(s_tab, s_c, r_c, left=1.0, right=1.0)
             h_f, h_c = math.sqrt(math.prod(inf_f["cell_m"])), math.sqrt(math.prod(inf_c["cell_m"]))
             r = r + (r - rc) * h_f / (h_c - h_f)
