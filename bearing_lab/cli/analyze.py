@@ -68,9 +68,6 @@ def _pick_channel(ds, name, path):
     default = ds.attrs.get("default_channel")
     if default in candidates:
         return default
-    for pref in ("outer_ring_acc_y", "outer_ring_acc_x"):
-        if pref in candidates:
-            return pref
     if not candidates:
         raise AnalysisError(f"{path}: no 1-D time signal to analyse")
     return candidates[0]
