@@ -125,6 +125,15 @@ def test_calibration_scales_that_are_not_a_sensor_are_refused(tmp_path, scale):
         load_case(p)
 
 
+def test_a_case_never_names_code_to_run(tmp_path):
+    paper = Path(str(shipped_cases()["paper"]))
+    text = paper.read_text().replace("[studies]\nenabled = true", "[studies]\nenabled = true\nmodule = \"os\"")
+    (tmp_path / "paper_reference.toml").write_text((paper.parent / "paper_reference.toml").read_text())
+    (tmp_path / "p.toml").write_text(text)
+    with pytest.raises(ValidationCaseError, match="unknown key 'module' in \\[studies\\]"):
+        load_case(tmp_path / "p.toml")
+
+
 def test_speed_values(tmp_path):
     for bad in ("\"fast\"", "-1.0", "0"):
         p = tmp_path / "s.toml"

@@ -96,3 +96,29 @@ def test_modules_and_functions_stay_small():
         for node in ast.walk(ast.parse(text)):
             if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
                 assert node.end_lineno - node.lineno + 1 <= 80, (p.name, node.name)
+
+
+def test_import_rpm_stores_the_speed_a_case_reads_as_file(standin, capsys):
+    nc = standin / "rig.nc"
+    assert main(["import", str(standin / "rig.uff"), "--rpm", "1793", "-o", str(nc)]) == 0
+    import bearing_lab as bl
+    ds = bl.open_recording(nc)
+    assert ds.attrs["shaft_speed_rpm"] == 1793.0 and "--rpm" in ds.attrs["shaft_speed_source"]
+    from bearing_lab.validation.speed import resolve_speed
+    sp = resolve_speed("file", ds, ds["Acc"].values, bearing="6308", case_name="c")
+    assert sp.rpm == 1793.0 and "stored in the recording" in sp.source and "--rpm" in sp.source
+    assert main(["import", str(standin / "rig.uff"), "--rpm", "-5", "-o", str(standin / "bad.nc")]) == 2
+    assert "--rpm -5" in capsys.readouterr().err
+
+
+def test_case_new_writes_a_case_that_names_what_is_missing(standin, capsys):
+    out = standin / "new.toml"
+    assert main(["case", "new", str(standin / "rig.uff"), "-o", str(out)]) == 0
+    text = out.read_text()
+    assert 'file = "rig.uff"' in text and "20000 Hz" in text and 'speed = "estimate"' in text
+    from bearing_lab.errors import ValidationCaseError
+    from bearing_lab.validation import load_case
+    with pytest.raises(ValidationCaseError, match="give bearing"):
+        load_case(out)
+    assert main(["case", "new", str(standin / "rig.uff"), "-o", str(out)]) == 2     # exists: not overwritten
+    assert "--force" in capsys.readouterr().err
