@@ -329,6 +329,16 @@ def _fit_problems(best, lo, hi, names, fit_db, before_db, bounds_given):
     return problems
 
 
+def _samples(obj, fs):
+    """(x, fs) of an array, or of a Dataset's default channel (recording or simulation)."""
+    if hasattr(obj, "data_vars"):
+        ch = obj.attrs.get("default_channel") or next(iter(obj.data_vars))
+        return np.asarray(obj[ch].values, float), float(obj.attrs["sampling_rate_hz"])
+    if fs is None:
+        raise AnalysisError("structural path: give fs (Hz) with a plain array")
+    return np.asarray(obj, float), float(fs)
+
+
 def fit_structural_path(recording, simulation, fs, period, *, band=None, n_resonances=1,
                         frequency_bounds=(500.0, None), damping_bounds=(0.005, 0.5), gain_bounds=(1e-3, 1e3),
                         pre=0.5e-3, post=None, source="") -> StructuralPath:
@@ -336,13 +346,14 @@ def fit_structural_path(recording, simulation, fs, period, *, band=None, n_reson
 
     Parameters
     ----------
-    recording : array_like, 1-D
-        The measured acceleration (m s-2), as long as available.
-    simulation : array_like, 1-D
+    recording : array_like, 1-D, or Dataset
+        The measured acceleration (m s-2), as long as available (a recording Dataset: its
+        default channel).
+    simulation : array_like, 1-D, or Dataset
         The simulated outer-ring acceleration of the declared scene *without* a sensor
-        resonator, at the same rate.
-    fs : float
-        Sampling rate, Hz.
+        resonator, at the same rate (a simulated Dataset: its default channel).
+    fs : float or None
+        Sampling rate, Hz (None: from the Datasets, which must agree).
     period : float
         Impact period of the recording, s.
     band : (float, float), optional
@@ -370,6 +381,12 @@ def fit_structural_path(recording, simulation, fs, period, *, band=None, n_reson
         Fewer than :data:`MIN_IMPACTS` impacts in either signal, or invalid bounds.
     """
     from scipy.optimize import least_squares
+    recording, fs_r = _samples(recording, fs)
+    simulation, fs_s = _samples(simulation, fs)
+    if abs(fs_r - fs_s) > 1e-9 * fs_r:
+        raise AnalysisError(f"structural path: recording at {fs_r:g} Hz and simulation at {fs_s:g} Hz; "
+                            "simulate at the recording's rate")
+    fs = fs_r
     if n_resonances not in (1, 2):
         raise AnalysisError(f"structural path: n_resonances={n_resonances!r}; allowed values are 1 and 2")
     notes = []

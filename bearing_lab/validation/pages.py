@@ -115,7 +115,12 @@ def build_report(case, result, wall) -> Report:
     report = Report(f"Validation: {case.name}", subtitle=case.title)
     _overview(report, result.rows)
     _render_sections(report, result.sections)
-    report.add_html("<ul>" + "".join(f"<li>{a}</li>" for a in MODEL_ASSUMPTIONS) + "</ul>", "Model assumptions")
+    from ..report import esc, table_html
+    model = result.extra.get("model") or {}
+    runs = model if model and all(isinstance(v, dict) for v in model.values()) else {"simulation": model}
+    report.add_html("<ul>" + "".join(f"<li>{esc(a)}</li>" for a in MODEL_ASSUMPTIONS) + "</ul>"
+                    + table_html([{"run": k, **v} for k, v in runs.items() if v],
+                                 intro="The simulations as they ran:"), "Model assumptions")
     _compute_tables(report, result, wall)
     report.add_provenance({"case": case.name, "case source": case.source, "case TOML": case.text,
                            **result.provenance})

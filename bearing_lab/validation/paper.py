@@ -146,6 +146,8 @@ def run_paper_case(case, out_dir, *, steps):
         extra["compute"][label] = {"wall_time_s": float(ds.attrs["wall_time_s"]),
                                    "compile_time_s": float(ds.attrs.get("compile_time_s", 0.0))}
         prov[f"scene ({label})"] = scene.to_toml()
+        from .recording_parts import model_details
+        extra.setdefault("model", {})[label] = model_details(ds)
         steps.step(f"simulate {label}")
     studies = _studies(case, out_dir)
     steps.step("studies")

@@ -14,7 +14,14 @@ from . import figures, simulation
 from .recording import open_spec
 from .speed import resolve_speed
 
-__all__ = ["context", "ratio_companion", "healthy_reference", "assemble"]
+__all__ = ["context", "ratio_companion", "healthy_reference", "assemble", "model_details"]
+
+
+def model_details(ds) -> dict:
+    """What the simulation that ran assumed (fidelity, contact and cage models, load path, solver)."""
+    keys = ("bearing", "fidelity", "defect_contact_models", "cage_model", "load_path", "solver_method",
+            "solver_rtol", "sensor_resonator", "anti_alias")
+    return {k: ds.attrs.get(k) for k in keys if k in ds.attrs}
 
 
 def context(case, prep, path, background=None) -> dict:
@@ -174,7 +181,7 @@ def assemble(case, prep, path, background, signals, rows, err, healthy, ctx):
                             "shaft_hz": prep.speed.rpm / 60.0, "speed_source": prep.speed.source,
                             "structural_path": path.to_dict()})
     ds = prep.dataset
-    extra = {"speed": {"rpm": prep.speed.rpm, "source": prep.speed.source},
+    extra = {"speed": {"rpm": prep.speed.rpm, "source": prep.speed.source}, "model": model_details(ds),
              "structural_path": path.to_dict(), "background": background.to_dict() if background else None,
              "numerical_error": err, "ratio": {k_: v for k_, v in (ctx.get("ratio") or {}).items()},
              "healthy": {"decomposition": healthy["decomposition"], "speed": healthy["speed"]} if healthy else None,

@@ -111,3 +111,15 @@ def test_save_load_round_trip_and_invalid_paths(tmp_path):
     (tmp_path / "bad.json").write_text("{")
     with pytest.raises(AnalysisError, match="bad.json"):
         StructuralPath.load(tmp_path / "bad.json")
+
+
+def test_the_fit_takes_a_recording_and_a_simulated_dataset():
+    import xarray as xr
+
+    def ds(x, fs=FS):
+        return xr.Dataset({"acc": ("time", x)}, attrs={"sampling_rate_hz": fs, "default_channel": "acc"})
+    measured = _path().apply(_impacts(n=60000, seed=1), FS)
+    path = fit_structural_path(ds(measured), ds(_impacts()), None, PERIOD, frequency_bounds=(1000.0, 5400.0))
+    assert path.resonances[0].frequency_hz == pytest.approx(3100.0, rel=0.03)
+    with pytest.raises(AnalysisError, match="simulate at the recording's rate"):
+        fit_structural_path(ds(measured), ds(_impacts(), fs=2 * FS), None, PERIOD)
