@@ -329,6 +329,42 @@ def _fit_problems(best, lo, hi, names, fit_db, before_db, bounds_given):
     return problems
 
 
+def _check_bounds(frequency_bounds, damping_bounds, gain_bounds, fs):
+    """The search bounds as used, and notes on any change (an upper frequency above 0.45 fs is lowered)."""
+    notes = []
+    f_hi = frequency_bounds[1] if frequency_bounds[1] is not None else 0.45 * fs
+    if f_hi > 0.45 * fs:
+        notes.append(f"upper frequency bound {f_hi:g} Hz lowered to 0.45 fs = {0.45 * fs:g} Hz: the "
+                     "recording holds nothing above its anti-alias band")
+        f_hi = 0.45 * fs
+    bounds = {"frequency_hz": (float(frequency_bounds[0]), float(f_hi)),
+              "damping_ratio": tuple(map(float, damping_bounds)), "gain": tuple(map(float, gain_bounds))}
+    for name, (a, b) in bounds.items():
+        if not (0 < a < b and math.isfinite(b)):
+            raise AnalysisError(f"structural path: bounds {name}=({a:g}, {b:g}) must be positive and increasing")
+    return bounds, notes
+
+
+def _finish(prob, best, lo, hi, bounds, notes, source) -> StructuralPath:
+    """The fitted path with its report: residuals before and after, bounds, impacts, problems."""
+    fs, k = prob.fs, prob.nres
+    path = prob.path_of(best.x)
+    _, parts = prob.residuals_of(path.apply(prob.s, fs), parts=True)
+    _, parts0 = prob.residuals_of(prob.s, parts=True)
+    fit_db, before_db = _rms_db(np.concatenate(parts)), _rms_db(np.concatenate(parts0))
+    names = ([f"frequency_hz[{i}]" if k > 1 else "frequency_hz" for i in range(k)]
+             + [f"damping_ratio[{i}]" if k > 1 else "damping_ratio" for i in range(k)] + ["gain"])
+    given = {n: bounds[n.split("[")[0]] for n in names}
+    path.source = source or "fitted on the pooled impulse responses"
+    path.fit = {"residual_db": fit_db, "initial_db": before_db, "bounds": bounds,
+                "n_impacts_recording": int(prob.te.size), "n_impacts_simulation": int(prob.ts.size),
+                "evaluations": int(best.nfev), "notes": notes,
+                "problems": _fit_problems(best, lo, hi, names, fit_db, before_db, given)}
+    path.curves = {"time_s": (np.arange(prob.env_e.size) - prob.pk) / fs, "recording": prob.env_e,
+                   "before": prob.envelope(prob.s), "after": prob.envelope(path.apply(prob.s, fs))}
+    return path
+
+
 def _samples(obj, fs):
     """(x, fs) of an array, or of a Dataset's default channel (recording or simulation)."""
     if hasattr(obj, "data_vars"):
@@ -389,17 +425,8 @@ def fit_structural_path(recording, simulation, fs, period, *, band=None, n_reson
     fs = fs_r
     if n_resonances not in (1, 2):
         raise AnalysisError(f"structural path: n_resonances={n_resonances!r}; allowed values are 1 and 2")
-    notes = []
-    f_hi = frequency_bounds[1] if frequency_bounds[1] is not None else 0.45 * fs
-    if f_hi > 0.45 * fs:
-        notes.append(f"upper frequency bound {f_hi:g} Hz lowered to 0.45 fs = {0.45 * fs:g} Hz: the "
-                     "recording holds nothing above its anti-alias band")
-        f_hi = 0.45 * fs
-    bounds = {"frequency_hz": (float(frequency_bounds[0]), float(f_hi)),
-              "damping_ratio": tuple(map(float, damping_bounds)), "gain": tuple(map(float, gain_bounds))}
-    for name, (a, b) in bounds.items():
-        if not (0 < a < b and math.isfinite(b)):
-            raise AnalysisError(f"structural path: bounds {name}=({a:g}, {b:g}) must be positive and increasing")
+    bounds, notes = _check_bounds(frequency_bounds, damping_bounds, gain_bounds, fs)
+    f_hi = bounds["frequency_hz"][1]
     post = 0.6 * period if post is None else post
     prob = _PathProblem(recording, simulation, fs, period, band=band, pre=pre, post=post, n_resonances=n_resonances)
     k = n_resonances
@@ -411,18 +438,4 @@ def fit_structural_path(recording, simulation, fs, period, *, band=None, n_reson
         r = least_squares(prob.residuals, x0, bounds=(lo, hi), x_scale=0.3, max_nfev=60)
         if best is None or r.cost < best.cost:
             best = r
-    path = prob.path_of(best.x)
-    _, parts = prob.residuals_of(path.apply(prob.s, fs), parts=True)
-    _, parts0 = prob.residuals_of(prob.s, parts=True)
-    fit_db, before_db = _rms_db(np.concatenate(parts)), _rms_db(np.concatenate(parts0))
-    names = ([f"frequency_hz[{i}]" if k > 1 else "frequency_hz" for i in range(k)]
-             + [f"damping_ratio[{i}]" if k > 1 else "damping_ratio" for i in range(k)] + ["gain"])
-    given = {n: bounds[n.split("[")[0]] for n in names}
-    path.source = source or "fitted on the pooled impulse responses"
-    path.fit = {"residual_db": fit_db, "initial_db": before_db, "bounds": bounds,
-                "n_impacts_recording": int(prob.te.size), "n_impacts_simulation": int(prob.ts.size),
-                "evaluations": int(best.nfev), "notes": notes,
-                "problems": _fit_problems(best, lo, hi, names, fit_db, before_db, given)}
-    path.curves = {"time_s": (np.arange(prob.env_e.size) - prob.pk) / fs, "recording": prob.env_e,
-                   "before": prob.envelope(prob.s), "after": prob.envelope(path.apply(prob.s, fs))}
-    return path
+    return _finish(prob, best, lo, hi, bounds, notes, source)

@@ -241,14 +241,14 @@ def _recording(name, where, raw, base_dir, *, allowed=None) -> RecordingSpec:
 
 
 def _ratio_spec(case, raw) -> RecordingSpec:
+    """The ``[ratio]`` companion: a registry name when the registry knows it, else a file."""
     rec = str(raw["recording"])
-    p = Path(rec)
-    is_file = p.suffix and (p.is_absolute() or case.base_dir is None or (Path(str(case.base_dir)) / p).exists())
     spec = RecordingSpec(channel=raw.get("channel"), speed=raw.get("speed", "file"))
-    if is_file and not _is_registry(rec):
-        spec.file = p if p.is_absolute() or case.base_dir is None else Path(str(case.base_dir)) / p
-    else:
+    if _is_registry(rec):
         spec.name = rec
+    else:
+        p = Path(rec).expanduser()
+        spec.file = p if p.is_absolute() or case.base_dir is None else Path(str(case.base_dir)) / p
     return spec
 
 

@@ -23,12 +23,12 @@ DEFAULT_ROWS = ("shaft_hz", "bpfo", "excitation_period", "rms", "peak", "crest_f
 
 
 def _relative(path, case_dir) -> str:
-    import os
+    """The recording relative to the case's folder when it lies inside it, else absolute."""
     p = Path(path).resolve()
     if case_dir is not None:
         try:
-            return Path(os.path.relpath(p, Path(case_dir).resolve())).as_posix()
-        except ValueError:  # another drive
+            return p.relative_to(Path(case_dir).resolve()).as_posix()
+        except ValueError:
             pass
     return p.as_posix()
 
