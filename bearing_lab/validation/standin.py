@@ -107,7 +107,7 @@ def make_standin_recording(path, *, scene="paper-O2", overrides=None, rpm=1793.0
     noise_g : float
         RMS of the white sensor noise, g.
     seed : int
-        Seed of the speed walk and the noise (same seed, same file).
+        Seed of the speed walk, the tone phases and the noise (same seed, same samples).
     channel : str
         Channel name written to the file.
 
@@ -116,7 +116,7 @@ def make_standin_recording(path, *, scene="paper-O2", overrides=None, rpm=1793.0
     StandIn
         ``hidden`` holds the truth: scene, overrides, rpm, jitter, resonance, tones, noise.
     """
-    from ..sim import simulate
+    from . import simulation
     path = Path(path)
     fmt = FORMATS.get(path.suffix.lower())
     if fmt is None:
@@ -129,7 +129,7 @@ def make_standin_recording(path, *, scene="paper-O2", overrides=None, rpm=1793.0
                "sensor.damping_ratio": resonance_damping, "sensor.gain": sensor_gain})
     if ov["speed.profile"] is None:
         ov.pop("speed.profile")
-    ds = simulate(scene, duration=duration, fs=fs, progress=False, **ov)
+    ds = simulation.run(scene, duration=duration, fs=fs, **ov)
     x = np.asarray(ds[ds.attrs["default_channel"]].values, float)
     t = np.arange(x.size) / fs
     tones = default_tones(rpm) if tones is None else [tuple(map(float, tn)) for tn in tones]
