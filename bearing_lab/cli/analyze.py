@@ -2,7 +2,7 @@
 
 Why here: the CLI only reads, picks a channel and prints; the analysis is
 :func:`bearing_lab.analysis.analyze`, so the JSON printed here is exactly what a
-script gets from Python (contract.md's ``analyze --json`` schema).
+script gets from Python (the ``analyze --json`` schema of :func:`bearing_lab.analysis.analyze`).
 
 ``--rpm`` is a nominal speed used as a prior; ``--rpm file`` takes the file's
 stored ``shaft_speed_rpm`` (only when asked: stored speeds are nominal).
@@ -30,7 +30,8 @@ def register(subparsers):
     p.add_argument("--rpm", default=None,
                    help="nominal shaft speed in r/min (a prior for the estimate), or 'file' to use "
                         "the file's stored shaft_speed_rpm")
-    p.add_argument("--json", action="store_true", help="print the result as JSON (contract.md)")
+    p.add_argument("--json", action="store_true",
+                   help="print the result as JSON (the schema of bearing_lab.analysis.analyze)")
     p.add_argument("--plot", metavar="FILE.png", default=None,
                    help="also write a figure: waveform, spectrum, SES with fault-frequency markers")
     p.set_defaults(func=run)
@@ -68,9 +69,6 @@ def _pick_channel(ds, name, path):
     default = ds.attrs.get("default_channel")
     if default in candidates:
         return default
-    for pref in ("outer_ring_acc_y", "outer_ring_acc_x"):
-        if pref in candidates:
-            return pref
     if not candidates:
         raise AnalysisError(f"{path}: no 1-D time signal to analyse")
     return candidates[0]
