@@ -9,11 +9,11 @@ from bearing_lab.analysis import analyze, plot_analysis
 from bearing_lab.cli import main
 from bearing_lab.errors import AnalysisError
 
-FAULT_KEYS = {"expected_hz", "measured_hz", "snr_db", "harmonics"}
+FAULT_KEYS = {"expected_hz", "measured_hz", "snr_db", "harmonics", "sidebands", "detected"}
 METRIC_KEYS = {"rms", "peak", "peak_to_peak", "crest_factor", "kurtosis", "impulse_factor",
                "clearance_factor", "shape_factor"}
 TOP_KEYS = {"channel", "sampling_rate_hz", "shaft_hz", "diagnosis", "fault_frequencies",
-            "excitation_period_s", "metrics", "units"}
+            "excitation_period_s", "metrics", "units", "speed_source", "speed", "verdict", "evidence"}
 
 
 def _outer_race_signal(fs=12000.0, seconds=10.0, fr=1797 / 60, seed=0):
@@ -34,7 +34,9 @@ def check_schema(r):
         assert isinstance(v["harmonics"], int)
     assert set(r["metrics"]) == METRIC_KEYS
     assert all(isinstance(v, float) and np.isfinite(v) for v in r["metrics"].values())
-    assert r["diagnosis"] in ("outer_race", "inner_race", "ball", "none")
+    assert r["diagnosis"] in ("outer_race", "inner_race", "ball", "none", "uncertain")
+    assert r["verdict"] in ("diagnosed", "uncertain", "no fault evidence")
+    assert r["speed_source"] in ("given", "file", "tacho", "estimated", "unresolved")
     assert r["excitation_period_s"] is None or isinstance(r["excitation_period_s"], float)
     json.dumps(r, allow_nan=False)
 
