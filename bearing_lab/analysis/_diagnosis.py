@@ -34,14 +34,10 @@ Verdict (after Smith & Randall's graded reading):
 from __future__ import annotations
 
 from ..errors import AnalysisError
-import numpy as np
-from scipy import fft as _fft
-from scipy.stats import binom
-
 from ._cyclo import enhanced_envelope_spectrum
 from ._families import LABELS, SK_MIN, CyclicSpectrum, route_verdict, search_families
 from ._spectral import cepstral_prewhitening, fast_kurtogram, squared_envelope_spectrum
-from ._speed import LINE_SNR_DB, line_floor_db
+from ._shaft import discrete_comb
 
 __all__ = ["run_routes", "combine", "coincidences", "ROUTES", "VERDICTS"]
 
@@ -49,8 +45,6 @@ ROUTES = ("kurtogram_ses", "cpw_ses", "ees")
 VERDICTS = ("diagnosed", "uncertain", "no fault evidence")
 #: Decoy carriers reach this multiple of the largest kinematic ratio (see _families.decoy_ratios).
 DECOY_SPAN = 1.3
-#: A family is "discrete" when this fraction of its harmonics across the band are clear lines.
-DISCRETE_FRACTION = 0.5
 #: A discrete (slip-free) comb is a bearing fault only this close to the kinematic frequency.
 KINEMATIC_MATCH = 1e-3
 
@@ -119,40 +113,6 @@ def run_routes(x, fs, geometry, shaft_hz, *, tolerance=0.02, n_harmonics=5, prew
             "routes": routes, "xw": xw, "notes": [note] if note else []}
 
 
-def discrete_comb(x, fs, f1, *, max_lines=300):
-    """Is the comb ``k f1`` a set of discrete lines of x (a fault without slip)?
-
-    A fault comb without slip (a simulation with a kinematic cage) is a set of
-    discrete lines far up the spectrum; a real fault's random slip smears its
-    high harmonics into a continuum.  Harmonics ``k = 5 ..`` up to 0.45 fs (at
-    most ``max_lines``) count when a line stands ``LINE_SNR_DB`` over the running
-    median within +-1 bin of ``k f1``.  The comb is discrete when at least half of
-    them count and that many hits are unlikely by chance (binomial, hit rate
-    three times the density of clear lines among the bins examined, p < 1e-3).
-
-    Returns
-    -------
-    (discrete, fraction, harmonics examined)
-    """
-    n = x.size
-    df = fs / n
-    k = np.arange(5, int(0.45 * fs // f1) + 1)[:max_lines]
-    if k.size < 10:
-        return False, 0.0, int(k.size)
-    a, b = max(1, int(k[0] * f1 / df) - 200), min(n // 2, int(k[-1] * f1 / df) + 200)
-    amp = np.abs(_fft.rfft(x - x.mean()))[a:b]
-    snr = line_floor_db(amp, width=max(31, int(round(10.0 / df))))
-    local = np.zeros(amp.size, bool)
-    local[1:-1] = (amp[1:-1] >= amp[:-2]) & (amp[1:-1] >= amp[2:])
-    clear = local & (snr >= LINE_SNR_DB)
-    pos = np.rint(k * f1 / df).astype(int) - a
-    pos = pos[(pos >= 1) & (pos < amp.size - 1)]
-    hits = int(np.count_nonzero(clear[pos - 1] | clear[pos] | clear[pos + 1]))
-    p = min(0.5, 3 * float(np.mean(clear)))
-    frac = hits / max(1, pos.size)
-    return bool(frac >= DISCRETE_FRACTION and binom.sf(hits - 1, pos.size, p) < 1e-3), frac, int(pos.size)
-
-
 def _check_discrete(x, fs, routes, fault_hz):
     """The pre-whitened route abstains for a slip-free fault comb of discrete lines.
 
@@ -194,23 +154,36 @@ def _label_set(routes, names):
 
 
 def _route_states(routes):
-    """Per live route: ("named", label), ("none", None) or ("uncertain", candidates)."""
+    """Per live route: (kind, leader label, other candidates).
+
+    kind: "named" (a dominant family), "rivals" (the leader and families standing on
+    lines of their own), "weak" (a ball family without cage modulation, or a cage
+    family alone: leader "ball"), "none".
+    """
     states = {}
     for n in ROUTES:
         if routes[n]["abstained"]:
             continue
         v = routes[n]["verdict"]
+        cands = list(v["candidates"])
         if v["verdict"] in LABELS.values():
-            states[n] = ("named", v["verdict"])
+            states[n] = ("named", v["verdict"], [])
+        elif v["verdict"] == "uncertain" and len(cands) > 1:
+            states[n] = ("rivals", cands[0], cands[1:])
         elif v["verdict"] == "uncertain":
-            states[n] = ("uncertain", tuple(v["candidates"]))
+            states[n] = ("weak", cands[0], [])
         else:
-            states[n] = ("none", None)
+            states[n] = ("none", None, [])
     return states
 
 
 def combine(routes, speed):
     """Three-level verdict from the routes' verdicts and the speed's status.
+
+    The fault named is the one that leads in every route that sees a fault; the
+    envelope routes (kurtogram, pre-whitened) must confirm it, each naming it or
+    abstaining, and neither may hold a rival family on lines of its own.  A rival
+    in the cyclostationary route is reported as a secondary finding.
 
     Parameters
     ----------
@@ -223,47 +196,52 @@ def combine(routes, speed):
     -------
     dict
         ``diagnosis`` (outer_race, inner_race, ball, none, uncertain), ``verdict``
-        (diagnosed, uncertain, no fault evidence), ``candidates``, ``decided_by``
-        (route names), ``reason``.
+        (diagnosed, uncertain, no fault evidence), ``candidates``, ``secondary``,
+        ``decided_by`` (route names), ``reason``.
     """
     states = _route_states(routes)
-    named = {n: s[1] for n, s in states.items() if s[0] == "named"}
-    unsure = {n: s[1] for n, s in states.items() if s[0] == "uncertain"}
-    cands = list(dict.fromkeys([c for n in states for c in routes[n]["verdict"]["candidates"]]))
+    # a weak state (cage family alone, ball family without cage modulation) leads only
+    # when no route names a fault: cage-rate lines come with race faults too
+    leaders = {n: st[1] for n, st in states.items() if st[0] in ("named", "rivals")}
+    if not leaders:
+        leaders = {n: st[1] for n, st in states.items() if st[0] == "weak"}
+    cands = list(dict.fromkeys([c for st in states.values() if st[1] for c in [st[1]] + st[2]]))
+    envelope_routes = ("kurtogram_ses", "cpw_ses")
 
-    def out(diagnosis, verdict, reason, by=()):
+    def out(diagnosis, verdict, reason, by=(), secondary=()):
         return {"diagnosis": diagnosis, "verdict": verdict, "candidates": cands, "decided_by": list(by),
-                "reason": reason}
+                "secondary": list(secondary), "reason": reason}
 
     if speed.get("status") == "unresolved":
         return out("uncertain", "uncertain", "shaft speed unresolved: " + speed.get("note", ""))
-    labels = set(named.values())
-    others = {c for cs in unsure.values() for c in cs} - labels
-    if not labels:
-        if unsure:
-            why = "; ".join(f"{n}: {routes[n]['verdict']['reason']}" for n in unsure)
-            return out("uncertain", "uncertain", why)
+    if not leaders:
         return out("none", "no fault evidence", "no route detects a fault family")
-    if len(labels) > 1 or others:
-        said = ", ".join([f"{n} {v}" for n, v in named.items()] +
-                         [f"{n} uncertain ({' or '.join(c)})" for n, c in unsure.items()])
-        return out("uncertain", "uncertain", "the routes name different faults: " + said)
-    x = labels.pop()
-    # a route that is uncertain only about x does not contradict it
-    agrees = {n for n, s in states.items() if s == ("named", x) or s == ("uncertain", (x,))}
-    envelope = [n for n in ("kurtogram_ses", "cpw_ses") if named.get(n) == x]
-    env_ok = envelope and all(routes[n]["abstained"] or n in agrees for n in ("kurtogram_ses", "cpw_ses"))
+    if len(set(leaders.values())) > 1:
+        said = ", ".join(f"{n} {x}" for n, x in leaders.items())
+        return out("uncertain", "uncertain", "the routes lead with different faults: " + said)
+    x = next(iter(leaders.values()))
+    rivals = [n for n in envelope_routes if states.get(n, ("",))[0] == "rivals"]
+    if rivals:
+        why = "; ".join(f"{n}: {routes[n]['verdict']['reason']}" for n in rivals)
+        return out("uncertain", "uncertain", why)
+    envelope = [n for n in envelope_routes if states.get(n, ("",))[0] == "named"]
+    env_ok = envelope and all(routes[n]["abstained"] or states[n][0] in ("named", "weak") for n in envelope_routes)
+    secondary = states["ees"][2] if "ees" in states else []
     if env_ok:
-        verdict = out(x, "diagnosed", f"{' and '.join(envelope)} name{'s' if len(envelope) == 1 else ''} {x}"
-                      + "; " + "; ".join(f"{n} abstains" for n in ("kurtogram_ses", "cpw_ses")
-                                         if routes[n]["abstained"]), envelope)
-    elif x == "ball" and set(named) == {"ees"} and not envelope:
+        why = f"{' and '.join(envelope)} name{'s' if len(envelope) == 1 else ''} {x}"
+        why += "".join(f"; {n} abstains" for n in envelope_routes if routes[n]["abstained"])
+        if secondary:
+            why += f"; ees also holds a {' and '.join(secondary)} family of its own (secondary)"
+        verdict = out(x, "diagnosed", why, envelope, secondary)
+    elif x == "ball" and states.get("ees", ("",))[0] == "named" and not envelope:
         verdict = out(x, "diagnosed", "the cyclic spectral coherence shows a cage-modulated 2 BSF family "
                                       "that the envelope spectra do not", ["ees"])
+    elif all(states[n][0] == "weak" for n in leaders):
+        return out("uncertain", "uncertain", "; ".join(f"{n}: {routes[n]['verdict']['reason']}" for n in leaders))
     else:
+        seen = [n for n in leaders]
         return out("uncertain", "uncertain",
-                   f"only {' and '.join(named)} name{'s' if len(named) == 1 else ''} {x}; the other envelope "
-                   "route sees no fault family")
+                   f"{x} is seen by {' and '.join(seen)} only; the envelope routes do not both confirm it")
     if speed.get("status") == "contradicted":
         return out("uncertain", "uncertain", f"{x} at the given speed, but " + speed.get("note", ""))
     return verdict
@@ -272,10 +250,12 @@ def combine(routes, speed):
 def coincidences(fault_hz, shaft_hz, df, *, tolerance=0.02, n_harmonics=5, bins=2.0):
     """Fault lines that a shaft or cage harmonic can mimic.
 
-    For each family (2 BSF for the ball) and harmonic ``k``: a shaft harmonic
-    within ``bins`` bins of ``k F`` (the line cannot be told from it, and the
-    shaft mask may remove it), and, for the fundamental, a shaft harmonic inside
-    the slip window; for 2 BSF also a cage (FTF) harmonic within ``bins`` bins.
+    - a shaft harmonic within ``bins`` bins of a harmonic ``k F`` of a family (the
+      lines cannot be told apart at this record length, and the shaft mask may
+      remove the fault line), or inside the slip window of the fundamental;
+    - 2 BSF within a tenth of a cage spacing of a cage harmonic ``n FTF`` (a
+      property of the bearing: on the ZA-2115, 2 BSF = 18.94 FTF), so that a cage
+      comb reaching that far mimics the ball family.
 
     Returns
     -------
@@ -289,17 +269,27 @@ def coincidences(fault_hz, shaft_hz, df, *, tolerance=0.02, n_harmonics=5, bins=
         name = "2 BSF" if key == "bsf" else key.upper()
         for k in range(1, n_harmonics + 1):
             fk = k * carrier
-            refs = [("shaft", shaft_hz)] + ([("cage", fault_hz["ftf"])] if key == "bsf" else [])
-            for what, g in refs:
-                m = int(round(fk / g))
-                dist = abs(fk - m * g) / df
-                in_window = k == 1 and what == "shaft" and abs(fk - m * g) <= tolerance * fk
-                if m >= 1 and (dist <= bins or in_window):
-                    out.append({"family": key, "harmonic": k, "frequency_hz": float(fk), "near": what,
-                                "order": m, "distance_bins": float(dist),
-                                "text": f"{k if k > 1 else ''}{'x' if k > 1 else ''}{name} ({fk:.2f} Hz) lies "
-                                        f"{dist:.1f} bins ({100 * abs(fk / (m * g) - 1):.2f} %) from {m} "
-                                        f"{'f_r' if what == 'shaft' else 'FTF'}"})
+            m = int(round(fk / shaft_hz))
+            dist = abs(fk - m * shaft_hz) / df
+            label = name if k == 1 else f"{k} x {name}"
+            if m >= 1 and dist <= bins:
+                out.append({"family": key, "harmonic": k, "frequency_hz": float(fk), "near": "shaft", "order": m,
+                            "distance_bins": float(dist),
+                            "text": f"{label} ({fk:.2f} Hz) lies {dist:.1f} bins from {m} f_r: the lines cannot "
+                                    "be told apart in this record"})
+            elif m >= 1 and k == 1 and abs(fk - m * shaft_hz) <= tolerance * fk:
+                out.append({"family": key, "harmonic": 1, "frequency_hz": float(fk), "near": "shaft", "order": m,
+                            "distance_bins": float(dist),
+                            "text": f"{m} f_r ({m * shaft_hz:.2f} Hz) lies inside the +-{100 * tolerance:g} % "
+                                    f"search window of {name} ({fk:.2f} Hz), {dist:.1f} bins away: shaft lines "
+                                    "are masked there"})
+    ratio = 2 * fault_hz["bsf"] / fault_hz["ftf"]
+    n = int(round(ratio))
+    if abs(ratio - n) <= 0.1:
+        out.append({"family": "bsf", "harmonic": 1, "frequency_hz": float(2 * fault_hz["bsf"]), "near": "cage",
+                    "order": n, "distance_bins": float(abs(ratio - n) * fault_hz["ftf"] / df),
+                    "text": f"2 BSF = {ratio:.2f} FTF: a cage comb reaching its {n}th harmonic mimics the "
+                            "ball family"})
     return out
 
 
@@ -313,7 +303,9 @@ def family_summary(ev, *, bsf_scale=False):
             "sideband_spacing_hz": None if ev["modulator_hz"] is None else float(ev["modulator_hz"]),
             "evidence_db": float(ev["evidence_db"]),
             "decoy_max_db": None if ev["decoy_max_db"] is None else float(ev["decoy_max_db"]),
-            "detected": bool(ev["detected"])}
+            "decoy_threshold_db": (None if ev.get("decoy_threshold_db") is None
+                                   else float(ev["decoy_threshold_db"])),
+            "detected": bool(ev["detected"]), "explained_by": ev.get("explained_by")}
 
 
 def route_summary(route):

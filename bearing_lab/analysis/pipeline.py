@@ -49,7 +49,7 @@ from ._speed import shaft_frequency
 from ._tacho import ORDER_TRACK_VARIATION, order_track, tacho_pulses, tacho_speed
 from ._util import check_fs, check_signal
 
-__all__ = ["analyze", "plot_analysis", "SPEED_SOURCES"]
+__all__ = ["analyze", "plot_analysis", "shaft_speed", "SPEED_SOURCES"]
 
 SPEED_SOURCES = ("given", "file", "tacho", "estimated", "unresolved")
 
@@ -90,7 +90,8 @@ def _tacho_speed(x, fs, tacho, pulses_per_rev):
     return x, _fixed_speed(fr, "tacho", "measured", note, **extra)
 
 
-def _speed(x, fs, geom, *, rpm, rpm_source, shaft_hz, tacho, pulses_per_rev, tolerance, n_harmonics):
+def _speed(x, fs, geom, *, rpm, rpm_source, shaft_hz, tacho, pulses_per_rev, tolerance, n_harmonics,
+           fallback=True):
     """(signal to analyse, speed dict, pre-whitened signal or None)."""
     if shaft_hz is not None:
         fr = float(shaft_hz)
@@ -117,7 +118,7 @@ def _speed(x, fs, geom, *, rpm, rpm_source, shaft_hz, tacho, pulses_per_rev, tol
         return cache["cs"]
 
     sp = resolve_speed(x, fs, geom, rpm=rpm, rpm_source=rpm_source, cs=cpw_spectrum, tolerance=tolerance)
-    if sp["shaft_hz"] is None:
+    if sp["shaft_hz"] is None and fallback:
         # nothing to go by: the strongest harmonic family, for the fault-frequency table only
         sp["shaft_hz"] = float(shaft_frequency(x, fs, window="boxcar")[0])
         sp["note"] += f"; fault frequencies shown at the strongest line family, {sp['shaft_hz']:.3f} Hz"
@@ -142,7 +143,7 @@ def _evidence(res, verdict, speed, fs, n, geom, tolerance, n_harmonics, decided)
     routes = res["routes"]
     lead, second, margin = runner_up(routes[decided])
     ff = res["fault_hz"]
-    ev = {"candidates": verdict["candidates"], "runner_up": LABELS[second],
+    ev = {"candidates": verdict["candidates"], "secondary": verdict["secondary"], "runner_up": LABELS[second],
           "margin_db": margin, "decided_by": verdict["decided_by"], "reason": verdict["reason"],
           "band": {"low_hz": None if res["band"] is None else float(res["band"][0]),
                    "high_hz": None if res["band"] is None else float(res["band"][1]),
@@ -188,7 +189,8 @@ def _run(x, fs, *, bearing, rpm=None, shaft_hz=None, tolerance=0.02, n_harmonics
             "expected_hz": float(res["fault_hz"][k]),
             "measured_hz": None if ln["measured_hz"] is None else float(ln["measured_hz"] * scale),
             "snr_db": float(ln["snr_db"]), "harmonics": int(ln["harmonics"]),
-            "sidebands": int(ln["sidebands"]), "detected": bool(ln["detected"])}
+            "sidebands": int(ln["sidebands"]),
+            "detected": bool(ln["detected"] and ln.get("explained_by") is None)}
     result["evidence"] = _evidence(res, verdict, speed, fs, xa.size, geom, tolerance, n_harmonics, decided)
     result["evidence"]["reported_route"] = decided
     extras = {"f": routes[decided]["f"], "ses": routes[decided]["spectrum"], "band": res["band"],
@@ -221,17 +223,70 @@ def _unresolved(speed, geom, fs, n, m, tolerance, n_harmonics):
     readings = interpretations(comb, geom, BLIND_RANGE_HZ) if comb else []
     verdict = {"diagnosis": "uncertain", "verdict": "uncertain",
                "candidates": list(dict.fromkeys(r["diagnosis"] for r in readings)),
-               "decided_by": [], "reason": "shaft speed unresolved: " + speed["note"]}
+               "decided_by": [], "secondary": [], "reason": "shaft speed unresolved: " + speed["note"]}
     result = _result(fs, fr, verdict, None, m, speed)
     ff = geom.fault_frequencies(fr)
     for k in ("bpfo", "bpfi", "bsf", "ftf"):
         result["fault_frequencies"][k] = {"expected_hz": float(ff[k]), "measured_hz": None, "snr_db": 0.0,
                                           "harmonics": 0, "sidebands": 0, "detected": False}
-    result["evidence"] = {"candidates": verdict["candidates"], "runner_up": None, "margin_db": None,
+    result["evidence"] = {"candidates": verdict["candidates"], "secondary": [], "runner_up": None, "margin_db": None,
                           "decided_by": [], "reason": verdict["reason"], "band": None, "routes": {},
                           "flags": [], "interpretations": readings, "reported_route": None}
     extras = {"f": None, "ses": None, "band": None, "lines": None, "bearing": geom, "routes": {}, "route": None}
     return result, extras
+
+
+def shaft_speed(x, fs, *, bearing, rpm=None, rpm_source="given", tolerance=0.02, n_harmonics=5):
+    """Shaft speed of a vibration signal, checked against the bearing's kinematics.
+
+    The speed step of :func:`analyze` on its own: a given or stored ``rpm`` is a
+    prior refined by the signal's 1x line family; without one the signal alone
+    names a speed only when no fault comb of the bearing can explain that family.
+
+    Parameters
+    ----------
+    x : array_like, 1-D
+    fs : float
+        Sampling rate, Hz.
+    bearing : str or BearingGeometry
+    rpm : float, optional
+        Prior speed, r/min (None: blind).
+    rpm_source : {"given", "file"}
+        Where ``rpm`` comes from.
+    tolerance, n_harmonics
+        As in :func:`analyze`.
+
+    Returns
+    -------
+    dict
+        ``shaft_hz`` (the prior, the refined or the estimated value; None when a
+        blind search finds no 1x family at all), ``source`` ("given", "file",
+        "estimated", "unresolved"), ``status`` ("confirmed", "unconfirmed",
+        "contradicted", "resolved", "unresolved"), ``prior_hz``, ``harmonics`` and
+        ``snr_db`` of the 1x family, ``deviation_pct``, ``candidates``, ``note``.
+
+    Examples
+    --------
+    Outer-race impacts of a 6308 at 30 Hz and no shaft line at all: the impact comb
+    is not taken for the shaft.
+
+    >>> import numpy as np
+    >>> from bearing_lab.analysis import shaft_speed
+    >>> fs = 20000.0; t = np.arange(100000) / fs; bpfo = 3.0719 * 30.0
+    >>> x = np.exp(-1500 * (t % (1 / bpfo))) * np.sin(2 * np.pi * 3000 * t)
+    >>> x = x + np.random.default_rng(0).normal(0, 0.1, t.size)
+    >>> shaft_speed(x, fs, bearing="6308")["source"]
+    'unresolved'
+    >>> round(shaft_speed(x, fs, bearing="6308", rpm=1800)["shaft_hz"], 3)
+    30.0
+    """
+    fs = check_fs(fs, func="shaft_speed")
+    x = check_signal(x, func="shaft_speed", min_samples=1024)
+    if x.ndim != 1:
+        raise AnalysisError(f"shaft_speed: x must be one channel (1-D), got shape {x.shape}")
+    _, sp, _ = _speed(x, fs, _bearing(bearing), rpm=rpm, rpm_source=rpm_source, shaft_hz=None, tacho=None,
+                      pulses_per_rev=1, tolerance=tolerance, n_harmonics=n_harmonics, fallback=False)
+    return sp
 
 
 def analyze(x, fs, *, bearing, rpm=None, shaft_hz=None, channel="", units="m s-2", tolerance=0.02,
@@ -382,6 +437,12 @@ def plot_analysis(x, fs, *, bearing, rpm=None, shaft_hz=None, channel="", units=
 def _plot_envelope(ax3, ex, result, units):
     """Envelope spectrum of the reported route with expected and found fault lines."""
     route = ex["route"]
+    if route is None:
+        ax3.text(0.5, 0.5, "shaft speed unresolved: fault frequencies unknown, no family search\n"
+                 + result["evidence"]["reason"][:160], ha="center", va="center", wrap=True,
+                 transform=ax3.transAxes, fontsize=8)
+        ax3.set(title="envelope analysis not run", xticks=[], yticks=[])
+        return
     top = 1.05 * max(result["fault_frequencies"][k]["expected_hz"] * (2 if k == "bsf" else 1)
                      for k in ("bpfo", "bpfi", "bsf")) * 5
     keep = ex["f"] <= top
