@@ -125,7 +125,7 @@ class CyclicSpectrum:
     def masked(self, shaft_hz, cage_hz=None, skip_every=None):
         """A view of this spectrum with the harmonics of ``shaft_hz`` removed from the peaks.
 
-        ``cage_hz``: also remove the cage comb ``n FTF`` (within +-max(2 bins, 0.05 %)),
+        ``cage_hz``: also remove the cage comb ``n FTF`` (within +-max(1 bin, 0.05 %)),
         except every ``skip_every``-th harmonic (BPFO = Z FTF lies on the comb).
         """
         out = CyclicSpectrum(None, None, _base=self)
@@ -133,7 +133,7 @@ class CyclicSpectrum:
         mask = _shaft_mask(self.f, shaft_hz, self.df)
         if cage_hz:
             n = np.rint(self.f / cage_hz)
-            near = (n >= 1) & (np.abs(self.f - n * cage_hz) <= np.maximum(2 * self.df, 5e-4 * self.f))
+            near = (n >= 1) & (np.abs(self.f - n * cage_hz) <= np.maximum(self.df, 5e-4 * self.f))
             if skip_every:
                 near &= (n % skip_every) != 0
             mask = mask | near
@@ -360,8 +360,10 @@ def search_families(cs, fault_hz, *, shaft_hz, tolerance=0.02, n_harmonics=5, de
     dict
         :func:`family_evidence` per key (``bsf`` searched at 2 BSF).  When the
         cage (FTF) family is detected, its comb is masked for the other families
-        and their decoys (all but every Z-th line, where BPFO = Z FTF lies), and
-        the ball family's sidebands are searched at the measured cage rate.
+        and their decoys (all but every Z-th line, where BPFO = Z FTF lies), the
+        ball family's sidebands are searched at the measured cage rate, and a
+        BPFO family counts only where its lines stand above the comb's
+        neighbouring lines (else ``explained_by`` is "ftf").
     """
     cm = cs.masked(shaft_hz)
     if decoys and not shaft_hz:
@@ -382,7 +384,25 @@ def search_families(cs, fault_hz, *, shaft_hz, tolerance=0.02, n_harmonics=5, de
         carrier = 2 * fault_hz["bsf"] if key == "bsf" else fault_hz[key]
         out[key] = family_evidence(cm, carrier, modulator_hz=mods[key], tolerance=tolerance,
                                    n_harmonics=n_harmonics, decoy_hz=dec if decoys else None)
+    if out["ftf"]["detected"] and out["bpfo"]["detected"]:
+        _bpfo_above_cage(cs, out["bpfo"], cage, int(round(fault_hz["bpfo"] / fault_hz["ftf"])))
     return {k: out[k] for k in FAMILY_KEYS}
+
+
+def _bpfo_above_cage(cs, ev, cage, z):
+    """BPFO = Z FTF lies on the cage comb: its lines count only where they stand above the
+    comb's neighbouring lines ((Zk +- 1) FTF, (Zk +- 2) FTF); a cage comb alone puts lines at
+    Zk FTF no stronger than the others.  At least MIN_HARMONICS carriers must stand out."""
+    above = 0
+    for f, snr, k, m in ev["lines"]:
+        if m != 0:
+            continue
+        n = int(round(f / cage))
+        neigh = cs.best([(n + j) * cage for j in (-2, -1, 1, 2)], 1)[1]
+        above += snr > neigh.max()
+    if above < MIN_HARMONICS:
+        ev["detected"] = False
+        ev["explained_by"] = "ftf"
 
 
 def _pattern(f1, *, shaft_hz, ftf_hz, n_harmonics):
