@@ -13,10 +13,11 @@ against the competing families.
 
 One family (:func:`family_evidence`):
 
-- the carrier ``F`` is fitted inside the slip window ``expected (1 +- tol)`` by
+- the carrier ``F`` is chosen inside the slip window ``expected (1 +- tol)`` by
   the summed line SNR of its first ``n_harmonics`` harmonics (SNR over a running
   median; only local maxima of at least ``HARMONIC_SNR_DB`` count, each capped at
-  ``LINE_CAP_DB``), then refined by least squares on the harmonics found;
+  ``LINE_CAP_DB``); its value is the fundamental line's, interpolated by a
+  parabola through the log amplitudes;
 - harmonic ``k`` is searched within +-max(2, k/2 + 1) bins of ``k F``: a carrier
   measured to a quarter bin puts its k-th harmonic within k/4 bins, so the window
   grows with ``k`` but stays a few bins wide;
@@ -209,13 +210,9 @@ def _batch(cs, expected, modulator, tolerance, n_harmonics):
         j = np.where(step, nxt, j)
     f1 = 0.5 * (cand[np.arange(M), i] + cand[np.arange(M), j])
     has = top > 0
-    cidx, csnr = cs.best(f1[:, None] * k, hb)
-    found = cidx >= 0
-    fk = (cidx + _parabolic_offset(cs.spec, cidx)) * cs.df
-    wts = np.where(found, 10 ** (csnr / 20) * k ** 2, 0.0)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        f_ls = np.sum(wts * fk / k, axis=1) / np.sum(wts, axis=1)
-    f1 = np.where(has & found.any(axis=1), f_ls, f1)
+    # the carrier is its fundamental line, interpolated (parabola through log amplitudes)
+    i1, _ = cs.best(f1, 1)
+    f1 = np.where(has & (i1 >= 0), (i1 + _parabolic_offset(cs.spec, i1)) * cs.df, f1)
     cidx, csnr = cs.best(f1[:, None] * k, hb)
     cidx, csnr = np.where(has[:, None], cidx, -1), np.where(has[:, None], csnr, 0.0)
     orders = np.array([m for m in range(-SIDEBAND_ORDERS, SIDEBAND_ORDERS + 1) if m])
@@ -361,9 +358,10 @@ def search_families(cs, fault_hz, *, shaft_hz, tolerance=0.02, n_harmonics=5, de
         :func:`family_evidence` per key (``bsf`` searched at 2 BSF).  When the
         cage (FTF) family is detected, its comb is masked for the other families
         and their decoys (all but every Z-th line, where BPFO = Z FTF lies), the
-        ball family's sidebands are searched at the measured cage rate, and a
-        BPFO family counts only where its lines stand above the comb's
-        neighbouring lines (else ``explained_by`` is "ftf").
+        ball family's sidebands are searched at the measured cage rate, a BPFO
+        family counts only where its lines stand above the comb's neighbouring
+        lines, and a 2 BSF carrier lying on a cage harmonic (within max(2, n/10)
+        bins of n FTF) is the comb's (both then get ``explained_by`` "ftf").
     """
     cm = cs.masked(shaft_hz)
     if decoys and not shaft_hz:
@@ -386,6 +384,12 @@ def search_families(cs, fault_hz, *, shaft_hz, tolerance=0.02, n_harmonics=5, de
                                    n_harmonics=n_harmonics, decoy_hz=dec if decoys else None)
     if out["ftf"]["detected"] and out["bpfo"]["detected"]:
         _bpfo_above_cage(cs, out["bpfo"], cage, int(round(fault_hz["bpfo"] / fault_hz["ftf"])))
+    if out["ftf"]["detected"] and out["bsf"]["measured_hz"]:
+        # a 2 BSF carrier on a cage harmonic (ZA-2115: 2 BSF = 18.94 FTF) is the comb's line
+        n = round(out["bsf"]["measured_hz"] / cage)
+        if abs(out["bsf"]["measured_hz"] - n * cage) <= max(2.0, 0.1 * n) * cs.df:
+            out["bsf"]["detected"] = False
+            out["bsf"]["explained_by"] = "ftf"
     return {k: out[k] for k in FAMILY_KEYS}
 
 
