@@ -17,7 +17,8 @@ What it runs (one fixed method, no per-file settings):
   (``time.process_time``, best of ``--repeat``, one thread).
 
 Run: ``.venv/bin/python benchmarks/diagnosis_eval.py [--mirror DIR] [--quick] [--out FILE]``
-(``--quick`` skips the simulations).  Prints Markdown.
+(``--quick`` skips the simulations).  Prints Markdown; exits with 1 when a recording gets a
+confident wrong label.
 """
 from __future__ import annotations
 
@@ -265,7 +266,8 @@ def main(argv=None):
     print(text)
     if args.out:
         Path(args.out).write_text(text, encoding="utf-8")
-    wrong = sum(_wrong(r[m], r["truth"]) for r in rec + sims for m in ("stored", "blind"))
+    # the hard goal is on recordings; the simulations' table says what it says
+    wrong = sum(_wrong(r[m], r["truth"]) for r in rec for m in ("stored", "blind"))
     return 1 if wrong else 0
 
 

@@ -9,8 +9,11 @@ shaft:
 
 1. **1x family.**  A shaft candidate needs at least ``MIN_SHAFT_LINES`` clear
    harmonics (10 dB over the local floor, mains lines masked) in the amplitude
-   spectrum, and they must not all be multiples of one integer ``d >= 2``
-   (that is a comb at ``d f0``, of which ``f0`` is a sub-multiple).
+   spectrum; they must not all be multiples of one integer ``d >= 2`` (that is
+   a comb at ``d f0``, of which ``f0`` is a sub-multiple); and a family that
+   rich must be unlikely by chance (``CHANCE_MAX``): binomial odds from the
+   density of clear lines, times the number of candidates a blind search tries.
+   A sub-harmonic ``f0/2`` or ``f0/3`` with odd lines of its own is preferred.
 2. **With a prior** (a given or stored speed): the best such family within
    +-5 % of the prior refines it (interpolated DFT lines, weighted least
    squares, as in :func:`shaft_frequency`); without one the prior is used as
@@ -19,19 +22,21 @@ shaft:
    blind search below runs too, and a speed it resolves outside the window
    marks the prior "contradicted".
 3. **Blind** (no prior): the candidate family ``f0`` could also be the comb of
-   a fault frequency ``F_j = r_j f_s`` of another shaft speed ``f_s = f0 / r_j``
-   (r_j: BPFO, BPFI, 2 BSF, FTF ratios, within the slip tolerance).  Then:
+   a fault frequency of another shaft speed, ``f0 = r_j f_s`` (r_j: BPFO, BPFI,
+   2 BSF or FTF ratio, or their halves and thirds, within the slip tolerance),
+   and such a speed always lies in the search range.  So the signal names a speed
+   only with positive evidence:
 
-   - if ``f_s`` has a 1x family of its own (rule 1, lines that are not
-     harmonics of ``f0``), ``f_s`` is the shaft and ``f0`` its fault comb;
-   - else if a fault family of the bearing is detected in the squared envelope
-     spectrum at the frequencies ``f0`` implies (with the decoy test of
-     :mod:`._families`), ``f0`` is confirmed by the kinematics;
-   - else if the ``f0`` comb is itself an impulsive envelope family (a line
-     family in the pre-whitened squared envelope spectrum), or ``f_s`` shows
-     some shaft lines, the speed is **unresolved**: the evidence cannot tell
-     a shaft from a fault;
-   - else ``f0`` is taken (a plain 1x family that nothing else explains).
+   - if some ``f_s`` has a 1x family of its own (rule 1, lines that are not
+     harmonics of ``f0``), ``f_s`` is the shaft and ``f0`` its fault comb, and
+     ``f_s`` is judged the same way;
+   - if a fault family of the bearing is detected at the frequencies ``f0``
+     implies (noise rule and decoys, :mod:`._families`) in the squared envelope
+     spectrum of the pre-whitened signal or of the kurtogram band the diagnosis
+     would use at ``f0``, the kinematics confirm ``f0``;
+   - otherwise the speed is **unresolved**: a shaft and a fault comb would look
+     the same.  A healthy machine without a speed thus stays unresolved; without
+     a fault family there is nothing to name anyway.
 """
 from __future__ import annotations
 
@@ -40,8 +45,7 @@ from scipy import fft as _fft
 from scipy.stats import binom
 
 from ..errors import AnalysisError
-from ._families import CyclicSpectrum, family_evidence, search_families
-from ._spectral import fast_kurtogram, squared_envelope_spectrum
+from ._families import search_families
 from ._speed import LINE_SNR_DB, SNR_CAP_DB, interpolated_peak, line_floor_db
 
 __all__ = ["RawLines", "resolve_speed", "MIN_SHAFT_LINES", "PRIOR_TOLERANCE", "BLIND_RANGE_HZ"]
@@ -293,67 +297,31 @@ def _alternatives(raw, fam, factors, lo, hi, tolerance):
 
 
 def _corroborated(cs, geometry, f0, tolerance):
-    """A fault family detected (noise rule and decoys) at the frequencies f0 implies."""
-    if callable(cs):
-        cs = cs()
-    if cs is None:
-        return None
-    try:
-        fams = search_families(cs, geometry.fault_frequencies(f0), shaft_hz=f0, tolerance=tolerance)
-    except AnalysisError:
-        return None
-    hits = [k for k in ("bpfo", "bpfi", "bsf") if fams[k]["detected"]]
-    return max(hits, key=lambda k: fams[k]["evidence_db"]) if hits else None
+    """The strongest fault family detected (noise rule and decoys) at the frequencies f0
+    implies, in any of the spectra ``cs`` gives for f0 (the pre-whitened squared envelope
+    spectrum, and that of the kurtogram band the diagnosis at f0 would use); None if none."""
+    hits = {}
+    for spec in (cs(f0) if callable(cs) else [cs]):
+        if spec is None:
+            continue
+        try:
+            fams = search_families(spec, geometry.fault_frequencies(f0), shaft_hz=f0, tolerance=tolerance)
+        except AnalysisError:
+            continue
+        for k in ("bpfo", "bpfi", "bsf"):
+            if fams[k]["detected"]:
+                hits[k] = max(hits.get(k, 0.0), fams[k]["evidence_db"])
+    return max(hits, key=hits.get) if hits else None
 
 
-class ImpulseCheck:
-    """Is a line comb possibly an impact rate?  It is when its harmonics are discrete
-    lines far up the spectrum (:func:`discrete_comb`), or when its lines form a family
-    (noise rule) in the squared envelope spectrum of the most impulsive band the
-    diagnosis at this speed would demodulate (fast kurtogram, bands at least
-    ``top_factor * f0`` wide), or in that of the pre-whitened signal.  Spectral kurtosis is not required: impacts
-    buried in noise keep every band's kurtosis near 0 while their envelope lines stand
-    out (see :func:`envelope_band`)."""
-
-    def __init__(self, x, fs, top_factor, cs=None):
-        self.x, self.fs, self.top_factor, self.cs, self._cache = x, fs, top_factor, cs, {}
-
-    def band(self, min_bandwidth):
-        nb = int(2 ** np.floor(np.log2(max(1.0, self.fs / 2 / min_bandwidth))))
-        if nb not in self._cache:
-            try:
-                self._cache[nb] = fast_kurtogram(self.x, self.fs, min_bandwidth=self.fs / 2 / nb).band
-            except AnalysisError:
-                self._cache[nb] = None
-        return self._cache[nb]
-
-    def __call__(self, f0):
-        if discrete_comb(self.x, self.fs, f0)[0]:
-            return True  # a comb of discrete lines far up the spectrum: an impact train's signature
-        spectra = []
-        band = self.band(self.top_factor * f0)
-        if band is not None:
-            spectra.append(lambda: CyclicSpectrum(*squared_envelope_spectrum(
-                self.x, self.fs, window="hann", band=band, fmax=6 * f0 + 20)))
-        if self.cs is not None:
-            spectra.append(self.cs if callable(self.cs) else (lambda: self.cs))
-        for make in spectra:
-            try:
-                if family_evidence(make(), f0, tolerance=0.005, n_harmonics=5)["passes_noise_rule"]:
-                    return True
-            except AnalysisError:
-                continue
-        return False
-
-
-def _judge(raw, cs, impulsive, geometry, fam, lo, hi, tolerance, depth=0):
+def _judge(raw, cs, geometry, fam, lo, hi, tolerance, depth=0):
     """Resolve or refuse one candidate 1x family (module docstring, rule 3)."""
     f0 = fam["shaft_hz"]
     factors = geometry.frequency_factors()
     alts = _alternatives(raw, fam, factors, lo, hi, tolerance)
     if alts and depth == 0:
         name, alt = max(alts, key=lambda a: len(a[1]["harmonics"]))
-        res = _judge(raw, cs, impulsive, geometry, alt, lo, hi, tolerance, depth=1)
+        res = _judge(raw, cs, geometry, alt, lo, hi, tolerance, depth=1)
         note = (f"the {f0:.3f} Hz line family is the {name} comb of a {alt['shaft_hz']:.3f} Hz shaft "
                 f"({len(alt['harmonics'])} shaft harmonics of its own)")
         res["candidates"].append(_summary(fam, f"{name} comb, not the shaft"))
@@ -365,23 +333,14 @@ def _judge(raw, cs, impulsive, geometry, fam, lo, hi, tolerance, depth=0):
         return {"resolved": True, "family": fam, "candidates": cands,
                 "note": f"{len(fam['harmonics'])} shaft harmonics; the {fault.upper()} family at this speed "
                         "is detected in the envelope spectrum"}
-    if alts:
-        return {"resolved": False, "family": fam, "candidates": [_summary(fam, "1x line family")] + cands,
-                "note": f"the {f0:.3f} Hz line family could be the {alts[0][0]} comb of a "
-                        f"{alts[0][1]['shaft_hz']:.3f} Hz shaft, which has a 1x family too"}
-    if impulsive(f0):
-        alt_txt = ", ".join(f"{n} of a {f0 / (factors[k] * m):.2f} Hz shaft" for n, k, m in FAULT_RATIOS
-                            if lo <= f0 / (factors[k] * m) <= hi)
-        return {"resolved": False, "family": fam, "candidates": [_summary(fam, "1x line family, impulsive")],
-                "note": f"the {f0:.3f} Hz line family is also a line family of the envelope spectrum (an "
-                        f"impact rate or a modulation), and no fault family confirms it as the shaft: it "
-                        f"could be {alt_txt or 'a fault comb'}"}
-    return {"resolved": True, "family": fam, "candidates": cands,
-            "note": f"{len(fam['harmonics'])} shaft harmonics; no envelope family and no fault comb of "
-                    "another speed explains them"}
+    readings = ", ".join(f"{n} of a {f0 / (factors[k] * m):.2f} Hz shaft" for n, k, m in FAULT_RATIOS
+                         if lo <= f0 / (factors[k] * m) <= hi)
+    return {"resolved": False, "family": fam, "candidates": [_summary(fam, "1x line family")] + cands,
+            "note": f"no fault family at the frequencies {f0:.3f} Hz implies confirms it as the shaft, and "
+                    f"its line family could be a fault comb: {readings or 'of another speed'}"}
 
 
-def _blind(raw, cs, impulsive, geometry, tolerance, lo, hi):
+def _blind(raw, cs, geometry, tolerance, lo, hi):
     tried = []
     for f0 in raw.candidates(lo, hi, count=6):
         fam = raw.family(raw.octave(f0, lo, hi), hi)
@@ -389,7 +348,7 @@ def _blind(raw, cs, impulsive, geometry, tolerance, lo, hi):
         if not ok:
             tried.append(_summary(fam, why))
             continue
-        res = _judge(raw, cs, impulsive, geometry, fam, lo, hi, tolerance)
+        res = _judge(raw, cs, geometry, fam, lo, hi, tolerance)
         res["candidates"] = res["candidates"] + tried
         return res
     return {"resolved": False, "family": None, "candidates": tried,
@@ -411,10 +370,10 @@ def resolve_speed(x, fs, geometry, *, rpm=None, rpm_source="given", cs=None, tol
     rpm_source : {"given", "file"}
         Where the prior comes from (copied to ``source``).
     cs : CyclicSpectrum or callable, optional
-        Pre-whitened squared envelope spectrum reaching the fault lines of the
-        fastest candidate (or a function returning it, called only when a blind
-        search needs it), for the kinematic confirmation of a blind candidate;
-        without it no candidate is confirmed that way.
+        Cyclic spectrum reaching the fault lines of the fastest candidate, or a
+        function of a candidate speed returning a list of spectra (called only when
+        a blind search needs them), for the kinematic confirmation of a blind
+        candidate; without it no candidate is confirmed that way.
     tolerance : float
         Slip tolerance of fault frequencies.
     blind_range_hz : (float, float)
@@ -439,13 +398,11 @@ def resolve_speed(x, fs, geometry, *, rpm=None, rpm_source="given", cs=None, tol
         msg = (f"the record lasts {x.size / fs:.3g} s: its 1/T = {raw.df:.3g} Hz bins cannot resolve shaft "
                f"lines at {lowest:.3g} Hz (record at least {4 / lowest:.3g} s, or give the speed)")
         raise AnalysisError(msg)
-    fac = geometry.frequency_factors()
-    impulsive = ImpulseCheck(x, fs, 5 * max(fac["bpfo"], fac["bpfi"], 2 * fac["bsf"]) * (1 + tolerance) + 1, cs)
     out = {"shaft_hz": prior, "source": rpm_source if prior else "unresolved", "status": None,
            "prior_hz": prior, "harmonics": 0, "snr_db": 0.0, "deviation_pct": None, "candidates": [],
            "note": ""}
     if prior is None:
-        res = _blind(raw, cs, impulsive, geometry, tolerance, lo_b, hi_b)
+        res = _blind(raw, cs, geometry, tolerance, lo_b, hi_b)
         fam = res["family"]
         out.update(candidates=res["candidates"], note=res["note"])
         if fam is not None:
@@ -466,7 +423,7 @@ def resolve_speed(x, fs, geometry, *, rpm=None, rpm_source="given", cs=None, tol
                             f"{rpm_source} speed refine it")
             return out
         out["candidates"].append(_summary(fam, why or "outside the window"))
-    blind = _blind(raw, cs, impulsive, geometry, tolerance, lo_b, hi_b)
+    blind = _blind(raw, cs, geometry, tolerance, lo_b, hi_b)
     f_b = blind["family"]["shaft_hz"] if blind["family"] else None
     if blind["resolved"] and not lo <= f_b <= hi:
         out.update(status="contradicted", deviation_pct=100 * (f_b / prior - 1),

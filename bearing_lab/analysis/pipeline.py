@@ -44,7 +44,7 @@ from ._families import LABELS, CyclicSpectrum
 from ._impulse import excitation_period
 from ._metrics import METRIC_NAMES, metrics
 from ._shaft import BLIND_RANGE_HZ, resolve_speed
-from ._spectral import amplitude_spectrum, cepstral_prewhitening, squared_envelope_spectrum
+from ._spectral import amplitude_spectrum, cepstral_prewhitening, fast_kurtogram, squared_envelope_spectrum
 from ._speed import shaft_frequency
 from ._tacho import ORDER_TRACK_VARIATION, order_track, tacho_pulses, tacho_speed
 from ._util import check_fs, check_signal
@@ -109,15 +109,27 @@ def _speed(x, fs, geom, *, rpm, rpm_source, shaft_hz, tacho, pulses_per_rev, tol
     xw = cepstral_prewhitening(x)
     cache = {}
 
-    def cpw_spectrum():
-        # reaches the decoys of the fastest blind candidate
-        if "cs" not in cache:
+    def spectra(f0):
+        """Pre-whitened SES (once, reaching the fastest blind candidate's decoys) and the SES of
+        the kurtogram band the diagnosis would demodulate at f0 (cached by band width)."""
+        ff = geom.fault_frequencies(f0)
+        if "cpw" not in cache:
             fmax = min(0.49 * fs, spectrum_top(geom.fault_frequencies(BLIND_RANGE_HZ[1]), BLIND_RANGE_HZ[1],
                                                tolerance=tolerance, n_harmonics=n_harmonics))
-            cache["cs"] = CyclicSpectrum(*squared_envelope_spectrum(xw, fs, window="hann", fmax=fmax))
-        return cache["cs"]
+            cache["cpw"] = CyclicSpectrum(*squared_envelope_spectrum(xw, fs, window="hann", fmax=fmax))
+        line_top = n_harmonics * max(ff["bpfi"], 2 * ff["bsf"], ff["bpfo"]) * (1 + tolerance) + f0
+        nb = int(2 ** np.floor(np.log2(max(1.0, fs / 2 / line_top))))
+        if nb not in cache:
+            try:
+                band = fast_kurtogram(x, fs, min_bandwidth=fs / 2 / nb).band
+                top = min(0.49 * fs, spectrum_top(geom.fault_frequencies(BLIND_RANGE_HZ[1]), BLIND_RANGE_HZ[1],
+                                                  tolerance=tolerance, n_harmonics=n_harmonics))
+                cache[nb] = CyclicSpectrum(*squared_envelope_spectrum(x, fs, window="hann", band=band, fmax=top))
+            except AnalysisError:
+                cache[nb] = None
+        return [cache["cpw"], cache[nb]]
 
-    sp = resolve_speed(x, fs, geom, rpm=rpm, rpm_source=rpm_source, cs=cpw_spectrum, tolerance=tolerance)
+    sp = resolve_speed(x, fs, geom, rpm=rpm, rpm_source=rpm_source, cs=spectra, tolerance=tolerance)
     if sp["shaft_hz"] is None and fallback:
         # nothing to go by: the strongest harmonic family, for the fault-frequency table only
         sp["shaft_hz"] = float(shaft_frequency(x, fs, window="boxcar")[0])
