@@ -151,7 +151,7 @@ def _period(routes, decided, key, x, xw, fs, band):
     return float(period)
 
 
-def _evidence(res, verdict, speed, fs, n, geom, tolerance, n_harmonics, decided):
+def _evidence(res, verdict, speed, fs, n, tolerance, n_harmonics, decided):
     routes = res["routes"]
     lead, second, margin = runner_up(routes[decided])
     ff = res["fault_hz"]
@@ -203,7 +203,7 @@ def _run(x, fs, *, bearing, rpm=None, shaft_hz=None, tolerance=0.02, n_harmonics
             "snr_db": float(ln["snr_db"]), "harmonics": int(ln["harmonics"]),
             "sidebands": int(ln["sidebands"]),
             "detected": bool(ln["detected"] and ln.get("explained_by") is None)}
-    result["evidence"] = _evidence(res, verdict, speed, fs, xa.size, geom, tolerance, n_harmonics, decided)
+    result["evidence"] = _evidence(res, verdict, speed, fs, xa.size, tolerance, n_harmonics, decided)
     result["evidence"]["reported_route"] = decided
     extras = {"f": routes[decided]["f"], "ses": routes[decided]["spectrum"], "band": res["band"],
               "lines": fams, "bearing": geom, "routes": routes, "route": decided}
