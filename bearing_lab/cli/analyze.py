@@ -184,8 +184,7 @@ def _print(result, path, name, fs, bearing, units, tacho_name, note, plot):
     ev = result["evidence"]
     print(f"{path.name} [{name}]  fs {fs:g} Hz  bearing {bearing}" + (f"  ({note})" if note else ""))
     if result["speed_source"] == "unresolved":
-        print(f"shaft speed unresolved (speed_source unresolved; fault frequencies below at the strongest "
-              f"line family, {result['shaft_hz']:.3f} Hz): {sp['note']}")
+        print(f"shaft speed unresolved (speed_source unresolved): {sp['note']}")
     else:
         print(f"shaft {result['shaft_hz']:.3f} Hz ({60 * result['shaft_hz']:.1f} r/min), speed_source "
               f"{result['speed_source']}" + (f" (tacho channel {tacho_name})" if tacho_name else "")
