@@ -61,6 +61,7 @@ import uuid
 import numpy as np
 
 from . import __version__
+from .schema import DEFAULT_CHANNEL
 from .errors import BearingLabError, SceneError
 
 __all__ = ["sweep", "scene_hash", "code_fingerprint", "default_cache_dir", "dim_name", "key_units"]
@@ -75,7 +76,7 @@ _UNIT_STRINGS = {
 _SIM_KW = {"duration": "output.duration_s", "fs": "output.sample_rate_hz", "rtol": "solver.rtol",
            "method": "solver.method", "step": "solver.step_s", "fidelity": "fidelity"}
 _METRICS = ("rms", "peak", "crest_factor", "kurtosis")
-_METRIC_SIGNAL = "outer_ring_acc_y"
+_METRIC_SIGNAL = DEFAULT_CHANNEL  # the simulator's accelerometer signal
 
 
 # ---------------------------------------------------------------- helpers

@@ -27,7 +27,6 @@ class BearingLabBackendEntrypoint(BackendEntrypoint):
     """Read a rig recording with bearing_lab's readers (see :func:`bearing_lab.io.open_recording`)."""
 
     description = "Rolling-bearing rig recordings (UFF 58/58b, Testlab MAT/text, CWRU, IMS, MFPT, TDMS, MDF4, WAV)"
-    url = "https://github.com/bearing-lab/bearing_lab"
     open_dataset_parameters = ("filename_or_obj", "drop_variables", "format", "channels", "fs",
                                "sensitivity", "units")
 
