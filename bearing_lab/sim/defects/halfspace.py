@@ -322,17 +322,24 @@ def ratio_curve(defect: Defect, geom: RaceGeometry, delta: float, *, cells=TABLE
     solved: dict[int, tuple[float, np.ndarray]] = {}
     stats = {"solves": 0, "iterations": 0}
 
+    same: dict[bytes, list] = {}     # positions whose cells see the same outline: one solve
+
     def solve_round(ks, starts):
         todo, gaps, p0 = [], [], []
         for k, start in zip(ks, starts):
-            ins = defect.contains(S + k * dy, Z)
-            if not np.any(ins & touch):
+            ins = defect.contains(S + k * dy, Z) & touch
+            if not np.any(ins):
                 solved[k] = (1.0, p_int)
                 continue
             gap = np.where(ins, gf, g0)
             if np.all(gap >= delta):
                 solved[k] = (0.0, np.zeros_like(p_int))
                 continue
+            key = np.packbits(ins).tobytes()
+            if key in same:
+                same[key].append(k)
+                continue
+            same[key] = [k]
             todo.append(k)
             gaps.append(gap)
             p0.append(start)
@@ -342,6 +349,9 @@ def ratio_curve(defect: Defect, geom: RaceGeometry, delta: float, *, cells=TABLE
             stats["iterations"] += int(its.sum())
             for k, pk in zip(todo, p):
                 solved[k] = (float(pk.sum()) / f_int, pk)
+        for group in same.values():
+            for k in group[1:]:
+                solved[k] = solved[group[0]]
 
     coarse = list(range(k_lo, k_hi + 1, coarse_step))
     if coarse[-1] != k_hi:
