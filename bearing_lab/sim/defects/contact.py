@@ -32,7 +32,8 @@ Models
     at the same approach: ``G = share * delta^1.5``.  Solved at ``HALFSPACE_NODES``
     approaches (fractions of ``delta_max``) for ball positions a whole number of cells
     apart (refined where the share curves), interpolated linearly onto the table's psi;
-    between approaches ``G^(2/3)`` is interpolated linearly through (0, 0) and (drop, 0).
+    between approaches ``G^(2/3)`` is interpolated by a monotone cubic through (0, 0) and
+    (drop, 0).
     For rectangles with sides along and across the track the cell sizes put the sides on
     cell boundaries, and two grids (``TABLE_CELLS`` and half as many cells) are
     extrapolated to zero cell size (Richardson; the error is first order in the cell
@@ -496,20 +497,27 @@ def _halfspace_G(defect, geom, s_tab, delta, drop, *, e_star, misses, settings=N
         forces.append(inf_f["intact_force_n"])
         axes.append(inf_f["semi_axes_m"])
     r = np.column_stack(ratios)
-    # G^(2/3) linear in delta between the nodes, through (0, 0) and (drop, 0): exact for
-    # delta^1.5 scaling and for a rigid drop
+    # G^(2/3) between the nodes by a monotone cubic (Fritsch-Carlson, scipy's PCHIP)
+    # through (0, 0) and (drop, 0): exact for delta^1.5 scaling and for a rigid drop, and
+    # the share curves' bends between nodes cost a quarter of what straight lines did
+    from scipy.interpolate import PchipInterpolator
     g23 = (r ** (2 / 3)) * nodes_d[None, :]
+    xd = np.concatenate([[0.0], nodes_d])
+    # rows the ball's rigid drop does not touch share one set of nodes: one interpolant
+    plain = drop <= 0
     G = np.empty((n_psi, n_delta))
-    for j in range(n_psi):
-        xd = np.concatenate([[0.0], nodes_d])
-        yd = np.concatenate([[0.0], g23[j]])
-        if 0 < drop[j] < delta[-1]:
-            keep = xd > drop[j]
-            xd = np.concatenate([[0.0, drop[j]], xd[keep]])
-            yd = np.concatenate([[0.0, 0.0], yd[keep]])
-        elif drop[j] >= delta[-1]:
-            xd, yd = np.array([0.0, delta[-1]]), np.array([0.0, 0.0])
-        G[j] = np.interp(delta, xd, yd) ** 1.5
+    if np.any(plain):
+        yd = np.column_stack([np.zeros(int(plain.sum())), g23[plain]])
+        G[plain] = np.maximum(PchipInterpolator(xd, yd, axis=1)(delta), 0.0) ** 1.5
+    for j in np.flatnonzero(~plain):
+        if drop[j] >= delta[-1]:
+            G[j] = 0.0
+            continue
+        keep = xd > drop[j]
+        xj = np.concatenate([[0.0, drop[j]], xd[keep]])
+        yj = np.concatenate([[0.0, 0.0], g23[j, keep[1:]]])
+        G[j] = (np.maximum(PchipInterpolator(xj, yj)(delta), 0.0) ** 1.5 if xj.size >= 3
+                else np.interp(delta, xj, yj) ** 1.5)
     far = np.all(r == 1.0, axis=1)
     G[far] = delta[None, :] ** 1.5
     info.update({"halfspace_ratio": r, "halfspace_intact_force_n": np.array(forces),
