@@ -23,19 +23,21 @@ carries the floor's gap (the intact gap plus the depth), so a deep pit never tou
 
 The grid is ball-centred and covers the rigid interpenetration region ``{h < delta}``
 (the elastic contact lies inside it, with or without a defect: surface displacements
-are >= 0) with ``cells`` cells.  For a rectangle whose sides run along and across the
-track the cell sizes are adjusted so the sides fall on cell boundaries (no staircase);
-other outlines are resolved by their cells' centres.  Ball positions are whole numbers
-of cells along the track (so the outline moves by whole cells), first every few cells,
-then halved where linear interpolation misses the solved midpoint by more than
-``refine_tol``; each solve starts from its neighbour's pressure.
+are >= 0) with ``TABLE_CELLS`` cells.  For a rectangle whose sides run along and across
+the track the cell sizes are adjusted so the sides fall on cell boundaries (no
+staircase); other outlines are resolved by their cells' centres.  Ball positions are
+whole numbers of cells along the track (so the outline moves by whole cells), first
+every ``COARSE_STEP`` cells, then halved where linear interpolation misses the solved
+midpoint by more than ``REFINE_TOL``; positions whose cells see the same part of the
+outline are solved once; each round is one batch warm-started from its neighbours.
 
-Accuracy and cost (6308 outer race, E* = 114 GPa; ``benchmarks/defect_tables.py``):
-the intact force at 48 x 36 cells is within 0.2 % of Hertz (K_o delta^1.5) and the
-contact semi-axes from the pressure's second moments within 1 %; the share of the
-intact force carried over a centred 1 x 1 mm defect converges to first order in the
-cell size (the pressure is singular at the pit's edge); the figures and the error of
-the default grid are in ``docs/contact-model.md``.
+Accuracy and cost (6308 outer race; ``benchmarks/defect_tables.py``): on the tables'
+grids the intact force is within 0.4 % of Hertz (K_o delta^1.5) and the contact
+semi-axes from the pressure's second moments within 0.7 % up to 8.4 µm (800 N); the
+share of the intact force carried over a centred 1 x 1 mm defect converges to first
+order in the cell size (the pressure is singular at the pit's edge), which the
+two-grid extrapolation of :mod:`.contact` removes.  One approach costs about 30 ms of
+CPU; figures in ``docs/contact-model.md``.
 
 What is neglected: the pit is a pressure-free region of the half-space surface; the
 compliance the removed material would add (a flank next to a pit is the edge of a
