@@ -21,9 +21,30 @@ from contextlib import contextmanager
 import hashlib
 import os
 from pathlib import Path
+import stat
 import tempfile
+import threading
 
 __all__ = ["atomic_path", "atomic_open", "sha256_file", "sha256_bytes", "cache_dir"]
+
+
+_UMASK_LOCK = threading.Lock()
+
+
+def _new_file_mode(path: Path) -> int:
+    """The mode a plain ``open(path, "w")`` would give: the old file's, else 0o666 & ~umask.
+
+    (``mkstemp`` creates 0o600 files; a result file must not become private by being
+    written atomically.)
+    """
+    try:
+        return stat.S_IMODE(os.stat(path).st_mode)
+    except OSError:
+        pass
+    with _UMASK_LOCK:
+        mask = os.umask(0o022)
+        os.umask(mask)
+    return 0o666 & ~mask
 
 
 def _fsync_dir(directory: Path) -> None:
@@ -61,6 +82,10 @@ def atomic_path(path, *, suffix: str | None = None):
     directory = path.parent if str(path.parent) else Path(".")
     fd, tmp_name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix or path.suffix or ".tmp",
                                     dir=directory)
+    try:
+        os.fchmod(fd, _new_file_mode(path))
+    except (OSError, AttributeError):  # no fchmod (Windows): keep mkstemp's mode
+        pass
     os.close(fd)
     tmp = Path(tmp_name)
     try:

@@ -67,3 +67,19 @@ def test_sha256_and_cache_dir(tmp_path, monkeypatch):
     monkeypatch.setenv("BEARING_LAB_CACHE", str(tmp_path / "c"))
     d = cache_dir("tables")
     assert d == tmp_path / "c" / "tables" and d.is_dir() and os.access(d, os.W_OK)
+
+
+def test_atomic_write_keeps_the_usual_file_mode(tmp_path):
+    """A new file gets 0o666 & ~umask like open(); a replaced file keeps its mode."""
+    mask = os.umask(0o022)
+    os.umask(mask)
+    new = tmp_path / "new.txt"
+    with atomic_open(new) as fh:
+        fh.write("x")
+    assert (new.stat().st_mode & 0o777) == 0o666 & ~mask
+    old = tmp_path / "old.txt"
+    old.write_text("a")
+    old.chmod(0o640)
+    with atomic_open(old) as fh:
+        fh.write("b")
+    assert (old.stat().st_mode & 0o777) == 0o640
