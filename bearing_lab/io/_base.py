@@ -14,6 +14,12 @@ dropped sets, truncated data kept on request) are issued with
 global attribute ``warnings`` as one string, the messages joined by ``"; "``
 (empty string when there are none).  :func:`get_warnings` splits it again.
 
+Shortfalls are never silent: when a file declares more samples than it holds
+(a header's point count, a segment's size, a fixed row count), the reader calls
+:meth:`RecordingBuilder.shortfall`, which refuses the file unless the user opted
+in (``allow_truncated=True``); then the recording says so in ``warnings`` and in
+the attributes ``truncated = 1`` and ``declared_samples`` (what the file promised).
+
 Channel naming rule (all readers):
 
 1. a channel is named after the file's own channel identity (UFF: response
@@ -203,6 +209,21 @@ class RecordingBuilder:
         msg = str(msg).replace("; ", ", ")
         self.warnings.append(msg)
         warnings.warn(f"{self.path.name}: {msg}", RecordingWarning, stacklevel=4)
+
+    def shortfall(self, what: str, declared: int, present: int, allow: bool, *,
+                  unit: str = "points", declares: str = "the file declares"):
+        """A file holds fewer samples than it declares: refuse, or keep them when allowed.
+
+        ``what`` names the part of the file (``"set 2 ('acc')"``); with ``allow`` the
+        recording keeps ``present`` samples, warns and records ``declared_samples``.
+        """
+        what = f"{what}: {declares} {declared} {unit}, {present} present"
+        if not allow:
+            self.fail(f"{what}: truncated file; pass allow_truncated=True (CLI --allow-truncated) "
+                      f"to keep the {present} {unit}")
+        self.warn(f"{what}: truncated, kept the {present} {unit} present")
+        self.attrs["truncated"] = 1
+        self.attrs["declared_samples"] = max(int(self.attrs.get("declared_samples", 0)), int(declared))
 
     # -- channels -------------------------------------------------------------------
     def unique_name(self, name: str) -> str:
