@@ -17,6 +17,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..errors import RecordingError
+
 HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 
 
@@ -29,15 +31,39 @@ def mat_version(head: bytes) -> str | None:
     return "5"
 
 
+def _h5_names(path: str) -> tuple[str, ...]:
+    """Variable names of a v7.3 file (runs in the guarded child)."""
+    import h5py
+    try:
+        with h5py.File(path, "r") as f:
+            return tuple(k for k in f.keys() if not k.startswith("#"))
+    except _ERRORS as exc:
+        raise _corrupt(path, exc) from None
+
+
+def _h5_load(path: str, variable_names) -> dict:
+    """Variables of a v7.3 file as plain Python (runs in the guarded child)."""
+    import h5py
+    out = {}
+    try:
+        with h5py.File(path, "r") as f:
+            for k in f.keys():
+                if k.startswith("#") or (variable_names and k not in variable_names):
+                    continue
+                out[k] = _h5_plain(f, f[k])
+    except (*_ERRORS, RecursionError) as exc:
+        raise _corrupt(path, exc) from None
+    return out
+
+
 @functools.lru_cache(maxsize=64)
-def _variables(path: str, mtime: int, size: int) -> tuple[str, ...]:
+def _variables(path: str, mtime: int, size: int, inode: int) -> tuple[str, ...]:
     with open(path, "rb") as fh:
         head = fh.read(1024)
     v = mat_version(head)
-    if v == "7.3":
-        import h5py
-        with h5py.File(path, "r") as f:
-            return tuple(k for k in f.keys() if not k.startswith("#"))
+    if v == "7.3":  # libhdf5 reads the file in a child process: damage cannot crash us
+        from ._guard import guarded
+        return guarded(path, "HDF5", _h5_names, path)
     if v == "5":
         from . import _mat5
         return tuple(_mat5.variable_names(Path(path).read_bytes()))
@@ -45,7 +71,6 @@ def _variables(path: str, mtime: int, size: int) -> tuple[str, ...]:
 
 
 def _corrupt(path, exc):
-    from ..errors import RecordingError
     from ._mat5 import Mat5Error
     why = str(exc) if isinstance(exc, Mat5Error) else f"{type(exc).__name__}: {exc}"
     return RecordingError(f"{path}: the MATLAB file is truncated or corrupt ({why}); export or "
@@ -67,7 +92,9 @@ def mat_variables(path) -> tuple[str, ...]:
     p = Path(path)
     st = p.stat()
     try:
-        return _variables(str(p), st.st_mtime_ns, st.st_size)
+        return _variables(str(p), st.st_mtime_ns, st.st_size, st.st_ino)
+    except RecordingError:
+        raise
     except _ERRORS as exc:
         raise _corrupt(p, exc) from exc
 
@@ -113,6 +140,8 @@ def load_mat(path, variable_names=None) -> dict:
     """
     try:
         return _load_mat(path, variable_names)
+    except RecordingError:
+        raise
     except _ERRORS as exc:
         raise _corrupt(path, exc) from exc
 
@@ -122,13 +151,8 @@ def _load_mat(path, variable_names):
         head = fh.read(1024)
     v = mat_version(head)
     if v == "7.3":
-        import h5py
-        out = {}
-        with h5py.File(path, "r") as f:
-            for k in f.keys():
-                if k.startswith("#") or (variable_names and k not in variable_names):
-                    continue
-                out[k] = _h5_plain(f, f[k])
-        return out
+        from ._guard import guarded
+        names = tuple(variable_names) if variable_names else None
+        return guarded(path, "HDF5", _h5_load, str(path), names)
     from . import _mat5
     return _mat5.load(Path(path).read_bytes(), variable_names=variable_names)
