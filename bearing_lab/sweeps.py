@@ -39,7 +39,11 @@ Every scene runs through the same function on every path and the results are
 placed by index, so a Dask sweep is bit for bit equal to a serial one.
 
 Cache: a finished scene is written to ``cache_dir/<hash>.nc`` (netCDF4,
-uncompressed, float64 kept exactly) where the hash is the sha256 of the resolved scene TOML
+uncompressed, float64 kept exactly, written atomically) with its checksum in
+``<hash>.nc.sha256``; on reading, the file must match its checksum and hold the
+scene's variables and shapes with finite values, else it is computed again, the
+sweep warns (:class:`CacheWarning`) and says so in ``sweep_cache_rejected`` and
+``sweep_cache_rejected_entries``.  The hash is the sha256 of the resolved scene TOML
 (:meth:`Scene.to_toml`), the bearing_lab version (with a fingerprint of the
 simulator's source, so a development install never reuses results of older
 code) and the simulate keywords.  A
@@ -63,7 +67,8 @@ import numpy as np
 from . import __version__
 from .errors import BearingLabError, SceneError
 
-__all__ = ["sweep", "scene_hash", "code_fingerprint", "default_cache_dir", "dim_name", "key_units"]
+__all__ = ["sweep", "scene_hash", "code_fingerprint", "default_cache_dir", "dim_name", "key_units",
+           "CacheWarning"]
 
 # units of the --set key suffixes (scene.py's _SUFFIX), as CF/UDUNITS strings
 _UNIT_STRINGS = {
@@ -76,6 +81,12 @@ _SIM_KW = {"duration": "output.duration_s", "fs": "output.sample_rate_hz", "rtol
            "method": "solver.method", "step": "solver.step_s", "fidelity": "fidelity"}
 _METRICS = ("rms", "peak", "crest_factor", "kurtosis")
 _METRIC_SIGNAL = "outer_ring_acc_y"
+_REQUIRED = ("outer_ring_acc_y", "outer_ring_acc_x", "outer_ring_disp_y", "outer_ring_disp_x",
+             "inner_ring_disp_y", "inner_ring_disp_x")
+
+
+class CacheWarning(UserWarning):
+    """A sweep-cache entry was damaged or incomplete and its scene was computed again."""
 
 
 # ---------------------------------------------------------------- helpers
@@ -207,35 +218,78 @@ def _metrics(x: np.ndarray) -> dict:
 
 
 # ---------------------------------------------------------------- one scene (runs on workers)
+def _checksum_path(path: Path) -> Path:
+    return path.with_name(path.name + ".sha256")
+
+
 def _write_cache(ds, path: Path) -> None:
     """Write one scene to the cache: netCDF4, float64 as is, *uncompressed* (zlib costs
-    ~0.12 s per 1 s scene, a third of its simulation, to save a third of 3.5 MB)."""
+    ~0.12 s per 1 s scene, a third of its simulation, to save a third of 3.5 MB), then its
+    checksum file ``<hash>.nc.sha256`` (``sha256sum -c`` format).  Both are written
+    atomically; an entry without its checksum is incomplete and is never read."""
+    from ._files import atomic_open, atomic_path, sha256_file
     path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.stem}.{uuid.uuid4().hex}.tmp.nc")
     out = ds.copy(deep=False)
     out.attrs = {k: (int(v) if isinstance(v, (bool, np.bool_)) else "" if v is None else v)
                  for k, v in ds.attrs.items()}
     try:
-        out.to_netcdf(tmp, engine="netcdf4", format="NETCDF4")
-        os.replace(tmp, path)  # atomic: a stopped sweep never leaves a half-written scene
+        with atomic_path(path) as tmp:
+            out.to_netcdf(tmp, engine="netcdf4", format="NETCDF4")
+            digest = sha256_file(tmp)
+        with atomic_open(_checksum_path(path), "w") as fh:
+            fh.write(f"{digest}  {path.name}\n")
     except (OSError, ValueError, RuntimeError) as exc:
         raise BearingLabError(f"sweep: cannot write the cache file {path}: {exc}") from None
-    finally:
-        if tmp.exists():
-            tmp.unlink()
 
 
-def _read_cache(path: Path, digest: str):
-    import xarray as xr
-    if not path.is_file():
-        return None
-    try:
-        ds = xr.load_dataset(path, engine="netcdf4")
-    except (OSError, ValueError, RuntimeError):
-        return None  # unreadable: recompute
+def _cache_problem(ds, digest: str, expect: dict) -> str | None:
+    """What is wrong with a cache entry's content, or None (shape, names, finite values)."""
     if ds.attrs.get("sweep_scene_hash") != digest:
-        return None
-    return ds
+        return "it belongs to another scene"
+    for name in _REQUIRED:
+        if name not in ds.data_vars:
+            return f"variable {name} is missing"
+    for dim, n in expect.items():
+        if ds.sizes.get(dim) != n:
+            return f"dimension {dim} has {ds.sizes.get(dim)} entries, the scene needs {n}"
+    for name, var in ds.data_vars.items():
+        if var.dtype.kind in "fc" and not np.all(np.isfinite(var.values)):
+            return f"variable {name} holds NaN/Inf"
+    return None
+
+
+def _read_cache(path: Path, digest: str, expect: dict):
+    """Return (Dataset or None, problem or None): None/None when there is no entry.
+
+    The file's bytes are checked against its checksum file before netCDF reads them
+    (a damaged file never reaches the C library), then the content is validated.
+    """
+    import xarray as xr
+    from ._files import sha256_file
+    if not path.is_file():
+        return None, None
+    sums = _checksum_path(path)
+    try:
+        recorded = sums.read_text().split()[0] if sums.is_file() else None
+    except (OSError, IndexError, UnicodeDecodeError):
+        recorded = None
+    if recorded is None:
+        return None, "no checksum file (an interrupted write)"
+    try:
+        if sha256_file(path) != recorded:
+            return None, "its sha256 does not match the checksum file"
+        ds = xr.load_dataset(path, engine="netcdf4")
+    except (OSError, ValueError, RuntimeError, KeyError) as exc:
+        return None, f"unreadable ({type(exc).__name__}: {exc})"
+    return (None, problem) if (problem := _cache_problem(ds, digest, expect)) else (ds, None)
+
+
+def _drop_entry(path: Path) -> None:
+    for p in (path, _checksum_path(path)):
+        try:
+            p.unlink()
+        except OSError:
+            pass
 
 
 def _simulate_scene(scene_toml: str, digest: str, cache_path: str | None):
@@ -396,14 +450,25 @@ def sweep(scene, params: dict, *, scheduler=None, n_workers: int | None = None, 
 
     acc = _Stack(shape, n)
     hits = 0
-    todo = []
+    todo, rejected = [], []
     for i, dg in enumerate(digests):
-        ds = _read_cache(cdir / f"{dg}.nc", dg) if cdir is not None else None
+        ds, problem = (None, None)
+        if cdir is not None:
+            expect = {"time": int(round(scenes[i].duration * scenes[i].fs_out)),
+                      "ball": scenes[i].bearing.n_balls}
+            ds, problem = _read_cache(cdir / f"{dg}.nc", dg, expect)
+        if problem is not None:
+            rejected.append(f"{dg[:12]} ({problem})")
+            _drop_entry(cdir / f"{dg}.nc")
         if ds is None:
             todo.append(i)
         else:
             acc.put(i, ds, cached=True)
             hits += 1
+    if rejected:
+        import warnings
+        warnings.warn(f"sweep: {len(rejected)} damaged cache entr{'y' if len(rejected) == 1 else 'ies'} "
+                      f"in {cdir} computed again: {'; '.join(rejected)}", CacheWarning, stacklevel=2)
 
     bar = None
     if progress:
@@ -512,6 +577,8 @@ def sweep(scene, params: dict, *, scheduler=None, n_workers: int | None = None, 
         "sweep_dims": " ".join(sdims),
         "sweep_n_scenes": int(n),
         "sweep_cache_hits": int(hits),
+        "sweep_cache_rejected": int(len(rejected)),
+        "sweep_cache_rejected_entries": "; ".join(rejected),
         "sweep_computed": int(n - hits),
         "sweep_cache_dir": str(cdir) if cdir is not None else "",
         "sweep_scheduler": desc if todo else "none (all scenes cached)",
