@@ -313,14 +313,13 @@ def _resolve(scene, params: dict, simulate_kwargs: dict):
     from .sim import load_scene
     if not isinstance(params, dict) or not params:
         raise SceneError("sweep: give the swept parameters as a dict {key: [values, ...]}")
-    fixed = {}
+    from .sim.scene import merge_overrides
     unknown_kw = {"progress"} & set(simulate_kwargs)
     if unknown_kw:
         raise BearingLabError("sweep: 'progress' is the sweep's own progress bar, not a simulate option")
-    for kw, v in simulate_kwargs.items():
-        if v is None:
-            continue
-        fixed[_SIM_KW.get(kw, kw)] = v
+    named = {_SIM_KW[k]: v for k, v in simulate_kwargs.items() if k in _SIM_KW}
+    fixed = merge_overrides({k: v for k, v in simulate_kwargs.items()
+                             if k not in _SIM_KW and v is not None}, **named)
     keys, values, seen = [], [], {}
     for key, vals in params.items():
         if not isinstance(key, str) or not key:
@@ -352,6 +351,13 @@ def _resolve(scene, params: dict, simulate_kwargs: dict):
             scenes.append(base.replace(**ov))
         except SceneError as exc:
             what = ", ".join(f"{k}={v!r}" for k, v in ov.items())
+            raise SceneError(f"sweep scene {what}: {exc}") from None
+    from .sim.budget import check_budget
+    for combo, sc in zip(itertools.product(*values), scenes):
+        try:
+            check_budget(sc)  # every scene, before any runs
+        except SceneError as exc:
+            what = ", ".join(f"{k}={v!r}" for k, v in zip(keys, combo))
             raise SceneError(f"sweep scene {what}: {exc}") from None
     shape = tuple(len(v) for v in values)
     for what, get in (("output.duration_s", lambda s: s.duration),
@@ -385,17 +391,22 @@ def _client_for(scheduler, n_workers):
         import logging
         import dask
         # the workers' statistical profiler samples the running task every 10 ms: ~5 % of a scene
-        with dask.config.set({"distributed.worker.profile.enabled": False}):
-            cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                                   dashboard_address=None, silence_logs=logging.ERROR)
-        return Client(cluster), cluster, True, f"local cluster, {n} worker processes x 1 thread"
+        try:
+            with dask.config.set({"distributed.worker.profile.enabled": False}):
+                cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                                       dashboard_address=None, silence_logs=logging.ERROR)
+            return Client(cluster), cluster, True, f"local cluster, {n} worker processes x 1 thread"
+        except Exception as exc:  # noqa: BLE001 - Dask raises RuntimeError, OSError, TimeoutError...
+            raise BearingLabError(f"sweep: the local Dask cluster of {n} worker(s) did not start "
+                                  f"({type(exc).__name__}: {exc}); run in this process with "
+                                  "scheduler='serial' (CLI --scheduler serial)") from None
     if isinstance(scheduler, str):
         if n_workers is not None:
             raise BearingLabError(f"sweep: n_workers applies to the local cluster; the cluster at "
                                   f"{scheduler} has its own workers")
         try:
             client = Client(scheduler, timeout="10s")
-        except (OSError, TimeoutError, ValueError) as exc:
+        except Exception as exc:  # noqa: BLE001 - OSError, TimeoutError, ValueError, RuntimeError
             raise BearingLabError(f"sweep: cannot connect to the Dask scheduler {scheduler!r}: {exc}") from None
         return client, None, True, f"scheduler {scheduler}"
     raise BearingLabError(f"sweep: scheduler={scheduler!r}: use None (local cluster), 'serial', "
