@@ -10,6 +10,8 @@ target, if any, is left exactly as it was.
 atomic_path(path)      -- context manager yielding a temporary path to write by name
                           (netCDF4, savefig, ...); renamed over ``path`` on success
 atomic_open(path, mode) -- context manager yielding an open file object ("w", "wb", ...)
+write_text(path, text)  -- atomic ``Path.write_text`` (UTF-8)
+savefig(fig, path, **kw) -- atomic ``Figure.savefig`` to a file name (format from its suffix)
 sha256_file(path)      -- hex digest of a file, read in 1 MiB blocks
 sha256_bytes(data)     -- hex digest of bytes
 cache_dir(kind)        -- per-user cache folder for ``kind`` ("tables", ...), created on use;
@@ -25,7 +27,8 @@ import stat
 import tempfile
 import threading
 
-__all__ = ["atomic_path", "atomic_open", "sha256_file", "sha256_bytes", "cache_dir"]
+__all__ = ["atomic_path", "atomic_open", "write_text", "savefig", "sha256_file", "sha256_bytes",
+           "cache_dir"]
 
 
 _UMASK_LOCK = threading.Lock()
@@ -111,6 +114,21 @@ def atomic_open(path, mode: str = "w", **kwargs):
     with atomic_path(path) as tmp:
         with open(tmp, mode.replace("x", "w"), **kwargs) as fh:
             yield fh
+
+
+def write_text(path, text: str, *, encoding: str = "utf-8") -> Path:
+    """Write ``text`` to ``path`` atomically; return the path."""
+    with atomic_open(path, "w", encoding=encoding) as fh:
+        fh.write(text)
+    return Path(path)
+
+
+def savefig(fig, path, **kwargs) -> Path:
+    """``fig.savefig`` to ``path`` atomically (the temporary name keeps the suffix, so the
+    format is still chosen by it); return the path."""
+    with atomic_path(path) as tmp:
+        fig.savefig(str(tmp), **kwargs)
+    return Path(path)
 
 
 def sha256_file(path, *, block: int = 1 << 20) -> str:

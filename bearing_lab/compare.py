@@ -122,11 +122,10 @@ def make_row(quantity: str, simulation, experiment, tolerance: Tolerance, *, lab
              group="") -> dict:
     """One table row: simulation, experiment, difference, % difference, tolerance, pass."""
     s, e = _f(simulation), _f(experiment)
-    ok = bool(tolerance.check(s, e))
+    # a row without two finite numbers never passes (NaN against NaN is not an agreement)
+    ok = bool(np.isfinite(s) and np.isfinite(e) and tolerance.check(s, e))
     if quantity in LINE_QUANTITIES and np.isnan(s) and np.isnan(e):
-        # a spectral line neither signal shows: the model agrees with the recording (no such line)
-        ok = True
-        note = ("neither shows this line: agreement. " + note).strip()
+        note = ("neither signal shows this line: nothing to compare, so not passed. " + note).strip()
     diff = s - e
     pct = 100.0 * diff / abs(e) if (np.isfinite(diff) and e != 0) else float("nan")
     lab, un = QUANTITIES.get(quantity, (quantity, "1"))

@@ -126,6 +126,29 @@ def _tolerances(name, raw, allowed) -> dict:
     return out
 
 
+SCALE_RANGE = (1e-6, 1e6)
+"""A calibration factor outside this range is a typo or a unit mix-up, not a sensor's
+(a sensitivity error of a million times would be noticed in the recording itself)."""
+
+
+def _check_scale(name, scale):
+    """recording.scale: a finite, positive calibration factor of a plausible size."""
+    lo, hi = SCALE_RANGE
+    if isinstance(scale, bool) or not isinstance(scale, (int, float)) or not math.isfinite(scale) \
+            or not lo <= scale <= hi:
+        raise _err(name, f"recording.scale = {scale!r}: the calibration factor on the recording's SI "
+                         f"values must be a positive number between {lo:g} and {hi:g} (1.0 when the "
+                         "file is calibrated)")
+
+
+def _check_bounds(name, key, value):
+    ok = (isinstance(value, list) and len(value) == 2
+          and all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+                  and v > 0 for v in value) and value[0] < value[1])
+    if not ok:
+        raise _err(name, f"{key} = {value!r}: give [low, high], two finite positive numbers, low < high")
+
+
 def _check_scene(name, scene, overrides, where, base: Path):
     from .sim import load_scene
     from .errors import SceneError
@@ -201,6 +224,7 @@ def load_case(spec) -> ValidationCase:
         bad = set(rec) - {"name", "path", "channel", "scale", "units", "description"}
         if bad:
             raise _err(name, f"unknown key recording.{sorted(bad)[0]}; keys are name, path, channel, scale, units")
+        _check_scale(name, rec.get("scale", 1.0))
         sc = raw.get("scene")
         if not isinstance(sc, dict):
             raise _err(name, "needs a [scene] table (scene, speed, duration_s, set)")
@@ -224,6 +248,9 @@ def load_case(spec) -> ValidationCase:
         bad = set(cal) - {"enabled", "frequency_hz", "damping_ratio", "gain"}
         if bad:
             raise _err(name, f"unknown key calibration.{sorted(bad)[0]}")
+        for key in ("frequency_hz", "damping_ratio", "gain"):
+            if key in cal:
+                _check_bounds(name, f"calibration.{key}", cal[key])
         order = raw.get("ordering")
         if order is not None:
             bad = set(order) - {"recording", "scene", "label", "set"}
@@ -970,25 +997,34 @@ def run_case(case: ValidationCase, out_dir, *, progress=True, mirror=None, posit
                "wall_time_s": wall, "status": status, "title": case.title,
                "calibration": extra.get("calibration"), "numerical_error": ne, "compute": comp,
                "ordering": extra.get("ordering"), "studies": extra.get("studies")}
-    (out / "summary.json").write_text(json.dumps(_clean(summary), indent=1, default=str), encoding="utf-8")
+    from ._files import write_text
+    write_text(out / "summary.json", json.dumps(_clean(summary), indent=1, default=str, allow_nan=False))
     return CaseOutcome(case.name, case.title, status, rows, wall, out, extra=extra)
 
 
 def run_validation(specs=None, out_dir="reports", *, strict=False, progress=True, mirror=None):
     """Run cases (default: the embedded default set) and write ``out_dir/index.html``.
 
-    Returns (outcomes, exit status): 0, or 1 with ``strict`` when a row fails or a case errors.
-    Bad input (unknown case, invalid file, missing recording of a named case) raises
-    ValidationCaseError before anything runs.
+    Returns (outcomes, exit status): 0, or 1 with ``strict`` when a row fails or a case errors,
+    or 2 when a named case is bad input (unknown case, invalid file or value, missing
+    recording): such a case is listed as "error" in the index with its reason, and every
+    other case still runs.
     """
     from .report import write_index
     out_dir = Path(out_dir)
     notes = []
+    bad_input = []  # cases named by the user that cannot run: listed, the others still run
     if specs:
-        cases = [load_case(s) for s in specs]
-        for c in cases:
-            check_case(c, mirror)
-        skipped = []
+        cases, skipped = [], []
+        for spec in specs:
+            try:
+                c = load_case(spec)
+                check_case(c, mirror)
+            except ValidationCaseError as exc:
+                bad_input.append(CaseOutcome(str(spec), str(spec), "error", reason=str(exc),
+                                             extra={"bad_input": True}))
+                continue
+            cases.append(c)
     else:
         cases, skipped = default_set(mirror)
         if skipped:
@@ -1008,8 +1044,12 @@ def run_validation(specs=None, out_dir="reports", *, strict=False, progress=True
             bar.set_postfix_str(c.name)
         try:
             oc = run_case(c, out_dir, progress=progress, mirror=mirror)
-        except ValidationCaseError:
-            raise
+        except ValidationCaseError as exc:  # bad input found while running: listed, the rest run
+            bad_input.append(CaseOutcome(c.name, c.title, "error", reason=str(exc),
+                                         extra={"bad_input": True}))
+            if bar is not None:
+                bar.update(1)
+            continue
         except Exception as exc:  # one broken case must not lose the others' reports: listed as "error"
             msg = f"{type(exc).__name__}: {exc}".splitlines()[0]
             if not isinstance(exc, BearingLabError):
@@ -1020,6 +1060,7 @@ def run_validation(specs=None, out_dir="reports", *, strict=False, progress=True
             bar.update(1)
     if bar is not None:
         bar.close()
+    outcomes = bad_input + outcomes
     entries = []
     for oc in outcomes:
         entries.append({"case": oc.name, "title": oc.title, "status": oc.status, "n_pass": oc.n_pass,
@@ -1031,4 +1072,6 @@ def run_validation(specs=None, out_dir="reports", *, strict=False, progress=True
         entries.append({"case": name, "title": title, "status": "skip", "reason": reason, "link": None})
     write_index(out_dir / "index.html", entries, notes=notes)
     bad = any(o.status in ("fail", "error") for o in outcomes)
+    if bad_input:  # after every other case ran and the index was written
+        return outcomes, 2
     return outcomes, (1 if strict and bad else 0)

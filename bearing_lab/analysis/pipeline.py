@@ -261,5 +261,6 @@ def plot_analysis(x, fs, *, bearing, rpm=None, shaft_hz=None, channel="", units=
     ax3.set_ylim(0, 1.15 * ymax)
     ax3.legend(loc="upper right", fontsize=8)
     if path is not None:
-        fig.savefig(str(path), dpi=110)
+        from .._files import savefig
+        savefig(fig, path, dpi=110)  # atomic: an existing figure survives a failed write
     return fig, result

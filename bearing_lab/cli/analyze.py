@@ -9,8 +9,8 @@ stored ``shaft_speed_rpm`` (only when asked: stored speeds are nominal).
 """
 from __future__ import annotations
 
-import json
 from pathlib import Path
+import sys
 
 from ..errors import AnalysisError, RecordingError
 
@@ -125,12 +125,21 @@ def run(args) -> int:
     x = np.asarray(da.values, dtype=float)
     units = da.attrs.get("units", "1")
     kw = dict(bearing=bearing, rpm=rpm, channel=str(name), units=units)
-    if args.plot:
-        _, result = plot_analysis(x, fs, path=args.plot, **kw)
-    else:
-        result = analyze(x, fs, **kw)
+    import warnings
+    with np.errstate(all="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # overflow is reported once, below
+        if args.plot:
+            _, result = plot_analysis(x, fs, path=args.plot, **kw)
+        else:
+            result = analyze(x, fs, **kw)
+    bad = [k for k, v in result.get("metrics", {}).items() if v is None or not np.isfinite(v)]
+    if bad:
+        print(f"bearing-lab analyze: warning: {path.name} [{name}]: metrics {', '.join(bad)} are not "
+              f"finite (the largest |value| is {np.max(np.abs(x)):.3g} {units}): reported as null",
+              file=sys.stderr)
     if args.json:
-        print(json.dumps(result, indent=1))
+        from .._json import dumps
+        print(dumps(result, indent=1))  # no NaN/Infinity tokens: strict parsers read it
         return 0
     ff = result["fault_frequencies"]
     print(f"{path.name} [{name}]  fs {fs:g} Hz  bearing {bearing}  shaft {result['shaft_hz']:.3f} Hz "

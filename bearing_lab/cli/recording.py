@@ -42,7 +42,8 @@ def _add_read_options(p):
     p.add_argument("--units", default=None,
                    help="unit of the stored values where the file has none or an unknown one (e.g. g)")
     p.add_argument("--allow-truncated", action="store_true",
-                   help="keep the points present when a UFF header promises more")
+                   help="keep what a truncated file holds (UFF, IMS, TDMS, WAV) instead of refusing it; "
+                        "the recording then says so in its warnings and attributes")
     p.add_argument("--full-scale", default=None, help="WAV calibration, e.g. '5 V' or '50 g'")
     p.add_argument("--record", type=int, default=None, help="CWRU record number in a multi-record file")
 

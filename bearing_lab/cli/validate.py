@@ -49,6 +49,11 @@ def run(args) -> int:
             line += f"  {o.reason}"
         print(line)
     print(f"reports: {os.path.join(args.output, 'index.html')}  ({time.perf_counter() - t0:.1f} s)")
+    if status == 2:  # bad input: one line per case that could not run (the others did)
+        for o in outcomes:
+            if o.extra.get("bad_input"):
+                print(f"bearing-lab validate: error: {o.reason}", file=sys.stderr)
+        return 2
     if status:
         failed = [o.name for o in outcomes if o.status in ("fail", "error")]
         print(f"bearing-lab validate: --strict: failing cases: {', '.join(failed)}", file=sys.stderr)

@@ -50,6 +50,9 @@ import numpy as np
 from ..errors import BearingLabError, RecordingError
 from .. import units as _units
 
+MIN_RATE_HZ = 1e-3   # slower than a sample every 17 minutes: not a vibration recording
+MAX_RATE_HZ = 1e9    # faster than any vibration data-acquisition front end
+
 ENGINES: dict[str, type["RecordingReader"]] = {}
 """Format name -> reader class, in sniffing order (registered by each format module)."""
 
@@ -410,7 +413,10 @@ class RecordingBuilder:
         if n < 2:
             self.fail(f"only {n} sample(s): not a time history")
         if time is None:
-            fs = float(fs)
+            try:
+                fs = float(fs)
+            except (TypeError, ValueError):
+                self.fail(f"sampling rate {fs!r} is not a number; pass fs=<Hz>")
             if not (np.isfinite(fs) and fs > 0):
                 self.fail(f"sampling rate {fs!r} Hz is not positive; pass fs=<Hz>")
             t = float(t0) + np.arange(n, dtype=np.float64) / fs
@@ -424,6 +430,10 @@ class RecordingBuilder:
                 self.fail(f"time values are not strictly increasing (at sample {k + 1}); "
                           "sort or repair the time column, or pass fs= and drop it")
             fs = 1.0 / float(np.median(dt))
+        if not MIN_RATE_HZ <= fs <= MAX_RATE_HZ:
+            self.fail(f"sampling rate {fs:.6g} Hz is outside {MIN_RATE_HZ:g} Hz .. {MAX_RATE_HZ:.0e} "
+                      "Hz: not a rate of a vibration recording (a damaged increment, or a wrong "
+                      "fs=/time unit)")
         if self.sha256 is None:
             # after parsing, so the bytes come from the page cache (or the reader's map)
             self.sha256 = file_sha256(self.path, data) if self.checksum else ""

@@ -216,12 +216,12 @@ class Report:
         if path.exists() and not overwrite:
             raise FileExistsError(f"{path} exists (pass overwrite=True)")
         path.parent.mkdir(parents=True, exist_ok=True)
+        from .._files import write_text
         if path.suffix == ".json":
-            path.write_text(json.dumps({"title": self.title, "subtitle": self.subtitle, "sections": self.sections,
-                                        "rows": self.rows, "info": self.info}, default=str, allow_nan=True),
-                            encoding="utf-8")
+            write_text(path, json.dumps({"title": self.title, "subtitle": self.subtitle, "sections": self.sections,
+                                         "rows": self.rows, "info": self.info}, default=str, allow_nan=True))
         elif path.suffix in (".html", ".htm"):
-            path.write_text(self.to_html(), encoding="utf-8")
+            write_text(path, self.to_html())
         else:
             raise ValueError(f"Invalid value for the report path suffix: allowed are '.html' and '.json', "
                              f"but got {path.suffix!r} instead.")
@@ -261,5 +261,5 @@ def write_index(path, entries: list[dict], *, title="bearing_lab validation", no
                                               rows="\n".join(rows), notes=notes_html)
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(page, encoding="utf-8")
-    return path
+    from .._files import write_text
+    return write_text(path, page)

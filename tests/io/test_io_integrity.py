@@ -221,3 +221,37 @@ def test_info_describes_simulation_output(tmp_path):
     d = json.loads(r.stdout)
     assert d["kind"] == "simulation" and d["default_channel"] == "outer_ring_acc_y"
     assert main is not None
+
+
+# ------------------------------------------------------------------ input checks
+def test_unreadable_file_is_a_recording_error(tmp_path, monkeypatch, datafile):
+    """The API leaked PermissionError for a file without read permission."""
+    import builtins
+    import bearing_lab.io as bio
+    p = tmp_path / "locked.uff"
+    p.write_bytes(datafile("lms/binary8byte_g.uff").read_bytes())
+    p.chmod(0)
+    if os.geteuid() == 0:  # root reads anything: make open() refuse as it would for a user
+        def refuse(path, *a, **k):
+            if str(path) == str(p):
+                raise PermissionError(13, "Permission denied", str(path))
+            return builtins.open(path, *a, **k)
+        monkeypatch.setattr(bio, "open", refuse, raising=False)
+    with pytest.raises(RecordingError, match=r"locked.uff: cannot read the file \(Permission denied\)"):
+        open_recording(p)
+
+
+@pytest.mark.parametrize("inc, needle", [("1.00000E-300", "1e+300 Hz is outside"),
+                                         ("1.00000E+300", "1e-300 Hz is outside")])
+def test_absurd_sampling_rates_refused(write, sine, inc, needle):
+    from bearing_lab.io._testing import uff58_block
+    p = write("rate.uff", uff58_block(sine, binary=True, inc=inc))
+    import re
+    with pytest.raises(RecordingError, match=re.escape(f"rate.uff: sampling rate {needle}")):
+        open_recording(p)
+
+
+def test_absurd_rate_given_by_the_user_refused(write):
+    p = write("a.csv", "a [g],b [g]\n" + "\n".join(f"{v},{-v}" for v in range(10)) + "\n")
+    with pytest.raises(RecordingError, match="a.csv: sampling rate 1e-300 Hz is outside"):
+        open_recording(p, fs=1e-300)

@@ -128,7 +128,44 @@ def test_cli_bad_input_exits_2_with_one_line(tmp_path, capsys, args, match):
     assert len(err.splitlines()) == 1, err
     assert err.startswith("bearing-lab validate: error:")
     assert match in err
-    assert not (tmp_path / "out" / "index.html").exists()
+    index = (tmp_path / "out" / "index.html").read_text()   # the run still leaves its index
+    assert "error" in index
+
+
+@pytest.mark.parametrize("scale", ["0.0", "nan", "-1e6", "1e300", "inf", '"2"'])
+def test_calibration_scale_refused(tmp_path, scale):
+    """recording.scale 0, NaN, -1e6 and 1e300 were accepted (0 and NaN ended as ERROR, exit 0)."""
+    text = GOOD.format(rec="x.mat", set="", reason="ok").replace('channel = "DE"',
+                                                                 f'channel = "DE"\nscale = {scale}')
+    with pytest.raises(ValidationCaseError, match=r"recording.scale = .*between 1e-06 and 1e\+06"):
+        load_case(_case(tmp_path, text))
+
+
+def test_calibration_bounds_checked(tmp_path):
+    text = GOOD.format(rec="x.mat", set="", reason="ok") + "[calibration]\nfrequency_hz = [5400.0, 1000.0]\n"
+    with pytest.raises(ValidationCaseError, match=r"calibration.frequency_hz = \[5400.0, 1000.0\]"):
+        load_case(_case(tmp_path, text))
+
+
+def test_one_bad_case_does_not_stop_the_others(tmp_path, monkeypatch, capsys):
+    """A bad case among several aborted the whole run, with no index: now it is listed, the
+    others run, and the exit status says bad input."""
+    from bearing_lab import validation
+    ran = []
+
+    def fake_run(case, out_dir, **kw):
+        ran.append(case.name)
+        return validation.CaseOutcome(case.name, case.title, "pass", rows=[{"pass": True}])
+
+    monkeypatch.setattr(validation, "run_case", fake_run)
+    monkeypatch.setattr(validation, "check_case", lambda c, mirror=None: None)
+    good = _case(tmp_path, GOOD.format(rec="x.mat", set="", reason="ok"), "good.toml")
+    rc = main(["validate", "no-such-case", str(good), "-o", str(tmp_path / "out"), "--no-progress"])
+    assert rc == 2 and ran == ["mine"]
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "unknown validation case 'no-such-case'" in err[0]
+    index = (tmp_path / "out" / "index.html").read_text()
+    assert "no-such-case" in index and "mine" in index
 
 
 def test_default_set_without_mirror_skips_the_recordings(tmp_path, monkeypatch):

@@ -104,10 +104,15 @@ def test_comparison_round_trip(tmp_path):
     assert back.plot_envelope(ax=axes[2], fmax=600) is axes[2]
 
 
-def test_a_line_absent_from_both_signals_agrees_but_one_sided_fails():
+def test_a_row_without_two_numbers_never_passes():
+    """NaN against NaN counted as PASS ("agreement"): a row that measured nothing is a failure."""
     t = Tolerance("pct", 1.0, "r")
     nan = float("nan")
-    assert make_row("bpfi", nan, nan, t)["pass"] and "agreement" in make_row("bpfi", nan, nan, t)["note"]
+    row = make_row("bpfi", nan, nan, t)
+    assert row["pass"] is False and "neither signal shows this line" in row["note"]
+    assert not make_row("excitation_period", nan, nan, Tolerance("factor", 2.0, "r"))["pass"]
+    assert not make_row("impulse_strength_ratio", nan, nan, Tolerance("ordering", None, "r"))["pass"]
+    assert make_row("bpfi", 162.0, 161.7, t)["pass"]
     assert not make_row("bpfi", nan, 161.7, t)["pass"]
     assert not make_row("bpfi", 162.0, nan, t)["pass"]
     assert not make_row("rms", nan, nan, t)["pass"]  # not a line: a missing number fails
