@@ -5,7 +5,9 @@ all survive a crash, a kill or a second process writing the same name.  The rule
 same everywhere: write a temporary file in the target's directory, flush it to disk,
 then rename it over the target in one step (``os.replace`` is atomic on POSIX and on
 Windows within one volume).  On any failure the temporary file is removed and the old
-target, if any, is left exactly as it was.
+target, if any, is left exactly as it was.  A writer killed outright (SIGKILL) leaves its
+hidden temporary ``.<name>.<host>-<pid>.*``; the next successful write of the same file
+removes it once that process is gone.
 
 atomic_path(path)      -- context manager yielding a temporary path to write by name
                           (netCDF4, savefig, ...); renamed over ``path`` on success
@@ -23,6 +25,7 @@ from contextlib import contextmanager
 import hashlib
 import os
 from pathlib import Path
+import socket
 import stat
 import tempfile
 import threading
@@ -32,6 +35,7 @@ __all__ = ["atomic_path", "atomic_open", "write_text", "savefig", "sha256_file",
 
 
 _UMASK_LOCK = threading.Lock()
+_HOST = "".join(c for c in socket.gethostname() if c.isalnum())[:16] or "host"
 
 
 def _new_file_mode(path: Path) -> int:
@@ -83,8 +87,8 @@ def atomic_path(path, *, suffix: str | None = None):
     """
     path = Path(path)
     directory = path.parent if str(path.parent) else Path(".")
-    fd, tmp_name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix or path.suffix or ".tmp",
-                                    dir=directory)
+    fd, tmp_name = tempfile.mkstemp(prefix=f".{path.name}.{_HOST}-{os.getpid()}.",
+                                    suffix=suffix or path.suffix or ".tmp", dir=directory)
     try:
         os.fchmod(fd, _new_file_mode(path))
     except (OSError, AttributeError):  # no fchmod (Windows): keep mkstemp's mode
@@ -104,6 +108,38 @@ def atomic_path(path, *, suffix: str | None = None):
             pass
         raise
     _fsync_dir(directory)
+    _remove_stale(directory, path.name)
+
+
+def _remove_stale(directory: Path, name: str) -> None:
+    """Delete temporaries of ``name`` left by killed writers of this host (their process is gone).
+
+    A writer killed by SIGKILL cannot remove its temporary; the next successful write of the
+    same file does, when the temporary's process id no longer runs here.
+    """
+    prefix = f".{name}.{_HOST}-"
+    try:
+        entries = [e for e in os.scandir(directory) if e.name.startswith(prefix)]
+    except OSError:
+        return
+    for e in entries:
+        pid = e.name[len(prefix):].split(".", 1)[0]
+        if not pid.isdigit() or int(pid) == os.getpid() or _alive(int(pid)):
+            continue
+        try:
+            os.unlink(e.path)
+        except OSError:
+            pass
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OSError):
+        return True
+    return True
 
 
 @contextmanager

@@ -83,3 +83,21 @@ def test_atomic_write_keeps_the_usual_file_mode(tmp_path):
     with atomic_open(old) as fh:
         fh.write("b")
     assert (old.stat().st_mode & 0o777) == 0o640
+
+
+def test_temporaries_of_killed_writers_are_removed_by_the_next_write(tmp_path):
+    """A SIGKILLed writer cannot clean up; the next successful write of the file does."""
+    target = tmp_path / "out.nc"
+    code = textwrap.dedent(f"""
+        import os, signal
+        from bearing_lab._files import atomic_path
+        with atomic_path({str(target)!r}) as tmp:
+            tmp.write_bytes(b"partial")
+            os.kill(os.getpid(), signal.SIGKILL)
+    """)
+    for _ in range(2):
+        subprocess.run([sys.executable, "-c", code], capture_output=True)
+    assert len([p for p in tmp_path.iterdir() if p.name.startswith(".out.nc.")]) == 2
+    with atomic_open(target, "w") as fh:
+        fh.write("whole")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.nc"]

@@ -1,5 +1,7 @@
 """Fuzzing the readers with seeded mutants of real recordings, each read in a guarded subprocess.
 
+(And :func:`kill_writes`: writers killed at random moments must leave a whole file.)
+
 Why in the package: the CI test (``tests/io/test_io_fuzz.py``) and the long run
 (``benchmarks/fuzz_readers.py``) use the same corpus, mutations and verdicts, and a
 user can rerun one mutant from its seed and index (``python -m bearing_lab.io._fuzz
@@ -512,6 +514,64 @@ def _save(name, seed, index, keep: Path) -> Path:
     d.mkdir(parents=True, exist_ok=True)
     (d / fname).write_bytes(blob)
     return d / fname
+
+
+# ------------------------------------------------------------------ killed writers
+_WRITE_LOOP = """
+import sys, numpy as np, xarray as xr
+from bearing_lab.io import to_netcdf, to_uff58b
+target, kind, n = sys.argv[1], sys.argv[2], int(sys.argv[3])
+k = 0
+while True:
+    k += 1
+    t = np.arange(n) / 10000.0
+    ds = xr.Dataset({"acc": ("time", np.sin(t * (1 + k % 2)), {"units": "m s-2", "quantity":
+                     "acceleration", "original_units": "m/s2"})}, coords={"time": ("time", t,
+                     {"units": "s"})}, attrs={"sampling_rate_hz": 10000.0, "bearing_lab_version": "0",
+                     "source_file": "x", "source_sha256": "", "reader": "csv", "warnings": "",
+                     "default_channel": "acc"})
+    (to_netcdf if kind == "netcdf" else to_uff58b)(ds, target)
+"""
+
+
+def _written_versions(n):
+    t = np.arange(n) / 10000.0
+    return [np.sin(t * 1), np.sin(t * 2)]
+
+
+def kill_writes(target: Path, kills: int, *, kind: str = "netcdf", seed: int = 0,
+                n: int = 2_000_000, max_delay: float = 4.0) -> dict:
+    """SIGKILL a process that writes ``target`` over and over; after each kill the file must
+    open and hold one complete version.  Returns counts: ``intact``, ``destroyed``,
+    ``never_written`` (killed before the first write) and ``temporaries`` left behind."""
+    import signal
+    from ..errors import RecordingError
+    from . import open_recording
+    target = Path(target)
+    rng = np.random.default_rng(seed)
+    versions = _written_versions(n)
+    out = {"kills": kills, "intact": 0, "destroyed": 0, "never_written": 0, "examples": []}
+    for _ in range(kills):
+        proc = subprocess.Popen([sys.executable, "-c", _WRITE_LOOP, str(target), kind, str(n)],
+                                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        time.sleep(float(rng.uniform(0.5, max_delay)))
+        proc.send_signal(signal.SIGKILL)
+        proc.wait()
+        if not target.exists():
+            out["never_written"] += 1
+            continue
+        try:
+            values = _open_quietly(target, {}).to_array().values[0]
+            whole = any(np.array_equal(values, v.astype(np.float64)) for v in versions)
+        except RecordingError as exc:
+            whole, values = False, str(exc)
+        if whole:
+            out["intact"] += 1
+        else:
+            out["destroyed"] += 1
+            out["examples"].append(str(values)[:200])
+    out["temporaries"] = len([p for p in target.parent.iterdir() if p.name.startswith(f".{target.name}.")])
+    return out
 
 
 def main(argv=None) -> int:

@@ -255,3 +255,14 @@ def test_absurd_rate_given_by_the_user_refused(write):
     p = write("a.csv", "a [g],b [g]\n" + "\n".join(f"{v},{-v}" for v in range(10)) + "\n")
     with pytest.raises(RecordingError, match="a.csv: sampling rate 1e-300 Hz is outside"):
         open_recording(p, fs=1e-300)
+
+
+@pytest.mark.parametrize("kind, kills", [("netcdf", 5), ("uff", 3)])
+def test_killed_writers_leave_a_whole_file(tmp_path, kind, kills):
+    """4 of 4 killed `-o` writes destroyed the existing file; now the file that stays is always
+    one complete version (benchmarks/hostile_inputs.py kills 20 times)."""
+    from bearing_lab.io._fuzz import kill_writes
+    res = kill_writes(tmp_path / f"out.{'nc' if kind == 'netcdf' else 'uff'}", kills, kind=kind,
+                      seed=3, n=1_000_000, max_delay=2.5)
+    assert res["destroyed"] == 0, res
+    assert res["intact"] + res["never_written"] == kills and res["intact"] >= 1, res
