@@ -561,12 +561,14 @@ def sweep(scene, params: dict, *, scheduler=None, n_workers: int | None = None, 
     out["wall_time_s"] = (sdims, acc.wall.reshape(shape),
                           {"units": "s", "long_name": "compute time of the scene (simulate's wall_time_s, "
                                                       "without compilation; from the run that filled the cache)"})
-    out["solver_steps"] = (sdims, acc.steps.reshape(shape), {"long_name": "accepted solver steps"})
+    out["solver_steps"] = (sdims, acc.steps.reshape(shape), {"units": "1",
+                                                             "long_name": "accepted solver steps"})
     out["cached"] = (sdims, acc.cached.reshape(shape).astype(np.int8),
-                     {"long_name": "1: the scene was read from the sweep cache", "flag_values": "0 1"})
+                     {"units": "1", "long_name": "1: the scene was read from the sweep cache",
+                      "flag_values": "0 1"})
     out["scene_hash"] = (sdims, np.asarray(digests, dtype=object).reshape(shape),
-                         {"long_name": "sha256 of the resolved scene TOML, version and simulate options "
-                                       "(the cache file name)"})
+                         {"units": "1", "long_name": "sha256 of the resolved scene TOML, version and "
+                                                     "simulate options (the cache file name)"})
     out.attrs.update(acc.common_attrs)
     # attributes that differ between scenes (e.g. the fidelity "auto" picked) become variables
     for name, vals in acc.scene_attrs.items():
@@ -577,8 +579,9 @@ def sweep(scene, params: dict, *, scheduler=None, n_workers: int | None = None, 
         arr = (np.asarray(vals, dtype=float) if kinds <= {int, float} and kinds != {int}
                else np.asarray(vals, dtype=np.int64) if kinds == {int}
                else np.asarray([str(v) for v in vals], dtype=object))
-        out[var] = (sdims, arr.reshape(shape), {"long_name": f"simulation attribute {name!r} of each scene "
-                                                             "(it differs across the sweep)"})
+        out[var] = (sdims, arr.reshape(shape), {"units": key_units(name) or "1",
+                                                "long_name": f"simulation attribute {name!r} of each "
+                                                             "scene (it differs across the sweep)"})
     out.attrs.update({
         "title": f"bearing_lab sweep of scene {base.name!r}",
         "scene_name": base.name,
