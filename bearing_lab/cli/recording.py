@@ -74,6 +74,8 @@ def _open(args):
 
 def _cmd_import(args) -> int:
     from ..io import get_warnings, to_netcdf
+    from ..io_netcdf import check_output_path
+    check_output_path(args.output)  # before reading: a bad -o is said at once
     ds = _open(args)
     to_netcdf(ds, args.output)
     for w in get_warnings(ds):
