@@ -460,26 +460,7 @@ def sweep(scene, params: dict, *, scheduler=None, n_workers: int | None = None, 
     n = len(scenes)
 
     acc = _Stack(shape, n)
-    hits = 0
-    todo, rejected = [], []
-    for i, dg in enumerate(digests):
-        ds, problem = (None, None)
-        if cdir is not None:
-            expect = {"time": int(round(scenes[i].duration * scenes[i].fs_out)),
-                      "ball": scenes[i].bearing.n_balls}
-            ds, problem = _read_cache(cdir / f"{dg}.nc", dg, expect)
-        if problem is not None:
-            rejected.append(f"{dg[:12]} ({problem})")
-            _drop_entry(cdir / f"{dg}.nc")
-        if ds is None:
-            todo.append(i)
-        else:
-            acc.put(i, ds, cached=True)
-            hits += 1
-    if rejected:
-        import warnings
-        warnings.warn(f"sweep: {len(rejected)} damaged cache entr{'y' if len(rejected) == 1 else 'ies'} "
-                      f"in {cdir} computed again: {'; '.join(rejected)}", CacheWarning, stacklevel=2)
+    hits, todo, rejected = _from_cache(cdir, scenes, digests, acc)
 
     bar = None
     if progress:
@@ -601,6 +582,34 @@ def sweep(scene, params: dict, *, scheduler=None, n_workers: int | None = None, 
     })
     out.attrs.setdefault("Conventions", "CF-1.8")
     return out
+
+
+def _from_cache(cdir, scenes, digests, acc):
+    """Put every valid cached scene into ``acc``; return (hits, indices to compute, rejected).
+
+    A damaged or incomplete entry is deleted, listed in ``rejected`` and warned about
+    (:class:`CacheWarning`): its scene is computed again.
+    """
+    hits, todo, rejected = 0, [], []
+    for i, dg in enumerate(digests):
+        ds, problem = (None, None)
+        if cdir is not None:
+            expect = {"time": int(round(scenes[i].duration * scenes[i].fs_out)),
+                      "ball": scenes[i].bearing.n_balls}
+            ds, problem = _read_cache(cdir / f"{dg}.nc", dg, expect)
+        if problem is not None:
+            rejected.append(f"{dg[:12]} ({problem})")
+            _drop_entry(cdir / f"{dg}.nc")
+        if ds is None:
+            todo.append(i)
+        else:
+            acc.put(i, ds, cached=True)
+            hits += 1
+    if rejected:
+        import warnings
+        warnings.warn(f"sweep: {len(rejected)} damaged cache entr{'y' if len(rejected) == 1 else 'ies'} "
+                      f"in {cdir} computed again: {'; '.join(rejected)}", CacheWarning, stacklevel=3)
+    return hits, todo, rejected
 
 
 # attributes that differ per scene or are replaced by the sweep's own

@@ -42,7 +42,6 @@ import math
 from pathlib import Path
 import re
 import tomllib
-import warnings
 
 import numpy as np
 
@@ -225,14 +224,6 @@ SCHEMA: dict[str, dict[str, tuple]] = {
         "max_memory_mb": (4000.0, _NUM, "pos", "refuse a scene whose output needs more memory, MB"),
     },
 }
-MAX_SPEED_FACTOR = 3e6
-"""n·d_m (r/min × mm) above which no ball bearing runs: about 1e6 is the usual oil-lubricated
-limit, 3e6 the highest in special designs (Harris & Kotzalas, *Rolling Bearing Analysis*, 5th
-ed., 2007, vol. 1, ch. 1)."""
-MAX_SENSOR_HZ = 1e6
-MAX_SUPPORT_DEFLECTION = 1e-3
-"""m: a shaft or mount spring that gives more than this under the load and the weights holds
-no bearing; the model's small-displacement geometry fails long before."""
 DEFECT_KEYS = {"race", "shape", "length_mm", "width_mm", "depth_mm", "offset_mm", "skew_deg",
                "angle_deg", "vertices_mm", "diameter_mm", "contact_model"}
 
@@ -344,22 +335,9 @@ class Scene:
             defects.append(defect)
         scene = cls(d, bearing, tuple(defects))
         scene._check_physics()
-        scene._warn_off_track()
+        from .limits import warn_off_track
+        warn_off_track(scene)
         return scene
-
-    def _warn_off_track(self):
-        """A defect the balls never touch makes a healthy bearing: say so (a 5 for a 0.5?)."""
-        from .auto import MISS_DELTA
-        for i, defect in enumerate(self.defects):
-            if not defect.misses_track(self.bearing, MISS_DELTA, clearance=self.clearance):
-                continue
-            where = "defect" if len(self.defects) == 1 else f"defect[{i}]"
-            raw = self.data["defect"][i]
-            warnings.warn(f"{where} misses the ball track: no part of it comes within reach of the "
-                          f"balls (offset_mm={raw.get('offset_mm', 0)}, width_mm="
-                          f"{raw.get('width_mm', '-')}, skew_deg={raw.get('skew_deg', 0)}), so "
-                          "this simulates a healthy bearing; check defect.offset_mm",
-                          SceneWarning, stacklevel=3)
 
     def replace(self, **overrides) -> "Scene":
         """Return a new scene with ``--set``-style overrides (``{"load.radial_n": 480}``)."""
@@ -396,41 +374,8 @@ class Scene:
             raise SceneError(f"output.sample_rate_hz={self.fs_out:g} is below 1 kHz: too coarse for bearing vibration")
         if d["output"]["duration_s"] > 600:
             raise SceneError(f"output.duration_s={d['output']['duration_s']:g} s exceeds 600 s; split the run")
-        n_out = round(self.duration * self.fs_out)
-        if n_out < 2:
-            raise SceneError(f"output.duration_s={self.duration:g} s at output.sample_rate_hz="
-                             f"{self.fs_out:g} gives {n_out} sample(s); a record needs at least 2")
-        if d["output"]["oversample"] < 2:
-            raise SceneError(f"output.oversample={d['output']['oversample']}: the anti-alias filter "
-                             "needs a fine grid at least twice the output rate (use 2 or more; "
-                             "default 8)")
-        self._check_speed_and_supports()
-        f_sensor = d["sensor"]["frequency_hz"]
-        if f_sensor > MAX_SENSOR_HZ:
-            raise SceneError(f"sensor.frequency_hz={f_sensor:g}: no mounted accelerometer resonates "
-                             f"above {MAX_SENSOR_HZ:.0e} Hz (typical mounted resonances: 5-60 kHz)")
-
-    def _check_speed_and_supports(self):
-        d, b = self.data, self.bearing
-        dm_mm = b.pitch_diameter * 1e3
-        rpm = float(np.max(self.speed_profile()[1]))
-        if rpm * dm_mm > MAX_SPEED_FACTOR:
-            raise SceneError(f"speed {rpm:g} r/min: n·d_m = {rpm * dm_mm:.3g} mm/min is beyond any "
-                             f"ball bearing (at most {MAX_SPEED_FACTOR:.0e}; this bearing's limit is "
-                             f"{MAX_SPEED_FACTOR / dm_mm:.0f} r/min)")
-        m_i, m_o, m_b = self.masses()
-        g = d["gravity"]["g_m_s2"] if d["gravity"]["enabled"] else 0.0
-        load = max(d["load"]["radial_n"], d["load"]["step_radial_n"] or 0.0)
-        force = load + (m_i + m_o + b.n_balls * m_b) * g
-        for sec in ("shaft", "mount"):
-            for axis in ("x", "y"):
-                k = d[sec][f"stiffness_{axis}_n_m"]
-                if force / k > MAX_SUPPORT_DEFLECTION:
-                    raise SceneError(f"{sec}.stiffness_{axis}_n_m={k:g}: under {force:.3g} N (load "
-                                     f"and weights) this support would deflect {force / k:.3g} m; a "
-                                     f"bearing support deflects less than "
-                                     f"{MAX_SUPPORT_DEFLECTION * 1e3:g} mm (stiffness at least "
-                                     f"{force / MAX_SUPPORT_DEFLECTION:.3g} N/m)")
+        from .limits import check_limits
+        check_limits(self)
 
     # ---- SI accessors
     @property
