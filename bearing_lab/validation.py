@@ -377,20 +377,9 @@ def _bounds(b) -> str:
 
 
 def _clean(v):
-    """JSON-safe: NaN/inf -> None, numpy scalars -> Python."""
-    if isinstance(v, dict):
-        return {k: _clean(x) for k, x in v.items()}
-    if isinstance(v, (list, tuple)):
-        return [_clean(x) for x in v]
-    if isinstance(v, (np.bool_, bool)):
-        return bool(v)
-    if isinstance(v, (np.integer,)):
-        return int(v)
-    if isinstance(v, (float, np.floating)):
-        return float(v) if math.isfinite(v) else None
-    if isinstance(v, np.ndarray):
-        return _clean(v.tolist())
-    return v
+    """JSON-safe: NaN/inf -> None, numpy scalars -> Python (one rule for every JSON output)."""
+    from ._json import clean
+    return clean(v)
 
 
 @dataclass
