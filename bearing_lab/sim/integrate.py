@@ -28,7 +28,7 @@ import xarray as xr
 from scipy import signal
 
 from .. import __version__
-from ..errors import SolverError
+from ..errors import BearingLabError, SolverError
 from . import _kernels as K
 from .assembly import assemble
 from .scene import load_scene
@@ -228,7 +228,7 @@ def _assemble(sc):
         with np.errstate(all="ignore"):
             return assemble(sc)
     except (ValueError, ArithmeticError, RuntimeError) as exc:
-        if isinstance(exc, SolverError):
+        if isinstance(exc, BearingLabError):  # already one clear line (a SceneError, ...)
             raise
         raise SolverError(f"scene {sc.name!r}: no static equilibrium found for the initial state "
                           f"({type(exc).__name__}: {exc}); the load, speed, clearance or support "

@@ -19,9 +19,10 @@ limit, 3e6 the highest in special designs (Harris & Kotzalas, *Rolling Bearing A
 ed., 2007, vol. 1, ch. 1)."""
 MAX_SENSOR_HZ = 1e6
 """Hz: mounted accelerometer resonances lie between a few and some tens of kHz."""
-MAX_SUPPORT_DEFLECTION = 1e-3
-"""m: a shaft or mount spring that gives more than this under the load and the weights holds
-no bearing; the model's small-displacement geometry fails long before."""
+MAX_SUPPORT_DEFLECTION = 1e-2
+"""m: a shaft or mount spring that sags more than this under the load and the weights holds no
+bearing (a 100 N/m shaft spring put both rings 1.5 m off centre, and softer ones made the
+solver fail at its first step)."""
 
 
 def check_limits(scene) -> None:
@@ -53,18 +54,27 @@ def _check_speed(scene) -> None:
 
 
 def _check_supports(scene) -> None:
+    """The springs that carry the load to ground must not sag more than a centimetre.
+
+    With ``load.path = "bearing"`` the loaded ring's own spring is preloaded to its static
+    position, so the load reaches ground through the other ring's spring; with "springs"
+    both share it.
+    """
     d, b = scene.data, scene.bearing
     m_i, m_o, m_b = scene.masses()
     g = d["gravity"]["g_m_s2"] if d["gravity"]["enabled"] else 0.0
     load = max(d["load"]["radial_n"], d["load"]["step_radial_n"] or 0.0)
     force = load + (m_i + m_o + b.n_balls * m_b) * g
-    for sec in ("shaft", "mount"):
+    carrying = ("shaft", "mount")
+    if d["load"]["path"] == "bearing":
+        carrying = ("shaft",) if d["load"]["on"] == "outer" else ("mount",)
+    for sec in carrying:
         for axis in ("x", "y"):
             k = d[sec][f"stiffness_{axis}_n_m"]
             if force / k > MAX_SUPPORT_DEFLECTION:
                 raise SceneError(f"{sec}.stiffness_{axis}_n_m={k:g}: under {force:.3g} N (load "
-                                 f"and weights) this support would deflect {force / k:.3g} m; a "
-                                 f"bearing support deflects less than "
+                                 f"and weights) this support would sag {force / k:.3g} m; a "
+                                 f"bearing support gives less than "
                                  f"{MAX_SUPPORT_DEFLECTION * 1e3:g} mm (stiffness at least "
                                  f"{force / MAX_SUPPORT_DEFLECTION:.3g} N/m)")
 
