@@ -113,6 +113,15 @@ def test_guard_stops_a_hang_and_survives_a_crash(tmp_path):
     with pytest.raises(RecordingError, match="x.nc: damaged sizes"):
         guarded(p, "HDF5", _raise_memory, str(p))
     assert guarded(p, "HDF5", os.path.getsize, str(p)) == 1
+    import threading  # other threads (Dask, tqdm, a notebook) must not switch the guard off
+    stop = threading.Event()
+    busy = threading.Thread(target=stop.wait, daemon=True)
+    busy.start()
+    try:
+        with pytest.raises(RecordingError, match="did not finish"):
+            guarded(p, "netCDF-C", _sleep_forever, str(p), timeout=1.0)
+    finally:
+        stop.set()
 
 
 # ------------------------------------------------------------------ netCDF
