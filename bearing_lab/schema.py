@@ -1,4 +1,4 @@
-"""The Dataset contract shared by recordings and simulations (contract.md).
+"""The Dataset contract shared by recordings and simulations.
 
 Measured and simulated data meet here: every reader and the simulator return a
 Dataset that passes :func:`check_dataset`, so analysis, comparison and report
@@ -7,7 +7,11 @@ never ask where the data came from.
 - coordinate ``time`` in s, uniformly sampled (or flagged as uneven);
 - global attributes ``sampling_rate_hz``, ``bearing_lab_version`` and, where
   known, ``shaft_speed_rpm``;
-- every data variable carries a CF-style ``units`` attribute in SI.
+- every data variable carries a CF-style ``units`` attribute in SI and a
+  ``quantity`` ("acceleration", "displacement", "force", ...);
+- the global attribute ``default_channel`` names the accelerometer signal, so code
+  above the analysis layer asks the Dataset which variable to use instead of naming
+  a reader's or the simulator's variable.
 """
 from __future__ import annotations
 
@@ -16,6 +20,11 @@ import numpy as np
 from .errors import BearingLabError
 
 SI_UNITS = {"m s-2", "m", "N", "Pa", "V", "m s-1", "1", "rad", "rad s-1", "K", "s"}
+
+#: the simulator's accelerometer signal (its Datasets' ``default_channel``)
+DEFAULT_CHANNEL = "outer_ring_acc_y"
+#: the ``quantity`` attribute of a simulated variable, from its SI unit
+QUANTITY_OF_UNITS = {"m s-2": "acceleration", "m": "displacement", "N": "force", "rad s-1": "angular velocity"}
 
 SIMULATION_VARIABLES = {
     "outer_ring_acc_y": "m s-2",
@@ -54,7 +63,14 @@ def check_dataset(ds, *, kind: str | None = None) -> None:
             problems.append(f"variable {name!r} has no 'units' attribute")
         if var.dtype.kind == "f" and var.size and not np.all(np.isfinite(var.values)):
             problems.append(f"variable {name!r} holds NaN or Inf")
+    if ds.data_vars and "default_channel" in ds.attrs and ds.attrs["default_channel"] not in ds.data_vars:
+        problems.append(f"default_channel {ds.attrs['default_channel']!r} is not a variable")
     if kind == "simulation":
+        if "default_channel" not in ds.attrs:
+            problems.append("simulation attribute 'default_channel' missing")
+        for name, var in ds.data_vars.items():
+            if "quantity" not in var.attrs:
+                problems.append(f"variable {name!r} has no 'quantity' attribute")
         for name, units in SIMULATION_VARIABLES.items():
             if name not in ds:
                 problems.append(f"simulation variable {name!r} missing")

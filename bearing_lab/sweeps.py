@@ -65,6 +65,7 @@ import uuid
 import numpy as np
 
 from . import __version__
+from .schema import DEFAULT_CHANNEL
 from .errors import BearingLabError, SceneError
 
 __all__ = ["sweep", "scene_hash", "code_fingerprint", "default_cache_dir", "dim_name", "key_units",
@@ -80,7 +81,7 @@ _UNIT_STRINGS = {
 _SIM_KW = {"duration": "output.duration_s", "fs": "output.sample_rate_hz", "rtol": "solver.rtol",
            "method": "solver.method", "step": "solver.step_s", "fidelity": "fidelity"}
 _METRICS = ("rms", "peak", "crest_factor", "kurtosis")
-_METRIC_SIGNAL = "outer_ring_acc_y"
+_METRIC_SIGNAL = DEFAULT_CHANNEL  # the simulator's accelerometer signal
 _REQUIRED = ("outer_ring_acc_y", "outer_ring_acc_x", "outer_ring_disp_y", "outer_ring_disp_x",
              "inner_ring_disp_y", "inner_ring_disp_x")
 

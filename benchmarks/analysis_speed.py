@@ -114,8 +114,10 @@ def main(argv=None):
           f"numpy {np.__version__}, scipy {scipy.__version__}\n")
     print("| pipeline | best of {0} (s) | median (s) | diagnosis / BPFO found |".format(args.repeat))
     print("|---|---|---|---|")
+    bpfo = r["fault_frequencies"]["bpfo"]["measured_hz"]
     print(f"| bearing_lab analyze (kurtogram + SES + speed + fault search + metrics) | {b_best:.3f} | "
-          f"{b_med:.3f} | {r['diagnosis']}, {r['fault_frequencies']['bpfo']['measured_hz']:.3f} Hz |")
+          f"{b_med:.3f} | {r['diagnosis']} ({r['verdict']}), "
+          f"{'-' if bpfo is None else f'{bpfo:.3f}'} Hz |")
     print(f"| scipy-only (Butterworth filter-bank kurtogram + hilbert SES + argmax + metrics) | "
           f"{s_best:.3f} | {s_med:.3f} | -, {found['bpfo']:.3f} Hz |")
     print(f"\nspeed-up: {s_med / b_med:.1f}x (median); target for analyze: < 0.5 s")

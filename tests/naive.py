@@ -73,3 +73,44 @@ def interpolated_peak_frequency(x, fs, f_lo, f_hi, pad=8):
     a, b, c = np.log(spec[i - 1:i + 2])
     p = 0.5 * (a - c) / (a - 2 * b + c)
     return f[i] + p * (f[1] - f[0])
+
+
+def spectral_coherence_at(x, fs, alpha, nw):
+    """Cyclic spectral coherence magnitude at one cyclic frequency, averaged over f (brute force).
+
+    Welch cross-spectrum of x(t) and x(t) exp(-2j pi alpha t) with Hann frames of nw
+    samples and half overlap, normalised by the two power spectra (the textbook
+    definition, Antoni 2009), magnitude averaged over the interior bins.
+    """
+    x = np.asarray(x, float) - np.mean(x)
+    t = np.arange(x.size) / fs
+    y = x * np.exp(-2j * np.pi * alpha * t)
+    w = np.hanning(nw + 1)[:-1]
+    sxy = np.zeros(nw, complex)
+    sxx = np.zeros(nw)
+    syy = np.zeros(nw)
+    for start in range(0, x.size - nw + 1, nw // 2):
+        X = np.fft.fft(w * x[start:start + nw])
+        Y = np.fft.fft(w * y[start:start + nw])
+        sxy += X * np.conj(Y)
+        sxx += np.abs(X) ** 2
+        syy += np.abs(Y) ** 2
+    coh = np.abs(sxy) / np.sqrt(sxx * syy)
+    return float(np.mean(coh[1:nw // 2]))
+
+
+def resample_at_angle(x, fs, pulse_times, pulses_per_rev=1):
+    """Order tracking the slow way: shaft angle by linear interpolation between pulses,
+    then linear interpolation of x at each equal-angle instant."""
+    p = np.asarray(pulse_times, float)
+    revs = np.arange(p.size) / pulses_per_rev
+    shaft = revs[-1] / (p[-1] - p[0])
+    out = []
+    a = revs[0]
+    while a <= revs[-1]:
+        t = np.interp(a, revs, p)
+        if t * fs > x.size - 1:
+            break
+        out.append(np.interp(t * fs, np.arange(x.size), x))
+        a += shaft / fs
+    return np.array(out), float(shaft)

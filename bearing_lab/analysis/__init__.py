@@ -17,15 +17,20 @@ squared_envelope_spectrum(x, fs, *, window, band, prewhiten, fmax, axis) -- (f, 
 fast_kurtogram(x, fs, *, nlevel, min_bandwidth, fmin)   -- Kurtogram(kurtosis, levels, frequency, band, level, kurtosis_max)
 envelope_band(x, fs, *, frequency_range, min_bandwidth) -- (band, score): band with the strongest SES line family
 interpolated_peak(X, k, *, method)                      -- fractional bin of a DFT line (Quinn, Jacobsen, Hann)
-shaft_frequency(x, fs, *, window, rpm, ...)             -- (shaft Hz, number of harmonics used)
+shaft_frequency(x, fs, *, window, rpm, ...)             -- (shaft Hz, number of harmonics used): strongest 1x family
+shaft_speed(x, fs, *, bearing, rpm, rpm_source)         -- dict: speed checked against the bearing's fault combs
+tacho_pulses(tacho, fs)                                 -- pulse times of a once-per-rev signal, s
+tacho_speed(pulse_times, *, pulses_per_rev)             -- (mean shaft Hz, per-revolution Hz, variation)
+order_track(x, fs, pulse_times, *, pulses_per_rev)      -- (signal at constant shaft angle, mean shaft Hz)
+enhanced_envelope_spectrum(x, fs, *, alpha_max, nw)     -- (alpha, EES): cyclic spectral coherence averaged over f
 fault_line(f, ses, expected_hz, *, shaft_hz, tolerance, ...) -- dict: measured_hz, snr_db, harmonics, sidebands
-diagnose_ses(f, ses, fault_hz, *, shaft_hz, tolerance)  -- (diagnosis, lines per fault)
+diagnose_ses(f, ses, fault_hz, *, shaft_hz, tolerance)  -- (diagnosis, families): the family rule on one SES
 excitation_period(x, fs, *, frequency_range, band, method) -- (period s, lines or impulses used)
 excitation_duration(x, fs, *, level=0.1, baseline="median", axis=-1) -- (duration s, entry s, exit s) of one pulse
 impulses(x, fs, *, band, threshold, min_separation, level) -- Impulses(time, peak, duration, entry, exit, resolved)
 rms, peak, peak_to_peak, crest_factor, kurtosis, impulse_factor, clearance_factor, shape_factor (x, *, axis)
 metrics(x, *, axis=-1, units="1")                       -- dict of the eight metrics + "units"
-analyze(x, fs, *, bearing, rpm, shaft_hz, channel, units, ...) -- dict in contract.md's analyze --json schema
+analyze(x, fs, *, bearing, rpm, rpm_source, shaft_hz, tacho, ...) -- dict: speed, graded verdict and evidence (docs/analysis.md)
 plot_analysis(x, fs, *, bearing, ..., path)             -- (figure, result): waveform, spectrum, SES with markers
 xr                                                      -- xarray wrappers of the above (apply_ufunc, dask-friendly)
 """
@@ -36,7 +41,9 @@ from ._faults import diagnose_ses, fault_line  # noqa: F401
 from ._impulse import excitation_duration, excitation_period, impulses, Impulses  # noqa: F401
 from ._metrics import (clearance_factor, crest_factor, impulse_factor, kurtosis, metrics,  # noqa: F401
                        peak, peak_to_peak, rms, shape_factor)
-from .pipeline import analyze, plot_analysis  # noqa: F401
+from ._cyclo import enhanced_envelope_spectrum  # noqa: F401
+from ._tacho import order_track, tacho_pulses, tacho_speed  # noqa: F401
+from .pipeline import analyze, plot_analysis, shaft_speed  # noqa: F401
 from . import accessor as _accessor  # noqa: F401  (registers da.bearing)
 from . import xr  # noqa: F401
 
@@ -45,4 +52,5 @@ __all__ = ["amplitude_spectrum", "welch_psd", "cepstral_prewhitening", "bandpass
            "interpolated_peak", "shaft_frequency", "fault_line", "diagnose_ses", "excitation_period",
            "excitation_duration", "impulses", "Impulses", "rms", "peak", "peak_to_peak", "crest_factor",
            "kurtosis", "impulse_factor", "clearance_factor", "shape_factor", "metrics", "analyze",
-           "plot_analysis", "xr"]
+           "plot_analysis", "xr", "shaft_speed", "tacho_pulses", "tacho_speed", "order_track",
+           "enhanced_envelope_spectrum"]

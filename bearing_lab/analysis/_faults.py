@@ -175,7 +175,11 @@ def fault_line(f, ses, expected_hz, *, shaft_hz=None, tolerance=0.02, n_harmonic
 
 def diagnose_ses(f, ses, fault_hz, *, shaft_hz=None, tolerance=0.02, n_harmonics=5,
                  floor_width_hz=10.0):
-    """Search BPFO, BPFI, 2 BSF and FTF in one SES and name the fault.
+    """Search BPFO, BPFI, 2 BSF and FTF families in one SES and name the fault.
+
+    The family rule of :func:`bearing_lab.analysis.analyze` applied to one
+    spectrum (harmonics, sidebands, decoys when ``shaft_hz`` is given, and the
+    leader against its rivals); ``analyze`` itself combines three such routes.
 
     Parameters
     ----------
@@ -185,17 +189,22 @@ def diagnose_ses(f, ses, fault_hz, *, shaft_hz=None, tolerance=0.02, n_harmonics
         Kinematic frequencies with keys ``bpfo``, ``bpfi``, ``bsf``, ``ftf`` (Hz),
         e.g. ``get_bearing("6205").fault_frequencies(shaft_hz)``.
     shaft_hz : float, optional
-        Shaft frequency (masks its harmonics; inner-race sidebands).
+        Shaft frequency (masks its harmonics; inner- and outer-race sidebands;
+        scale of the decoys, which are skipped without it).
     tolerance, n_harmonics, floor_width_hz
         As in :func:`fault_line`.
 
     Returns
     -------
     diagnosis : str
-        ``"outer_race"``, ``"inner_race"``, ``"ball"`` or ``"none"``.
+        ``"outer_race"``, ``"inner_race"``, ``"ball"``, ``"uncertain"`` (two
+        families each on lines of their own, or a ball family without cage
+        modulation) or ``"none"``.
     lines : dict
-        :func:`fault_line` result per key (``bsf`` is searched at 2 BSF and its
-        ``expected_hz`` is 2 BSF; ``measured_hz`` likewise).
+        Per key: ``expected_hz``, ``measured_hz``, ``snr_db``, ``harmonics``,
+        ``groups``, ``sidebands``, ``evidence_db``, ``decoy_max_db``, ``detected``,
+        ``lines`` and ``units`` (``bsf`` is searched at 2 BSF: its
+        ``expected_hz`` and ``measured_hz`` are 2 BSF).
 
     Examples
     --------
@@ -206,25 +215,20 @@ def diagnose_ses(f, ses, fault_hz, *, shaft_hz=None, tolerance=0.02, n_harmonics
     >>> bpfo = 3.5848 * fr
     >>> x = np.exp(-900 * (t % (1 / bpfo))) * np.sin(2 * np.pi * 3000 * t)
     >>> x = x + np.random.default_rng(0).normal(0, 0.3, t.size)
-    >>> f, ses = squared_envelope_spectrum(x, fs, window="hann", band=(2000, 4000), fmax=1000)
+    >>> f, ses = squared_envelope_spectrum(x, fs, window="hann", band=(2000, 4000), fmax=1300)
     >>> ff = get_bearing("6205").fault_frequencies(fr)
     >>> diagnose_ses(f, ses, ff, shaft_hz=fr)[0]
     'outer_race'
     """
-    f = np.asarray(f, float)
-    ses = np.asarray(ses, float)
+    from ._families import CyclicSpectrum, route_verdict, search_families
+
     missing = [k for k in FAULT_KEYS if k not in fault_hz]
     if missing:
         raise AnalysisError(f"diagnose_ses: fault_hz lacks {missing}; give bpfo, bpfi, bsf and ftf in Hz")
-    df = f[1] - f[0]
-    snr = line_floor_db(ses, width=max(21, int(round(floor_width_hz / df))))
-    lines = {}
-    for key in FAULT_KEYS:
-        expected = 2 * fault_hz[key] if key == "bsf" else fault_hz[key]
-        lines[key] = fault_line(f, ses, expected, shaft_hz=shaft_hz, tolerance=tolerance,
-                                n_harmonics=n_harmonics, sidebands=(key == "bpfi"),
-                                floor_width_hz=floor_width_hz, snr_db=snr)
-    cands = [(lines[k]["evidence_db"], k) for k in DIAGNOSES if lines[k]["detected"]]
-    if not cands:
-        return "none", lines
-    return DIAGNOSES[max(cands)[1]], lines
+    cs = CyclicSpectrum(f, ses, floor_width_hz=floor_width_hz)
+    fams = search_families(cs, fault_hz, shaft_hz=shaft_hz, tolerance=tolerance, n_harmonics=n_harmonics,
+                           decoys=shaft_hz is not None)
+    verdict = route_verdict(fams, cs.masked(shaft_hz), shaft_hz=shaft_hz, ftf_hz=fault_hz["ftf"],
+                            n_harmonics=n_harmonics)
+    units = {"expected_hz": "Hz", "measured_hz": "Hz", "snr_db": "dB", "evidence_db": "dB"}
+    return verdict["verdict"], {k: dict(v, units=units) for k, v in fams.items()}

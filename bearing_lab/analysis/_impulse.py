@@ -315,7 +315,7 @@ def excitation_period(x, fs, *, frequency_range, band=None, method="ses", n_harm
     each): exactly periodic impacts 1e-8 without noise, <= 4e-6 at -10 dB and
     <= 1.5e-5 at -20 dB per-sample SNR.  With random slip (jitter sigma per
     interval) the period itself is defined only to sigma / sqrt(n_impacts)
-    (~3e-4 at 1 %, reference.md); the SES estimate stays within about 1.5 times
+    (~3e-4 at 1 %); the SES estimate stays within about 1.5 times
     3 sigma of the nominal period (RMS over seeds below 3 sigma), down to -20 dB
     at 1 % jitter and -10 dB at 2 %.  The SES peak of a slipping train is
     broadened, so the error is bin-limited (~1e-3 at 2 %); where impacts are

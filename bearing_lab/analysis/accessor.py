@@ -65,7 +65,7 @@ class BearingAccessor:
         return _x.metrics(self._da, **kw)
 
     def analyze(self, *, bearing, dim="time", fs=None, **kw):
-        """:func:`bearing_lab.analysis.analyze` of a 1-D DataArray (dict, contract.md schema)."""
+        """:func:`bearing_lab.analysis.analyze` of a 1-D DataArray (dict, see docs/analysis.md)."""
         from .pipeline import analyze
         fs = _x.sampling_rate(self._da, dim=dim, fs=fs)
         return analyze(self._da.transpose(dim).values, fs, bearing=bearing,

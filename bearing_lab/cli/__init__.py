@@ -4,7 +4,7 @@ Each sub-command lives in its own module in this package and exposes
 ``register(subparsers)``; that function adds its parser and sets ``func`` to a
 callable taking the parsed ``args`` and returning an exit status.  Errors that
 bearing_lab raises on purpose (:class:`bearing_lab.errors.BearingLabError`) are
-printed as one line on stderr with exit status 2 (contract.md).
+printed as one line on stderr with exit status 2.
 """
 from __future__ import annotations
 
@@ -21,6 +21,7 @@ COMMAND_MODULES = [
     "analyze",    # analyze
     "study",      # study
     "validate",   # validate
+    "case",       # case new, case standin
     "bench",      # bench
     "sweep",      # sweep (bearing_lab.sweep on Dask)
 ]

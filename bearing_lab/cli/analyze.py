@@ -1,63 +1,84 @@
-"""Sub-command ``analyze``: metrics, shaft speed, fault lines and diagnosis of one channel.
+"""Sub-command ``analyze``: metrics, shaft speed, fault families and a graded diagnosis of one channel.
 
-Why here: the CLI only reads, picks a channel and prints; the analysis is
-:func:`bearing_lab.analysis.analyze`, so the JSON printed here is exactly what a
-script gets from Python (contract.md's ``analyze --json`` schema).
+Why here: the CLI only reads, picks a channel and the speed prior, and prints;
+the analysis is :func:`bearing_lab.analysis.analyze`, so the JSON printed here is
+exactly what a script gets from Python (``docs/analysis.md`` describes it).
 
-``--rpm`` is a nominal speed used as a prior; ``--rpm file`` takes the file's
-stored ``shaft_speed_rpm`` (only when asked: stored speeds are nominal).
+Speed: by default the file's stored speed (``shaft_speed_rpm``: CWRU ``X###RPM``,
+MFPT ``rate``, simulations) is the prior (``speed_source`` "file"); ``--rpm R``
+gives one ("given"); ``--rpm none`` ignores any stored speed (blind); a tacho
+channel, named with ``--tacho`` or found by its name (tacho, tach, keyphasor,
+once-per-rev), is used first.
 """
 from __future__ import annotations
 
-from pathlib import Path
 import sys
+import re
+from pathlib import Path
 
 from ..errors import AnalysisError, RecordingError
+
+TACHO_NAME = re.compile(r"^(tacho?|tach|tachometer|keyphasor|key_phasor|kph|once[-_ ]?per[-_ ]?rev|1/rev)\d*$",
+                        re.IGNORECASE)
 
 
 def register(subparsers):
     p = subparsers.add_parser(
-        "analyze", help="metrics, shaft speed, fault frequencies and diagnosis of one channel",
-        description="Analyse one channel of a recording or a bearing_lab .nc file: metrics, shaft "
-                    "speed (from the signal), bearing fault lines in the squared envelope spectrum "
-                    "and a diagnosis (outer_race, inner_race, ball or none).")
+        "analyze", help="metrics, shaft speed, fault families and a graded diagnosis of one channel",
+        description="Analyse one channel of a recording or a bearing_lab .nc file: metrics, shaft speed "
+                    "(stored, given, from a tacho or from the signal), bearing fault families in three "
+                    "envelope spectra, and a verdict: diagnosed (outer_race, inner_race or ball), "
+                    "uncertain (with the candidates and the evidence) or no fault evidence.")
     p.add_argument("file", help="a recording (any format bearing-lab import reads) or a .nc")
     p.add_argument("--channel", "-c", default=None,
                    help="variable to analyse (default: the file's default channel, else the first)")
     p.add_argument("--bearing", "-b", default=None,
                    help="catalog bearing, e.g. 6205, 6203, 6308, ZA-2115, MFPT "
                         "(default: from the file's 'bearing' attribute)")
+    p.add_argument("--fs", type=float, default=None, metavar="HZ",
+                   help="sampling rate in Hz, for files that store none (CWRU records outside the "
+                        "registry, bare text); overrides a stored rate")
     p.add_argument("--rpm", default=None,
-                   help="nominal shaft speed in r/min (a prior for the estimate), or 'file' to use "
-                        "the file's stored shaft_speed_rpm")
-    p.add_argument("--json", action="store_true", help="print the result as JSON (contract.md)")
+                   help="shaft speed in r/min used as a prior; 'none' ignores a stored speed (blind "
+                        "estimate); 'file' requires the stored one (default: the stored speed if the "
+                        "file has one, else blind)")
+    p.add_argument("--tacho", default=None, metavar="CHANNEL",
+                   help="tacho channel (once-per-rev pulses) giving the speed; 'none' ignores one "
+                        "(default: a channel named tacho, tach, keyphasor or once-per-rev)")
+    p.add_argument("--pulses-per-rev", type=int, default=1, help="tacho pulses per revolution (default 1)")
+    p.add_argument("--json", action="store_true", help="print the result as JSON (fields described in the analysis documentation, docs/analysis.md)")
     p.add_argument("--plot", metavar="FILE.png", default=None,
-                   help="also write a figure: waveform, spectrum, SES with fault-frequency markers")
+                   help="also write a figure: waveform, spectrum, envelope spectrum with fault markers")
     p.set_defaults(func=run)
     return p
 
 
-def _open(path: Path):
-    try:
-        from ..io import open_recording
-    except ImportError:
-        open_recording = None
+def _open(path: Path, fs):
+    """(Dataset, sampling rate, note) with ``--fs`` passed to the reader or overriding the file."""
+    from ..io import open_recording
     if not path.is_file():
         raise RecordingError(f"{path}: no such file")
-    if open_recording is not None:
-        return open_recording(path)
-    if path.suffix == ".nc":
-        import xarray as xr
-        try:
-            return xr.open_dataset(path)
-        except (OSError, ValueError) as exc:
-            raise RecordingError(f"{path}: cannot read as netCDF: {exc}") from None
-    raise RecordingError(f"{path}: recording import (bearing_lab.io.open_recording) is not available "
-                         "in this installation; give a .nc file")
+    if fs is None:
+        ds = open_recording(path)
+        return ds, None, ""
+    if not fs > 0:
+        raise AnalysisError(f"--fs {fs!r} must be a positive sampling rate in Hz")
+    try:
+        return open_recording(path, fs=fs), fs, ""
+    except RecordingError as exc:
+        if "does not understand option" not in str(exc):
+            raise
+    ds = open_recording(path)
+    stored = ds.attrs.get("sampling_rate_hz")
+    return ds, fs, f"--fs {fs:g} Hz overrides the file's {stored} Hz"
+
+
+def _time_channels(ds):
+    return [v for v, da in ds.data_vars.items() if "time" in da.dims and da.ndim == 1]
 
 
 def _pick_channel(ds, name, path):
-    candidates = [v for v, da in ds.data_vars.items() if "time" in da.dims and da.ndim == 1]
+    candidates = _time_channels(ds)
     if name is not None:
         if name not in ds.data_vars:
             raise AnalysisError(f"{path}: no channel {name!r}; the file has {', '.join(map(str, ds.data_vars))}")
@@ -68,12 +89,20 @@ def _pick_channel(ds, name, path):
     default = ds.attrs.get("default_channel")
     if default in candidates:
         return default
-    for pref in ("outer_ring_acc_y", "outer_ring_acc_x"):
-        if pref in candidates:
-            return pref
+    candidates = [c for c in candidates if not TACHO_NAME.match(str(c))]
     if not candidates:
         raise AnalysisError(f"{path}: no 1-D time signal to analyse")
     return candidates[0]
+
+
+def _tacho(ds, value, channel, path):
+    """Name of the tacho channel to use, or None."""
+    if value is not None and value.lower() == "none":
+        return None
+    if value is not None:
+        return _pick_channel(ds, value, path)
+    hits = [c for c in _time_channels(ds) if TACHO_NAME.match(str(c)) and c != channel]
+    return hits[0] if hits else None
 
 
 def _bearing_name(ds, given, path):
@@ -94,19 +123,24 @@ def _bearing_name(ds, given, path):
 
 
 def _rpm(ds, value, path):
+    """(rpm or None, rpm_source)."""
+    stored = ds.attrs.get("shaft_speed_rpm")
     if value is None:
-        return None
-    if str(value).lower() == "file":
-        if "shaft_speed_rpm" not in ds.attrs:
+        return (float(stored), "file") if stored else (None, "given")
+    text = str(value).lower()
+    if text == "none":
+        return None, "given"
+    if text == "file":
+        if not stored:
             raise AnalysisError(f"{path}: --rpm file given but the file stores no shaft_speed_rpm")
-        return float(ds.attrs["shaft_speed_rpm"])
+        return float(stored), "file"
     try:
         rpm = float(value)
     except ValueError:
-        raise AnalysisError(f"--rpm {value!r} is not a number (r/min) nor 'file'") from None
+        raise AnalysisError(f"--rpm {value!r} is not a number (r/min), 'file' nor 'none'") from None
     if not rpm > 0:
         raise AnalysisError(f"--rpm {value!r} must be a positive speed in r/min")
-    return rpm
+    return rpm, "given"
 
 
 def run(args) -> int:
@@ -116,15 +150,19 @@ def run(args) -> int:
     from ..analysis.xr import sampling_rate
 
     path = Path(args.file)
-    ds = _open(path)
+    ds, fs, note = _open(path, args.fs)
     name = _pick_channel(ds, args.channel, path)
     da = ds[name]
-    fs = float(ds.attrs["sampling_rate_hz"]) if "sampling_rate_hz" in ds.attrs else sampling_rate(da)
+    if fs is None:
+        fs = float(ds.attrs["sampling_rate_hz"]) if "sampling_rate_hz" in ds.attrs else sampling_rate(da)
     bearing = _bearing_name(ds, args.bearing, path)
-    rpm = _rpm(ds, args.rpm, path)
+    rpm, rpm_source = _rpm(ds, args.rpm, path)
+    tacho_name = _tacho(ds, args.tacho, name, path)
     x = np.asarray(da.values, dtype=float)
     units = da.attrs.get("units", "1")
-    kw = dict(bearing=bearing, rpm=rpm, channel=str(name), units=units)
+    kw = dict(bearing=bearing, rpm=rpm, rpm_source=rpm_source, channel=str(name), units=units,
+              pulses_per_rev=args.pulses_per_rev,
+              tacho=None if tacho_name is None else np.asarray(ds[tacho_name].values, float))
     import warnings
     with np.errstate(all="ignore"), warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # overflow is reported once, below
@@ -132,7 +170,10 @@ def run(args) -> int:
             _, result = plot_analysis(x, fs, path=args.plot, **kw)
         else:
             result = analyze(x, fs, **kw)
-    bad = [k for k, v in result.get("metrics", {}).items() if v is None or not np.isfinite(v)]
+    if note:
+        result["notes"] = [note]
+    bad = [k for k, v in result.get("metrics", {}).items()
+           if not isinstance(v, (int, float)) or not np.isfinite(v)]
     if bad:
         print(f"bearing-lab analyze: warning: {path.name} [{name}]: metrics {', '.join(bad)} are not "
               f"finite (the largest |value| is {np.max(np.abs(x)):.3g} {units}): reported as null",
@@ -141,19 +182,47 @@ def run(args) -> int:
         from .._json import dumps
         print(dumps(result, indent=1))  # no NaN/Infinity tokens: strict parsers read it
         return 0
+    _print(result, path, name, fs, bearing, units, tacho_name, note, args.plot)
+    return 0
+
+
+def _print(result, path, name, fs, bearing, units, tacho_name, note, plot):
+    sp = result["speed"]
+    ev = result["evidence"]
+    print(f"{path.name} [{name}]  fs {fs:g} Hz  bearing {bearing}" + (f"  ({note})" if note else ""))
+    if result["speed_source"] == "unresolved":
+        print(f"shaft speed unresolved (speed_source unresolved): {sp['note']}")
+    else:
+        print(f"shaft {result['shaft_hz']:.3f} Hz ({60 * result['shaft_hz']:.1f} r/min), speed_source "
+              f"{result['speed_source']}" + (f" (tacho channel {tacho_name})" if tacho_name else "")
+              + f", {sp['status']}: {sp['note']}")
+    head = f"verdict: {result['verdict']}  diagnosis: {result['diagnosis']}"
+    if result["excitation_period_s"]:
+        head += f"  (excitation period {1e3 * result['excitation_period_s']:.4f} ms)"
+    print(head)
+    if ev.get("candidates") and result["verdict"] != "diagnosed":
+        print(f"  candidates: {', '.join(ev['candidates'])}")
+    if ev.get("runner_up"):
+        print(f"  runner-up: {ev['runner_up']} ({ev['margin_db']:.0f} dB less line evidence)")
+    print(f"  why: {ev['reason']}")
+    if ev.get("band") and ev["band"]["low_hz"] is not None:
+        b = ev["band"]
+        print(f"  demodulation band {b['low_hz']:.0f}-{b['high_hz']:.0f} Hz, spectral kurtosis "
+              f"{b['spectral_kurtosis']:.2f}{'' if b['impulsive'] else ' (not impulsive)'}")
+    for route, r in ev.get("routes", {}).items():
+        print(f"  route {route}: {r['verdict']} ({r['reason']})")
+    for r in ev.get("interpretations", []):
+        print(f"  could be {r['diagnosis']} with the shaft at {r['shaft_hz']:.2f} Hz ({r['rpm']:.0f} r/min)")
     ff = result["fault_frequencies"]
-    print(f"{path.name} [{name}]  fs {fs:g} Hz  bearing {bearing}  shaft {result['shaft_hz']:.3f} Hz "
-          f"({60 * result['shaft_hz']:.1f} r/min)")
-    print(f"diagnosis: {result['diagnosis']}"
-          + (f"  (excitation period {1e3 * result['excitation_period_s']:.4f} ms)"
-             if result["excitation_period_s"] else ""))
     for k in ("bpfo", "bpfi", "bsf", "ftf"):
         r = ff[k]
         meas = "-" if r["measured_hz"] is None else f"{r['measured_hz']:.2f} Hz"
         print(f"  {k.upper():4s} expected {r['expected_hz']:8.2f} Hz  found {meas:>11s}  "
-              f"SNR {r['snr_db']:5.1f} dB  harmonics {r['harmonics']}")
+              f"SNR {r['snr_db']:5.1f} dB  harmonics {r['harmonics']}  sidebands {r['sidebands']}"
+              + ("  detected" if r["detected"] else ""))
+    for flag in ev.get("flags", []):
+        print(f"  note: {flag}")
     m = result["metrics"]
     print("metrics: " + ", ".join(f"{k} {v:.4g}" for k, v in m.items()) + f"  (rms/peak in {units})")
-    if args.plot:
-        print(f"figure: {args.plot}")
-    return 0
+    if plot:
+        print(f"figure: {plot}")

@@ -77,6 +77,14 @@ def _cmd_import(args) -> int:
     from ..io_netcdf import check_output_path
     check_output_path(args.output)  # before reading: a bad -o is said at once
     ds = _open(args)
+    if args.rpm is not None:
+        import math
+        from ..errors import RecordingError
+        if not (math.isfinite(args.rpm) and args.rpm > 0):
+            raise RecordingError(f"--rpm {args.rpm:g}: give the shaft speed as a positive number of r/min")
+        old = ds.attrs.get("shaft_speed_rpm")
+        ds.attrs["shaft_speed_rpm"] = float(args.rpm)
+        ds.attrs["shaft_speed_source"] = "given at import (--rpm)" + (f"; the file stored {old:g}" if old else "")
     to_netcdf(ds, args.output)
     for w in get_warnings(ds):
         print(f"warning: {w}", file=sys.stderr)
@@ -216,6 +224,8 @@ def register(subparsers) -> None:
                               "CWRU/MFPT .mat, IMS, TDMS, MDF4) into SI units and write netCDF4.")
     p.add_argument("file", help="the recording")
     _add_read_options(p)
+    p.add_argument("--rpm", type=float, default=None,
+                   help="shaft speed, r/min, stored in the output (validation cases read it with speed = \"file\")")
     p.add_argument("-o", "--output", required=True, help="output .nc file")
     p.set_defaults(func=_cmd_import)
 

@@ -518,25 +518,42 @@ def _save(name, seed, index, keep: Path) -> Path:
 
 # ------------------------------------------------------------------ killed writers
 _WRITE_LOOP = """
-import sys, numpy as np, xarray as xr
-from bearing_lab.io import to_netcdf, to_uff58b
-target, kind, n = sys.argv[1], sys.argv[2], int(sys.argv[3])
+import sys
+from bearing_lab.io._fuzz import write_version
 k = 0
 while True:
     k += 1
-    t = np.arange(n) / 10000.0
-    ds = xr.Dataset({"acc": ("time", np.sin(t * (1 + k % 2)), {"units": "m s-2", "quantity":
-                     "acceleration", "original_units": "m/s2"})}, coords={"time": ("time", t,
-                     {"units": "s"})}, attrs={"sampling_rate_hz": 10000.0, "bearing_lab_version": "0",
-                     "source_file": "x", "source_sha256": "", "reader": "csv", "warnings": "",
-                     "default_channel": "acc"})
-    (to_netcdf if kind == "netcdf" else to_uff58b)(ds, target)
+    write_version(sys.argv[1], sys.argv[2], int(sys.argv[3]), k)
 """
 
 
-def _written_versions(n):
+def _version(n: int, k: int):
+    import xarray as xr
     t = np.arange(n) / 10000.0
-    return [np.sin(t * 1), np.sin(t * 2)]
+    return xr.Dataset({"acc": ("time", np.sin(t * (1 + k % 2)), {
+        "units": "m s-2", "quantity": "acceleration", "original_units": "m/s2"})},
+        coords={"time": ("time", t, {"units": "s"})},
+        attrs={"sampling_rate_hz": 10000.0, "bearing_lab_version": "0", "source_file": "x",
+               "source_sha256": "", "reader": "csv", "warnings": "", "default_channel": "acc"})
+
+
+def write_version(target, kind: str, n: int, k: int) -> None:
+    """Write version ``k`` (two alternating signals) of a test recording to ``target``."""
+    from . import to_netcdf, to_uff58b
+    (to_netcdf if kind == "netcdf" else to_uff58b)(_version(n, k), target)
+
+
+def _written_versions(n):
+    return [_version(n, k)["acc"].values for k in (1, 2)]
+
+
+def _wait_for_first_write(target: Path, proc, limit: float = 120.0) -> None:
+    t0 = time.perf_counter()
+    prefix = f".{target.name}."
+    while proc.poll() is None and time.perf_counter() - t0 < limit:
+        if any(p.name.startswith(prefix) for p in target.parent.iterdir()):
+            return
+        time.sleep(0.01)
 
 
 def kill_writes(target: Path, kills: int, *, kind: str = "netcdf", seed: int = 0,
@@ -550,11 +567,13 @@ def kill_writes(target: Path, kills: int, *, kind: str = "netcdf", seed: int = 0
     target = Path(target)
     rng = np.random.default_rng(seed)
     versions = _written_versions(n)
+    write_version(target, kind, n, 0)  # the existing output a killed writer must not destroy
     out = {"kills": kills, "intact": 0, "destroyed": 0, "never_written": 0, "examples": []}
     for _ in range(kills):
         proc = subprocess.Popen([sys.executable, "-c", _WRITE_LOOP, str(target), kind, str(n)],
                                 stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-        time.sleep(float(rng.uniform(0.5, max_delay)))
+        _wait_for_first_write(target, proc)  # kill while writing, not while importing
+        time.sleep(float(rng.uniform(0.0, max_delay)))
         proc.send_signal(signal.SIGKILL)
         proc.wait()
         if not target.exists():

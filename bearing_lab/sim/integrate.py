@@ -32,6 +32,7 @@ from ..errors import BearingLabError, SolverError
 from . import _kernels as K
 from .assembly import assemble
 from .scene import load_scene
+from ..schema import DEFAULT_CHANNEL, QUANTITY_OF_UNITS
 
 # Butcher tableaus: (A, b, b - b_hat, c, order used for step control, FSAL)
 _DP54 = (
@@ -299,7 +300,7 @@ def simulate(scene, *, fidelity: str | None = None, duration: float | None = Non
     coords = {"time": ("time", time, {"units": "s", "long_name": "time from the record start"}),
               "ball": ("ball", np.arange(z), {"long_name": "ball index (cage order)"})}
     def v(data, units, long):
-        return (("time",), data, {"units": units, "long_name": long})
+        return (("time",), data, {"units": units, "long_name": long, "quantity": QUANTITY_OF_UNITS[units]})
     ds = xr.Dataset(
         {
             "outer_ring_acc_y": v(acc[:, 1], "m s-2", "outer-ring acceleration Y (accelerometer signal)"),
@@ -312,10 +313,13 @@ def simulate(scene, *, fidelity: str | None = None, duration: float | None = Non
         coords=coords,
     )
     if res["cage_speed"] is not None:
-        ds["cage_speed"] = (("time",), res["cage_speed"], {"units": "rad s-1", "long_name": "cage angular speed"})
+        ds["cage_speed"] = (("time",), res["cage_speed"], {"units": "rad s-1", "long_name": "cage angular speed",
+                                                           "quantity": "angular velocity"})
     if d["output"]["ball_loads"]:
-        ds["ball_load_outer"] = (("ball", "time"), fo, {"units": "N", "long_name": "ball-outer race normal load"})
-        ds["ball_load_inner"] = (("ball", "time"), fi, {"units": "N", "long_name": "ball-inner race normal load"})
+        ds["ball_load_outer"] = (("ball", "time"), fo, {"units": "N", "long_name": "ball-outer race normal load",
+                                                        "quantity": "force"})
+        ds["ball_load_inner"] = (("ball", "time"), fi, {"units": "N", "long_name": "ball-inner race normal load",
+                                                        "quantity": "force"})
     stats = res["stats"]
     ds.attrs.update({
         "title": f"bearing_lab simulation of scene {sc.name!r}",
@@ -323,6 +327,7 @@ def simulate(scene, *, fidelity: str | None = None, duration: float | None = Non
         "bearing_lab_version": __version__,
         "shaft_speed_rpm": float(sc.nominal_rpm),
         "bearing": sc.bearing.name,
+        "default_channel": DEFAULT_CHANNEL,
         "fidelity": asm.fidelity,
         "scene_name": sc.name,
         "scene_toml": sc.to_toml(),

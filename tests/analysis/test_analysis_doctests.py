@@ -4,7 +4,7 @@ import importlib
 
 import pytest
 
-MODULES = ["_spectral", "_speed", "_faults", "_impulse", "_metrics", "pipeline", "accessor"]
+MODULES = ["_spectral", "_speed", "_faults", "_impulse", "_metrics", "pipeline", "accessor", "_cyclo", "_tacho"]
 
 
 @pytest.mark.parametrize("name", MODULES)

@@ -1,4 +1,4 @@
-"""Excitation period (reference.md limits), impulse segmentation, excitation duration."""
+"""Excitation period, impulse segmentation, excitation duration."""
 import numpy as np
 import pytest
 
@@ -6,12 +6,12 @@ import analysis_synth
 from bearing_lab.analysis import excitation_duration, excitation_period, impulses
 from bearing_lab.errors import AnalysisError
 
-T_BPFO = 0.0108509  # 6308 at 1800 r/min (reference.md)
+T_BPFO = 0.0108509  # 6308 at 1800 r/min: 1 / BPFO, BPFO = Z f_r (1 - D cos(a) / d_m) / 2
 
 
 def _sigma(jitter, n_impacts):
-    """reference.md: with random slip the period is defined only to ~3e-4 per 1 % of slip,
-    the spread of the mean of n intervals, jitter / sqrt(n)."""
+    """With random slip the period is defined only to the spread of the mean of n
+    intervals, jitter / sqrt(n) (~3e-4 per 1 % of slip over 10 s)."""
     return jitter / np.sqrt(n_impacts)
 
 
@@ -24,7 +24,8 @@ SEEDS = (1, 2, 3, 4)
 
 @pytest.mark.parametrize("jitter, snr_db", CASES)
 def test_period_of_impulse_train_within_reference_limits(jitter, snr_db):
-    """Exact impacts: 1e-6-1e-5 (reference.md; 2e-5 allowed at -20 dB, 1.5e-5 seen).
+    """Exact impacts: 1e-6-1e-5 of the period (the interpolated-DFT line estimate; 2e-5
+    allowed at -20 dB, 1.5e-5 seen).
     Random slip: each error within 5 sigma and the RMS over seeds within 3 sigma of the
     period's own definition (sigma = jitter / sqrt(n))."""
     errs, sig = [], []
@@ -86,7 +87,8 @@ def _passage(length_s, fs, kind):
 
 @pytest.mark.parametrize("kind", ["displacement", "acceleration"])
 def test_excitation_duration_orders_defect_lengths(kind):
-    """1, 3, 6 mm defects of the 6308 at 1800 r/min: 0.345, 1.035, 2.070 ms (reference.md)."""
+    """1, 3, 6 mm defects of the 6308 at 1800 r/min: a ball crosses them in 0.345, 1.035,
+    2.070 ms at the surface speed omega (d_m**2 - D_b**2) / (4 d_m) = 2.898 m/s."""
     fs = 200_000.0
     lengths = [0.345e-3, 1.035e-3, 2.070e-3]
     d = [excitation_duration(_passage(L, fs, kind), fs)[0] for L in lengths]

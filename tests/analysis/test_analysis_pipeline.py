@@ -1,4 +1,4 @@
-"""analyze(): contract.md JSON schema, plot, and the `bearing-lab analyze` command."""
+"""analyze(): the JSON layout of docs/analysis.md, plot, and the `bearing-lab analyze` command."""
 import json
 
 import numpy as np
@@ -9,11 +9,11 @@ from bearing_lab.analysis import analyze, plot_analysis
 from bearing_lab.cli import main
 from bearing_lab.errors import AnalysisError
 
-FAULT_KEYS = {"expected_hz", "measured_hz", "snr_db", "harmonics"}
+FAULT_KEYS = {"expected_hz", "measured_hz", "snr_db", "harmonics", "sidebands", "detected"}
 METRIC_KEYS = {"rms", "peak", "peak_to_peak", "crest_factor", "kurtosis", "impulse_factor",
                "clearance_factor", "shape_factor"}
 TOP_KEYS = {"channel", "sampling_rate_hz", "shaft_hz", "diagnosis", "fault_frequencies",
-            "excitation_period_s", "metrics", "units"}
+            "excitation_period_s", "metrics", "units", "speed_source", "speed", "verdict", "evidence"}
 
 
 def _outer_race_signal(fs=12000.0, seconds=10.0, fr=1797 / 60, seed=0):
@@ -34,7 +34,9 @@ def check_schema(r):
         assert isinstance(v["harmonics"], int)
     assert set(r["metrics"]) == METRIC_KEYS
     assert all(isinstance(v, float) and np.isfinite(v) for v in r["metrics"].values())
-    assert r["diagnosis"] in ("outer_race", "inner_race", "ball", "none")
+    assert r["diagnosis"] in ("outer_race", "inner_race", "ball", "none", "uncertain")
+    assert r["verdict"] in ("diagnosed", "uncertain", "no fault evidence")
+    assert r["speed_source"] in ("given", "file", "tacho", "estimated", "unresolved")
     assert r["excitation_period_s"] is None or isinstance(r["excitation_period_s"], float)
     json.dumps(r, allow_nan=False)
 
@@ -92,7 +94,7 @@ def test_cli_analyze_json_and_plot(tmp_path, capsys):
     assert png.is_file()
     assert main(["analyze", str(path), "--bearing", "6205"]) == 0
     out = capsys.readouterr().out
-    assert "diagnosis: outer_race" in out and "BPFO" in out
+    assert "verdict: diagnosed  diagnosis: outer_race" in out and "BPFO" in out
 
 
 def test_cli_analyze_bad_input_exits_2(tmp_path, capsys):
@@ -111,8 +113,80 @@ def test_cli_analyze_real_recording(datafile, capsys):
     assert main(["analyze", str(path), "--json"]) == 0
     r = json.loads(capsys.readouterr().out)
     check_schema(r)
-    assert r["diagnosis"] == "outer_race"
+    assert r["diagnosis"] == "outer_race" and r["verdict"] == "diagnosed"
+    assert r["speed_source"] == "file" and r["speed"]["status"] == "confirmed"
     assert r["units"] == "m s-2"
+
+
+@pytest.mark.data
+def test_cli_fan_end_file_with_fs_channel_and_blind_speed(datafile, capsys):
+    """A fan-end 6203 fault, channel FE, rate given (the file stores none), no speed."""
+    path = datafile("cwru/12k_FE/OR007@6_0.mat")
+    args = ["analyze", str(path), "--fs", "12000", "--channel", "FE", "--bearing", "6203", "--json"]
+    assert main(args + ["--rpm", "none"]) == 0
+    r = json.loads(capsys.readouterr().out)
+    check_schema(r)
+    assert r["channel"] == "FE" and r["sampling_rate_hz"] == 12000.0
+    assert r["speed_source"] in ("estimated", "unresolved")
+    assert r["diagnosis"] in ("outer_race", "uncertain")
+    if r["speed_source"] == "estimated":
+        assert r["shaft_hz"] == pytest.approx(1797 / 60, rel=0.005)
+    assert main(args) == 0
+    r = json.loads(capsys.readouterr().out)
+    assert r["speed_source"] == "file" and r["diagnosis"] == "outer_race"
+
+
+def _cwru_like(tmp_path, x, record=999):
+    """A CWRU-format file whose record the registry does not know: no rate anywhere."""
+    import scipy.io as sio
+    path = tmp_path / f"{record}_OR_unknown.mat"
+    sio.savemat(path, {f"X{record}_DE_time": (x / 9.80665)[:, None], f"X{record}RPM": np.array([[1797]])})
+    return path
+
+
+def test_cli_fs_for_a_file_without_sampling_rate(tmp_path, capsys):
+    x, fs, fr = _outer_race_signal(seconds=5.0)
+    path = _cwru_like(tmp_path, x)
+    assert main(["analyze", str(path), "--bearing", "6205"]) == 2
+    err = capsys.readouterr().err
+    assert "fs" in err and err.count("\n") == 1
+    assert main(["analyze", str(path), "--fs", "12000", "--channel", "DE", "--bearing", "6205", "--json"]) == 0
+    r = json.loads(capsys.readouterr().out)
+    assert r["sampling_rate_hz"] == 12000.0 and r["diagnosis"] == "outer_race"
+    assert r["speed_source"] == "file" and r["speed"]["prior_hz"] == pytest.approx(1797 / 60)
+
+
+def test_cli_rpm_none_ignores_the_stored_speed(tmp_path, capsys):
+    x, fs, fr = _outer_race_signal()
+    path = _nc(tmp_path, x, fs)
+    assert main(["analyze", str(path), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["speed_source"] == "file"
+    assert main(["analyze", str(path), "--json", "--rpm", "none"]) == 0
+    r = json.loads(capsys.readouterr().out)
+    assert r["speed_source"] in ("estimated", "unresolved") and r["speed"]["prior_hz"] is None
+    assert main(["analyze", str(path), "--json", "--rpm", "1790"]) == 0
+    assert json.loads(capsys.readouterr().out)["speed_source"] == "given"
+
+
+def test_cli_uses_a_tacho_channel(tmp_path, capsys):
+    x, fs, fr = _outer_race_signal()
+    t = np.arange(x.size) / fs
+    tacho = ((t * fr) % 1.0 < 0.05).astype(float)
+    ds = xr.Dataset({"acc": ("time", x, {"units": "m s-2"}), "tacho": ("time", tacho, {"units": "V"})},
+                    coords={"time": ("time", t, {"units": "s"})},
+                    attrs={"sampling_rate_hz": fs, "bearing": "6205", "default_channel": "acc",
+                           "bearing_lab_version": "0.1.0"})
+    path = tmp_path / "with_tacho.nc"
+    ds.to_netcdf(path)
+    assert main(["analyze", str(path), "--json"]) == 0
+    r = json.loads(capsys.readouterr().out)
+    assert r["speed_source"] == "tacho" and r["shaft_hz"] == pytest.approx(fr, rel=2e-4)
+    assert r["diagnosis"] == "outer_race"
+    assert main(["analyze", str(path), "--json", "--tacho", "none", "--rpm", "none"]) == 0
+    assert json.loads(capsys.readouterr().out)["speed_source"] != "tacho"
+    assert main(["analyze", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "verdict: diagnosed" in out and "tacho channel tacho" in out
 
 
 def _modulated_impacts(rate, mod_hz, fs=12000.0, seconds=10.0, seed=0):

@@ -6,7 +6,7 @@ from bearing_lab.analysis import interpolated_peak, shaft_frequency
 from bearing_lab.errors import AnalysisError
 
 FS = 20000.0
-T = np.arange(200_000) / FS  # 10 s at 20 kHz: 0.1 Hz bins (reference.md)
+T = np.arange(200_000) / FS  # 10 s at 20 kHz: 0.1 Hz bins
 
 
 @pytest.mark.parametrize("method", ["quinn", "jacobsen"])
@@ -28,7 +28,7 @@ def test_interpolated_peak_hann():
 
 
 def test_pure_tone_within_2_mHz_over_10_s_at_minus_20_dB():
-    """reference.md: Quinn reaches ~1 mHz at -20 dB per-sample SNR (CRB 1.2 mHz)."""
+    """Quinn (1997) reaches ~1 mHz at -20 dB per-sample SNR; the Cramer-Rao bound is 1.2 mHz."""
     errs = []
     for seed in range(10):
         rng = np.random.default_rng(seed)

@@ -1,47 +1,56 @@
-"""Report: sections, self-contained HTML, JSON round trip, index page."""
+"""The report layer: sections from templates, self-contained HTML, JSON round trip, provenance and
+citation as report methods, the index with known limitations apart, atomic writes."""
 import numpy as np
 from matplotlib.figure import Figure
 
-from bearing_lab.compare import Tolerance, make_row
 from bearing_lab.report import Report, rows_table, write_index
+from bearing_lab.validation import Tolerance, make_row
 
 
 def _rows():
-    return [make_row("bpfo", 107.3, 107.6, Tolerance("pct", 1.0, "issue 5")),
-            make_row("rms", 1.0, 6.6, Tolerance("factor", 2.0, "uncalibrated"), note="structure as is")]
+    return [make_row("bpfo", 107.3, 107.6, Tolerance("pct", 1.0, "line search"), label="BPFO", units="Hz"),
+            make_row("rms", 1.0, 6.6, Tolerance("factor", 2.0, "amplitude"), label="RMS", units="m s-2",
+                     note="structure as is"),
+            make_row("ratio", 1295.0, 1.24, Tolerance("factor", 2.0, "ratio", known_limitation="the load zone"),
+                     label="ratio", units="1")]
 
 
 def test_report_html_is_self_contained_and_round_trips(tmp_path):
     r = Report("Validation: t", subtitle="a <test> case")
-    r.add_comparison(_rows(), "Comparison table", figures=False)
+    r.add_rows(_rows(), "Comparison table")
     fig = Figure(figsize=(4, 2))
     fig.subplots().plot(np.arange(10))
     r.add_figure(fig, "A figure", caption="ten points")
     r.add_table([{"a": 1.5, "b": "x"}], "A table")
+    r.add_notice("Look", "a <b> notice", level="bad")
     r.add_provenance({"recording sha256": "ab" * 32, "scene": "name = 'x'\n[speed]\nrpm = 1"})
-    html_path = r.save(tmp_path / "r" / "index.html")
-    html = html_path.read_text()
+    r.add_citation()
+    html = r.save(tmp_path / "r" / "index.html").read_text()
     assert html.count("data:image/png;base64,") == 1
-    assert "a &lt;test&gt; case" in html and "<link" not in html and "<script" not in html
-    assert "1 of 2 rows pass" in html and "FAIL" in html
+    assert "a &lt;test&gt; case" in html and "a &lt;b&gt; notice" in html
+    assert "<link" not in html and "<script" not in html
+    assert "1 of 3 rows pass" in html and "1 failing as known model limitations" in html
+    assert "FAIL" in html and "known limitation" in html
+    # provenance is a report method: the software versions, revision, host and date come with it
+    assert "numpy" in r.info["versions"] and r.info["date"] and "host" in r.info
+    assert "Liu, Xu, Wang, Xu, Tang" in html and "Eksploatacja" in html and "bearing_lab 0.1.0" in html
     assert not r.passed
     back = Report.load(r.save(tmp_path / "r.json"))
-    assert back.title == r.title
-    assert len(back.rows) == len(r.rows) > 0
-    assert back.rows == r.rows or all(
-        a["quantity"] == b["quantity"] for a, b in zip(back.rows, r.rows))
+    assert back.title == r.title and len(back.rows) == 3
     assert [s["title"] for s in back.sections] == [s["title"] for s in r.sections]
     assert back.to_html().count("data:image/png;base64,") == 1
+    assert not list((tmp_path / "r").glob(".*"))      # no temporary files left by the atomic write
 
 
 def test_rows_table_and_index(tmp_path):
-    t = rows_table(_rows(), show_paper=True)
-    assert "paper: experiment" in t and t.count("<tr") == 3
+    t = rows_table(_rows(), show_reference=True, show_paper=True)
+    assert "reference (not the experiment)" in t and "paper&#x27;s own simulation" in t and t.count("<tr") == 4
     p = write_index(tmp_path / "index.html", [
         {"case": "paper", "title": "P", "status": "fail", "n_pass": 3, "n_rows": 9, "wall_time_s": 5.0,
-         "failing": ["healthy: BPFI"], "link": "paper/index.html"},
+         "failing": ["healthy: BPFI"], "known": ["slot: peak"], "link": "paper/index.html"},
+        {"case": "broken", "title": "B", "status": "error", "reason": "speed unresolved", "link": None},
         {"case": "cwru-130", "title": "C", "status": "skip", "reason": "recording not found", "link": None}],
         notes=["mirror missing"])
     html = p.read_text()
     assert 'href="paper/index.html"' in html and "skipped" in html and "mirror missing" in html
-    assert "recording not found" in html
+    assert "recording not found" in html and "speed unresolved" in html and "(slot: peak)" in html

@@ -1,0 +1,144 @@
+"""One ruler for recordings and simulations: the quantities a validation compares.
+
+Why: a comparison is only as honest as its measurement.  Both signals go through
+this one function (same window, same band selection, same line search, same
+impact cutting), and a quantity the signal does not show (no line found, no
+impulse) is NaN with a note saying why, never a default number.
+
+Public API
+----------
+measure(x, fs, *, bearing, rpm=None, shaft_hz=None, fault=None, duration_level=0.1)
+    -- dict of frequencies, metrics and impact quantities, plus ``extras``
+shaft_line(x, fs, expected_hz, *, tolerance=0.03) -- (measured Hz or None, SNR dB)
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..errors import AnalysisError
+from .impacts import impact_times, impulse_strength
+
+__all__ = ["measure", "shaft_line", "MEASURED"]
+
+#: the keys :func:`measure` returns (besides ``extras``), with their SI units
+MEASURED = {"shaft_hz": "Hz", "bpfo": "Hz", "bpfi": "Hz", "excitation_period": "s", "rms": "m s-2",
+            "peak": "m s-2", "crest_factor": "1", "kurtosis": "1", "impulse_duration": "s",
+            "impulse_strength": "m s-2"}
+
+
+def shaft_line(x, fs, expected_hz, *, tolerance=0.03):
+    """The shaft line near ``expected_hz`` in the Hann amplitude spectrum.
+
+    Returns ``(measured_hz, snr_db)``; ``measured_hz`` is None when no fundamental stands
+    above the fault search's threshold (:data:`bearing_lab.analysis._faults.FUNDAMENTAL_SNR_DB`).
+    """
+    from ._faults import fault_line
+    from ._spectral import amplitude_spectrum
+    f, a = amplitude_spectrum(x, fs, window="hann")
+    r = fault_line(f, a, expected_hz, tolerance=tolerance, n_harmonics=1)
+    return r["measured_hz"], float(r["snr_db"])
+
+
+def _band_for(x, fs, fmax_line):
+    from ._spectral import fast_kurtogram
+    try:
+        return fast_kurtogram(x, fs, min_bandwidth=min(fmax_line, 0.2 * fs)).band
+    except AnalysisError:
+        return None
+
+
+def _num(v) -> float:
+    return float(v) if v is not None else float("nan")
+
+
+def _impact_quantities(x, fs, period, level, out, notes):
+    from ._impulse import impulses
+    band = _band_for(x, fs, 4.0 / period)
+    times = impact_times(x, fs, period, band=band)
+    out["impulse_strength"] = impulse_strength(x, fs, period, band=band)
+    try:
+        imp = impulses(x, fs, band=band, min_separation=0.5 * period, level=level)
+        d = np.asarray(imp.duration, float)
+        out["impulse_duration"] = float(np.median(d)) if d.size else float("nan")
+        if not d.size:
+            notes["impulse_duration"] = "no impulse above the detection threshold"
+    except AnalysisError as exc:
+        out["impulse_duration"] = float("nan")
+        notes["impulse_duration"] = str(exc)
+    return band, times
+
+
+def measure(x, fs, *, bearing, rpm=None, shaft_hz=None, fault=None, duration_level=0.1):
+    """The quantities of a validation table for one signal, measured the same way for recording
+    and simulation.
+
+    Parameters
+    ----------
+    x : array_like, 1-D
+        Acceleration, m s-2.
+    fs : float
+        Sampling rate, Hz.
+    bearing : str or BearingGeometry
+        Catalog name or geometry.
+    rpm : float, optional
+        Nominal speed prior, r/min (the recording's stored speed, or the scene's).
+    shaft_hz : float, optional
+        Known shaft frequency, Hz: the kinematic fault frequencies are searched around it.
+    fault : {"bpfo", "bpfi"}, optional
+        Fault family whose period and impulses are measured (default: from the diagnosis).
+    duration_level : float
+        Relative level of the impulse duration (default 0.1).
+
+    Returns
+    -------
+    dict
+        The keys of :data:`MEASURED` (NaN where the signal shows nothing) and ``extras``:
+        ``analysis`` (the :func:`bearing_lab.analysis.analyze` result), ``band``,
+        ``impact_times``, ``notes`` (why a value is NaN), ``fault``, ``shaft_hz_used``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> fs = 12000.0; t = np.arange(60000) / fs; fr = 1797 / 60
+    >>> tau = t % (1 / (3.5848 * fr))
+    >>> x = np.exp(-900 * tau) * np.sin(2 * np.pi * 3000 * tau)
+    >>> x = x + np.random.default_rng(0).normal(0, 0.1, t.size)
+    >>> m = measure(x, fs, bearing="6205", rpm=1797, fault="bpfo")
+    >>> round(m["bpfo"], 1), bool(np.isnan(m["bpfi"]))
+    (107.4, True)
+    """
+    from .pipeline import analyze
+    x = np.asarray(x, dtype=float)
+    res = analyze(x, fs, bearing=bearing, rpm=rpm, shaft_hz=shaft_hz)
+    fr = res["shaft_hz"]
+    ff = res["fault_frequencies"]
+    notes, out = {}, {}
+    fi, snr = shaft_line(x, fs, fr if rpm is None else rpm / 60.0)
+    out["shaft_hz"] = _num(fi)
+    if fi is None:
+        notes["shaft_hz"] = f"no shaft line in the amplitude spectrum (best candidate {snr:.1f} dB above the floor)"
+    for k in ("bpfo", "bpfi"):
+        out[k] = _num(ff[k]["measured_hz"])
+        if ff[k]["measured_hz"] is None:
+            notes[k] = (f"no {k.upper()} line family in the squared envelope spectrum "
+                        f"(expected {ff[k]['expected_hz']:.2f} Hz; best {ff[k]['snr_db']:.1f} dB)")
+    key = fault or {"outer_race": "bpfo", "inner_race": "bpfi"}.get(res["diagnosis"])
+    period = res["excitation_period_s"]
+    if period is None and key is not None and ff[key]["measured_hz"]:
+        period = 1.0 / ff[key]["measured_hz"]
+    out["excitation_period"] = _num(period)
+    if period is None:
+        notes["excitation_period"] = "no fault diagnosed: no impact train to time"
+    for k in ("rms", "peak", "crest_factor", "kurtosis"):
+        out[k] = float(res["metrics"][k])
+    band, times = None, np.array([])
+    if period is not None and math.isfinite(period):
+        band, times = _impact_quantities(x, fs, period, duration_level, out, notes)
+    else:
+        out["impulse_strength"] = out["impulse_duration"] = float("nan")
+        notes["impulse_strength"] = notes["impulse_duration"] = "no impact train"
+    out["extras"] = {"analysis": res, "band": band, "impact_times": times, "notes": notes,
+                     "fault": key, "shaft_hz_used": fr}
+    return out

@@ -1,0 +1,76 @@
+"""``bearing-lab case new RECORDING [-o CASE.toml]`` and ``bearing-lab case standin SCENE -o FILE``.
+
+``case new`` writes a commented starting validation case from what the recording tells
+(channels, units, rate, duration, stored speed); ``case standin`` writes a recording a
+user can validate against: a simulated hidden defect with speed jitter, a housing
+resonance, machine tones and noise, as UFF 58b (``.uff``) or a Testlab MATLAB export
+(``.mat``).  The case format: ``docs/case-format.md``.
+"""
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+
+def _cmd_new(args) -> int:
+    from ..errors import ValidationCaseError
+    from ..validation.newcase import new_case_text
+    out = Path(args.output) if args.output else Path(args.recording).with_suffix(".toml")
+    if out.suffix != ".toml":
+        raise ValidationCaseError(f"-o {args.output}: a case file ends in .toml")
+    if out.exists() and not args.force:
+        raise ValidationCaseError(f"-o {out}: exists; pass --force to overwrite it")
+    if not out.parent.exists():
+        raise ValidationCaseError(f"-o {out}: directory {out.parent} does not exist")
+    text = new_case_text(args.recording, name=args.name, bearing=args.bearing, speed=args.speed,
+                         channel=args.channel, fmt=args.format, case_dir=out.parent)
+    from .._files import atomic_open
+    with atomic_open(out, "w", encoding="utf-8") as fh:
+        fh.write(text)
+    print(f"{out}: starting case for {args.recording}; give the bearing, load and defect (see the comments), "
+          f"then run `bearing-lab validate {out}`")
+    return 0
+
+
+def _cmd_standin(args) -> int:
+    from ..sim.scene import parse_set
+    from ..validation.standin import make_standin_recording
+    s = make_standin_recording(args.output, scene=args.scene, overrides=parse_set(args.set), rpm=args.rpm,
+                               duration=args.duration, fs=args.fs, jitter=args.jitter,
+                               resonance_hz=args.resonance_hz, noise_g=args.noise_g, seed=args.seed)
+    h = s.hidden
+    print(f"{s.path}: {h['format']}, {h['duration_s']:g} s at {h['fs']:g} Hz; hidden: scene {h['scene']} "
+          f"{' '.join(f'{k}={v}' for k, v in h['overrides'].items())}, {h['rpm']:g} r/min "
+          f"(jitter {100 * h['jitter']:g} %), resonance {h['resonance_hz']:g} Hz, noise {h['noise_g']:g} g",
+          file=sys.stdout)
+    return 0
+
+
+def register(subparsers) -> None:
+    p = subparsers.add_parser("case", help="validation cases: a starting case for a recording; stand-in recordings",
+                              description="Write a commented starting validation case from a recording (case new), "
+                                          "or a stand-in recording with a hidden defect (case standin).")
+    sub = p.add_subparsers(dest="case_command", metavar="ACTION")
+    n = sub.add_parser("new", help="a commented starting case from what the recording tells")
+    n.add_argument("recording", help="the recording (any supported format, or a .nc from bearing-lab import)")
+    n.add_argument("-o", "--output", default=None, help="case file to write (default: RECORDING with .toml)")
+    n.add_argument("--name", default=None, help="case name (default: the recording's file name)")
+    n.add_argument("--bearing", default=None, help="catalog bearing, e.g. 6308 (else left for you to fill in)")
+    n.add_argument("--speed", type=float, default=None, help="shaft speed, r/min (else the stored one, or 'estimate')")
+    n.add_argument("--channel", default=None, help="channel to compare (default: the file's default channel)")
+    n.add_argument("--format", default=None, help="reader name (default: sniffed)")
+    n.add_argument("--force", action="store_true", help="overwrite an existing case file")
+    n.set_defaults(func=_cmd_new)
+    s = sub.add_parser("standin", help="a recording with a hidden defect, jitter, a resonance, tones and noise")
+    s.add_argument("scene", help="built-in scene or scene TOML with the hidden bearing, load and defect")
+    s.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="scene key (repeatable)")
+    s.add_argument("--rpm", type=float, default=1793.0, help="mean shaft speed, r/min (default 1793)")
+    s.add_argument("--duration", type=float, default=2.0, help="seconds (default 2)")
+    s.add_argument("--fs", type=float, default=20000.0, help="sampling rate, Hz (default 20000)")
+    s.add_argument("--jitter", type=float, default=0.005, help="relative speed random walk (default 0.005)")
+    s.add_argument("--resonance-hz", type=float, default=4300.0, help="housing/sensor resonance (default 4300)")
+    s.add_argument("--noise-g", type=float, default=0.05, help="white sensor noise RMS, g (default 0.05)")
+    s.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    s.add_argument("-o", "--output", required=True, help="output file: .uff (UFF 58b) or .mat (Testlab export)")
+    s.set_defaults(func=_cmd_standin)
+    p.set_defaults(func=lambda a: (p.print_help(), 2)[1])

@@ -1,0 +1,158 @@
+"""HTML pieces of the report layer: escaping, number formatting, and every table from a template.
+
+Why templates: the page layout, each table and each block live in files under
+``report/templates/`` (``string.Template`` syntax: no template engine at run time), so
+a page's look changes without touching the code that fills it, and validation, studies
+and bench pages share them.
+"""
+from __future__ import annotations
+
+import base64
+import html
+import io
+import math
+from pathlib import Path
+from string import Template
+
+__all__ = ["template", "css", "esc", "fmt", "figure_png", "figure_html", "table_html", "rows_table",
+           "index_rows", "kv_html", "notice_html"]
+
+_TEMPLATES = Path(__file__).with_name("templates")
+
+
+def template(name: str) -> Template:
+    return Template((_TEMPLATES / name).read_text(encoding="utf-8"))
+
+
+def css() -> str:
+    return (_TEMPLATES / "base.css").read_text(encoding="utf-8")
+
+
+def esc(text) -> str:
+    return html.escape(str(text), quote=True)
+
+
+def fmt(v, digits=5) -> str:
+    """A number for a table: NaN / None as an em dash, otherwise ``digits`` significant digits."""
+    if v is None:
+        return "—"
+    if isinstance(v, bool):
+        return "yes" if v else "no"
+    try:
+        x = float(v)
+    except (TypeError, ValueError):
+        return esc(v)
+    if not math.isfinite(x):
+        return "—"
+    if x == 0:
+        return "0"
+    if abs(x) >= 1e5 or abs(x) < 1e-3:
+        return f"{x:.{digits - 1}e}"
+    return f"{x:.{digits}g}"
+
+
+def figure_png(fig, dpi=80) -> str:
+    """Base64 PNG of a matplotlib figure (a pyplot figure is closed afterwards)."""
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=dpi)
+    if getattr(fig.canvas, "manager", None) is not None:
+        import matplotlib.pyplot as plt
+        plt.close(fig)
+    return base64.b64encode(buf.getvalue()).decode("ascii")
+
+
+def figure_html(fig, alt, caption="", dpi=80) -> str:
+    return template("figure.html").substitute(alt=esc(alt), png=figure_png(fig, dpi=dpi), caption=esc(caption))
+
+
+def _cell(v) -> str:
+    numeric = isinstance(v, (int, float)) and not isinstance(v, bool)
+    return f'<td class="{"" if numeric else "l"}">{fmt(v) if numeric else esc("" if v is None else v)}</td>'
+
+
+def table_html(rows: list, *, columns=None, intro="", row_class=None) -> str:
+    """A list of dicts as a table (numbers right-aligned with 5 significant digits)."""
+    if not rows:
+        return (f"<p>{esc(intro)}</p>" if intro else "") + "<p>(no rows)</p>"
+    columns = columns or list(rows[0])
+    body = "\n".join(template("table_row.html").substitute(
+        css_class=(row_class(r) if row_class else ""), cells="".join(_cell(r.get(c)) for c in columns))
+        for r in rows)
+    return template("table.html").substitute(intro=f"<p>{esc(intro)}</p>\n" if intro else "",
+                                             head="".join(f'<th class="l">{esc(c)}</th>' for c in columns),
+                                             rows=body)
+
+
+_STATUS = {"pass": ("pass", "pass"), "known limitation": ("known", "known limitation"), "fail": ("fail", "FAIL")}
+
+
+def rows_table(rows: list, *, show_reference=False, show_paper=False, intro="") -> str:
+    """The validation table: quantity, simulation, experiment, difference, tolerance, status, reason."""
+    head = ["quantity", "units", "simulation", "experiment"]
+    if show_reference:
+        head.append("reference (not the experiment)")
+    if show_paper:
+        head.append("paper's own simulation")
+    head += ["difference %", "tolerance", "status", "signal / span", "reason, limitation, note"]
+    lines = []
+    for r in rows:
+        status = r.get("status") or ("pass" if r.get("pass") else "fail")
+        cls, label = _STATUS[status]
+        mark = "" if r.get("independent", True) else " &#8224;"
+        cells = [f'<td class="l">{esc(r.get("label") or r["quantity"])}{mark}</td>', f"<td>{esc(r.get('units', ''))}</td>",
+                 f"<td>{fmt(r.get('simulation'))}</td>", f"<td>{fmt(r.get('experiment'))}</td>"]
+        if show_reference:
+            cells.append(f"<td>{fmt(r.get('reference_value'))}<br><span class='note'>"
+                         f"{esc(r.get('reference_label', ''))}</span></td>")
+        if show_paper:
+            cells.append(f"<td>{fmt(r.get('paper_simulation'))}</td>")
+        text = esc(r.get("reason", ""))
+        if r.get("known_limitation") and not r.get("pass"):
+            text += f"<br><b>known limitation:</b> {esc(r['known_limitation'])}"
+        if r.get("note"):
+            text += f"<br><em>{esc(r['note'])}</em>"
+        cells += [f"<td>{fmt(r.get('difference_pct'), 3)}</td>", f"<td>{esc(r.get('tolerance', ''))}</td>",
+                  f'<td class="status">{label}</td>',
+                  f'<td class="l note">{esc(r.get("simulated_signal", ""))}<br>{esc(r.get("experiment_span", ""))}</td>',
+                  f'<td class="reason">{text}</td>']
+        lines.append(template("table_row.html").substitute(css_class=cls, cells="".join(cells)))
+    return template("rows_table.html").substitute(
+        intro=f"<p>{esc(intro)}</p>\n" if intro else "",
+        head="".join(f'<th class="{"l" if h.startswith(("quantity", "reason")) else ""}">{esc(h)}</th>' for h in head),
+        rows="\n".join(lines))
+
+
+def index_rows(entries: list) -> str:
+    out = []
+    for e in entries:
+        st = e["status"]
+        link = f'<a href="{esc(e["link"])}">{esc(e["case"])}</a>' if e.get("link") else esc(e["case"])
+        what = esc(e.get("title", ""))
+        if e.get("reason"):
+            what += f'<br><span class="note">{esc(e["reason"])}</span>'
+        failing = ", ".join(esc(f) for f in e.get("failing", []))
+        known = ", ".join(esc(f) for f in e.get("known", []))
+        if known:
+            failing = (failing + " " if failing else "") + f"({known})"
+        wall = fmt(e.get("wall_time_s"), 3) if e.get("wall_time_s") is not None else "—"
+        counts = f"{e.get('n_pass', 0)} / {e.get('n_rows', 0)}" if st in ("pass", "fail") else "—"
+        label = {"pass": "pass", "fail": "FAIL", "skip": "skipped", "error": "error"}[st]
+        out.append(template("index_row.html").substitute(status=st, link=link, what=what, label=label,
+                                                         counts=counts, wall=wall, failing=failing))
+    return "\n".join(out)
+
+
+def kv_html(info: dict) -> str:
+    import json
+    items = []
+    for k, v in info.items():
+        if isinstance(v, str) and ("\n" in v or len(v) > 160):
+            items.append(f"<dt>{esc(k)}</dt><dd><pre>{esc(v)}</pre></dd>")
+        else:
+            items.append(f"<dt>{esc(k)}</dt><dd>{esc(v if isinstance(v, str) else json.dumps(v, default=str))}</dd>")
+    return template("provenance.html").substitute(items="\n".join(items))
+
+
+def notice_html(heading: str, body: str, *, level="warn") -> str:
+    """A highlighted block (``level`` "warn", "bad" or "good"); ``body`` is escaped."""
+    return template("notice.html").substitute(level=level, heading=esc(heading), body=esc(body))

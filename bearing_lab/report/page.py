@@ -1,0 +1,183 @@
+"""The report page: ordered sections saved as one self-contained HTML file (or reloadable JSON)."""
+from __future__ import annotations
+
+import datetime as _dt
+import json
+import re
+from pathlib import Path
+
+from .html import (css, esc, figure_html, kv_html, notice_html, rows_table, table_html, template,
+                   index_rows)
+
+__all__ = ["Report", "write_index"]
+
+
+def _now() -> str:
+    return _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M:%S UTC")
+
+
+def _version() -> str:
+    from .. import __version__
+    return __version__
+
+
+def _anchor(title: str, used: set) -> str:
+    a = re.sub(r"[^a-z0-9]+", "-", title.lower()).strip("-") or "section"
+    base, i = a, 1
+    while a in used:
+        i += 1
+        a = f"{base}-{i}"
+    used.add(a)
+    return a
+
+
+class Report:
+    """One page: sections added in order (MNE's ``Report`` style), saved as self-contained HTML.
+
+    Figures are matplotlib :class:`~matplotlib.figure.Figure` objects (no backend is switched),
+    embedded as PNG.  ``rows`` collects the validation rows added with :meth:`add_rows`.
+    """
+
+    def __init__(self, title: str, *, subtitle: str = ""):
+        self.title = title
+        self.subtitle = subtitle
+        self.sections: list[dict] = []
+        self.rows: list[dict] = []
+        self.info: dict = {}
+
+    # ---- adding content
+    def add_html(self, html_text: str, title: str, *, tags=()):
+        self.sections.append({"title": title, "html": html_text, "tags": list(tags)})
+        return self
+
+    def add_figure(self, fig, title: str, *, caption: str = "", tags=(), dpi=80):
+        return self.add_html(figure_html(fig, title, caption, dpi=dpi), title, tags=tags)
+
+    def add_figures(self, figs, title: str, *, tags=(), dpi=80, intro=""):
+        """Several ``(figure, caption)`` pairs in one section."""
+        body = "\n".join(figure_html(f, title, c, dpi=dpi) for f, c in figs)
+        return self.add_html((f"<p>{esc(intro)}</p>" if intro else "") + body, title, tags=tags)
+
+    def add_table(self, rows: list, title: str, *, columns=None, tags=(), intro=""):
+        return self.add_html(table_html(rows, columns=columns, intro=intro), title, tags=tags)
+
+    def add_rows(self, rows: list, title: str = "Comparison table", *, show_reference=False, show_paper=False,
+                 intro="", tags=()):
+        """Validation rows (see :func:`bearing_lab.validation.rows.make_row`) as the status table."""
+        self.rows.extend(rows)
+        return self.add_html(rows_table(rows, show_reference=show_reference, show_paper=show_paper, intro=intro),
+                             title, tags=tags)
+
+    def add_comparison(self, result, title: str = "Comparison", *, tags=(), figures=True, intro=""):
+        """A :class:`~bearing_lab.compare.ComparisonResult`: its table, and its figures."""
+        self.add_rows(result.rows, title, intro=intro, tags=tags)
+        if figures:
+            from matplotlib.figure import Figure
+            fig = Figure(figsize=(10, 9), layout="constrained")
+            axes = fig.subplots(3, 1)
+            result.plot_waveforms(ax=axes[0], window_s=(0, 0.1))
+            result.plot_spectra(ax=axes[1])
+            result.plot_envelope(ax=axes[2], fmax=600)
+            self.add_figure(fig, f"{title}: figures", tags=tags)
+        return self
+
+    def add_notice(self, heading: str, body: str, *, level="warn", title=None):
+        """A highlighted block ("warn", "bad", "good"): in its own section when ``title`` is given,
+        else appended to the last section (or a "Notes" section)."""
+        block = notice_html(heading, body, level=level)
+        if title is not None or not self.sections:
+            return self.add_html(block, title or "Notes")
+        self.sections[-1]["html"] += "\n" + block
+        return self
+
+    def add_provenance(self, info: dict | None = None, title="Provenance", *, software=True, tags=()):
+        """Where the results came from: ``info`` (inputs, checksums) and, with ``software``, the
+        package versions, source revision, host and date."""
+        from .provenance import environment
+        merged = dict(info or {})
+        if software:
+            merged.update(environment())
+        self.info.update(merged)
+        return self.add_html(kv_html(merged), title, tags=tags)
+
+    def add_citation(self, title="How to cite", *, note=""):
+        from .provenance import citation
+        c = citation()
+        body = template("cite.html").substitute(software=esc(c["software"]), paper=esc(c["paper"]), note=esc(note))
+        return self.add_html(body, title)
+
+    # ---- output
+    @property
+    def passed(self) -> bool:
+        return all(r.get("pass") for r in self.rows)
+
+    def status(self) -> tuple:
+        """(css class, text) of the page's result badge."""
+        if not self.rows:
+            return "skip", "no rows"
+        failing = [r for r in self.rows if not r.get("pass")]
+        if not failing:
+            return "pass", "all rows pass"
+        if all(r.get("known_limitation") for r in failing):
+            return "fail", "rows fail, each a known model limitation"
+        return "fail", "rows fail"
+
+    def to_html(self) -> str:
+        used: set = set()
+        secs, toc = [], []
+        for s in self.sections:
+            a = _anchor(s["title"], used)
+            toc.append(f'<a href="#{a}">{esc(s["title"])}</a>')
+            secs.append(template("section.html").substitute(anchor=a, title=esc(s["title"]), body=s["html"]))
+        n_pass = sum(bool(r.get("pass")) for r in self.rows)
+        n_known = sum(bool(r.get("known_limitation")) and not r.get("pass") for r in self.rows)
+        cls, text = self.status()
+        return template("case.html").substitute(
+            title=esc(self.title), subtitle=esc(self.subtitle), css=css(), toc=" ".join(toc),
+            sections="\n".join(secs), n_pass=n_pass, n_rows=len(self.rows), status_class=cls, status_text=text,
+            known=f" ({n_known} failing as known model limitations)" if n_known else "", date=_now(),
+            version=_version())
+
+    def save(self, path, *, overwrite=True):
+        """Write ``.html`` (self-contained page) or ``.json`` (sections, rows, info: reloadable), atomically."""
+        from .._files import atomic_open
+        path = Path(path)
+        if path.exists() and not overwrite:
+            raise FileExistsError(f"{path} exists (pass overwrite=True)")
+        if path.suffix == ".json":
+            text = json.dumps({"title": self.title, "subtitle": self.subtitle, "sections": self.sections,
+                               "rows": self.rows, "info": self.info}, default=str, allow_nan=True)
+        elif path.suffix in (".html", ".htm"):
+            text = self.to_html()
+        else:
+            raise ValueError(f"Invalid value for the report path suffix: allowed are '.html' and '.json', "
+                             f"but got {path.suffix!r} instead.")
+        path.parent.mkdir(parents=True, exist_ok=True)
+        with atomic_open(path, "w", encoding="utf-8") as fh:
+            fh.write(text)
+        return path
+
+    @classmethod
+    def load(cls, path) -> "Report":
+        d = json.loads(Path(path).read_text(encoding="utf-8"))
+        r = cls(d["title"], subtitle=d.get("subtitle", ""))
+        r.sections, r.rows, r.info = d["sections"], d["rows"], d.get("info", {})
+        return r
+
+
+def write_index(path, entries: list, *, title="bearing_lab validation", notes=()):
+    """The page listing all cases.
+
+    ``entries``: dicts with ``case``, ``title``, ``status`` ("pass", "fail", "skip", "error"),
+    ``n_pass``, ``n_rows``, ``wall_time_s``, ``failing`` and ``known`` (row labels), ``link``
+    (relative, or None), ``reason`` (for skipped or errored cases).
+    """
+    from .._files import atomic_open
+    notes_html = "".join(f'<p class="note">{esc(n)}</p>' for n in notes)
+    page = template("index.html").substitute(title=esc(title), css=css(), date=_now(), version=_version(),
+                                              rows=index_rows(entries), notes=notes_html)
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with atomic_open(path, "w", encoding="utf-8") as fh:
+        fh.write(page)
+    return path

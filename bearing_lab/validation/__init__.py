@@ -1,0 +1,49 @@
+"""Validation: a simulation against a recording (or a paper's figures), quantity by quantity.
+
+A case (TOML; ``docs/case-format.md``) names the recording, the bearing, the speed,
+the load and the defect(s), optionally a healthy reference recording of the same rig,
+and a tolerance with a reason for each compared quantity.  The structural path from
+the outer ring to the sensor is identified once per rig and held fixed; the rig's
+measured background can be added to the simulation; every row can fail, and a failing
+row says whether it is a known model limitation.
+
+Modules: :mod:`.case` (parsing), :mod:`.quantities` (the table of quantities),
+:mod:`.rows` (tolerances, rows), :mod:`.speed` (speed sources), :mod:`.simulation`
+(scenes and every simulator call), :mod:`.rig` (structural path, background),
+:mod:`.recording_case` / :mod:`.paper` (the two case kinds), :mod:`.figures`,
+:mod:`.pages` (report, summary.json), :mod:`.runner`, :mod:`.standin` (stand-in
+recordings), :mod:`.newcase` (``bearing-lab case new``).
+
+Public API
+----------
+load_case(name_or_path)                        -- a checked ValidationCase
+list_cases()                                   -- {name: title} of the shipped cases
+shipped_cases()                                -- {name: Traversable} (package data bearing_lab/validation/cases)
+check_case(case, mirror=None)                  -- raise if a recording is missing
+default_set(mirror=None)                       -- (cases, skipped) of the default set
+run_case(case, out_dir, ...) / run_validation(specs, out_dir, ...)
+QUANTITIES                                     -- the table of quantities
+Tolerance, make_row                            -- pass rules and rows
+make_standin_recording(path, ...)              -- a simulated recording with a hidden defect, jitter,
+                                                  a resonance, tones and noise (UFF58b or Testlab .mat)
+new_case_text(recording_path, ...)             -- the commented starting case `bearing-lab case new` writes
+"""
+from .case import DEFAULT_CASE, RecordingSpec, ValidationCase, list_cases, load_case, shipped_cases  # noqa: F401
+from .quantities import QUANTITIES, Quantity  # noqa: F401
+from .rows import Tolerance, make_row  # noqa: F401
+from .runner import CaseOutcome, check_case, default_set, run_case, run_validation  # noqa: F401
+
+
+def __getattr__(name):
+    if name in ("make_standin_recording", "StandIn"):
+        from . import standin
+        return getattr(standin, name)
+    if name == "new_case_text":
+        from .newcase import new_case_text
+        return new_case_text
+    raise AttributeError(f"module 'bearing_lab.validation' has no attribute {name!r}")
+
+
+__all__ = ["load_case", "list_cases", "shipped_cases", "check_case", "default_set", "run_case", "run_validation",
+           "CaseOutcome", "ValidationCase", "RecordingSpec", "QUANTITIES", "Quantity", "Tolerance", "make_row",
+           "make_standin_recording", "new_case_text", "DEFAULT_CASE"]

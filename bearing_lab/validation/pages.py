@@ -1,0 +1,153 @@
+"""A case's files: the report page (through :mod:`bearing_lab.report`), summary.json, comparison.nc.
+
+Public API
+----------
+write_case(case, result, out, *, wall) -> status   -- DIR/<case>/{index.html, comparison.nc, summary.json[, structural_path.json]}
+summary(case, result, wall) -> dict                -- the summary.json content
+MODEL_ASSUMPTIONS                                  -- the assumptions listed on every page
+"""
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+
+from ..report import Report
+from .rows import ROW_KEYS
+
+__all__ = ["write_case", "summary", "MODEL_ASSUMPTIONS", "clean"]
+
+#: what every simulated number assumes (docs/validation.md explains each)
+MODEL_ASSUMPTIONS = [
+    "Planar rolling-bearing model: inner ring (prescribed rotation) and outer ring as rigid bodies on "
+    "spring-damper supports; balls spaced by the cage; Hertz point contacts (Harris & Kotzalas 2007) with "
+    "the IMPACT damping law; defects as 2-D outlines on the raceway.",
+    "Ring support stiffness and damping, groove conformities, clearance and the unbalance are the scene's "
+    "documented defaults unless the case sets them; the load path is through the bearing.",
+    "No surface roughness, waviness, lubricant film or thermal effects; no shaft bending modes.",
+    "The housing and sensor are not simulated: a structural path (one or two resonances and a gain) is "
+    "identified once per rig and applied to the outer-ring acceleration.",
+    "The rig's machine tones and broadband noise are not simulated: the optional background model adds "
+    "what a recording measures between impacts (or on a healthy reference).",
+]
+
+
+def clean(v):
+    """JSON-safe: NaN/inf -> None, numpy scalars -> Python."""
+    if isinstance(v, dict):
+        return {str(k): clean(x) for k, x in v.items()}
+    if isinstance(v, (list, tuple)):
+        return [clean(x) for x in v]
+    if isinstance(v, (np.bool_, bool)):
+        return bool(v)
+    if isinstance(v, np.integer):
+        return int(v)
+    if isinstance(v, (float, np.floating)):
+        return float(v) if math.isfinite(v) else None
+    if isinstance(v, np.ndarray):
+        return clean(v.tolist())
+    return v
+
+
+def summary(case, result, wall) -> dict:
+    rows = [{k: r.get(k) for k in ROW_KEYS} for r in result.rows]
+    failing = [r for r in result.rows if not r["pass"]]
+    return clean({"case": case.name, "rows": rows, "wall_time_s": wall, "title": case.title,
+                  "status": "pass" if result.rows and not failing else "fail",
+                  "unexplained_failures": [r["quantity"] for r in failing if not r.get("known_limitation")],
+                  "known_limitations": [r["quantity"] for r in failing if r.get("known_limitation")],
+                  **result.extra})
+
+
+def _overview(report, rows):
+    failing = [r for r in rows if not r["pass"]]
+    unexplained = [r for r in failing if not r.get("known_limitation")]
+    known = [r for r in failing if r.get("known_limitation")]
+    if not failing:
+        report.add_notice("All rows pass.", "", level="good", title="Overview")
+        return
+    body = ""
+    if unexplained:
+        body += "Failing without a known reason: " + "; ".join(r["label"] for r in unexplained) + ". "
+    if known:
+        body += "Failing as known model limitations: " + "; ".join(r["label"] for r in known) + "."
+    report.add_notice(f"{len(failing)} of {len(rows)} rows fail.", body,
+                      level="bad" if unexplained else "warn", title="Overview")
+
+
+def _render_sections(report, sections):
+    last = None
+    for kind, title, payload in sections:
+        start = len(report.sections)
+        if kind == "rows":
+            report.add_rows(payload["rows"], title, show_reference=payload.get("show_reference", False),
+                            show_paper=payload.get("show_paper", False), intro=payload.get("intro", ""))
+        elif kind == "table":
+            report.add_table(payload["rows"], title, intro=payload.get("intro", ""))
+        elif kind == "figures":
+            report.add_figures(payload, title)
+        elif kind == "notice":
+            report.add_notice(title, payload[0], level=payload[1], title=title)
+        if title == last and len(report.sections) == start + 1 and start > 0:
+            merged = report.sections.pop()
+            report.sections[-1]["html"] += "\n" + merged["html"]
+        last = title
+
+
+def _compute_tables(report, result, wall):
+    ne = result.extra.get("numerical_error") or {}
+    items = ne.items() if ne and all(isinstance(v, dict) for v in ne.values()) else [("simulation", ne)]
+    rows = [{"run": k, "solver rtol": v["rtol"], "check rtol": v["rtol_check"], "checked over (s)": v["duration_s"],
+             "peak difference (m s-2)": v["peak_difference_m_s2"],
+             "peak difference (% of peak)": v["peak_difference_pct_of_peak"]} for k, v in items if v]
+    comp = result.extra.get("compute") or {}
+    crow = ([{"run": k, **v} for k, v in comp.items()] if comp and all(isinstance(v, dict) for v in comp.values())
+            else [{"run": "declared scene", **comp}])
+    report.add_table(crow + [{"run": "whole case (simulations, analysis, fits, figures)", "wall_time_s": wall}],
+                     "Compute time", intro="Simulation wall time excludes numba compilation (compile_time_s).")
+    report.add_table(rows, "Estimated numerical error", intro=(
+        "Each simulation is rerun with the solver tolerance divided by 10 over its first seconds; the peak "
+        "difference of the accelerometer signal estimates the integration error."))
+
+
+def build_report(case, result, wall) -> Report:
+    report = Report(f"Validation: {case.name}", subtitle=case.title)
+    _overview(report, result.rows)
+    _render_sections(report, result.sections)
+    from ..report import esc, table_html
+    model = result.extra.get("model") or {}
+    runs = model if model and all(isinstance(v, dict) for v in model.values()) else {"simulation": model}
+    report.add_html("<ul>" + "".join(f"<li>{esc(a)}</li>" for a in MODEL_ASSUMPTIONS) + "</ul>"
+                    + table_html([{"run": k, **v} for k, v in runs.items() if v],
+                                 intro="The simulations as they ran:"), "Model assumptions")
+    _compute_tables(report, result, wall)
+    report.add_provenance({"case": case.name, "case source": case.source, "case TOML": case.text,
+                           **result.provenance})
+    report.add_citation(note="Tolerances, quantities and the background model: docs/validation.md; the case "
+                             "format: docs/case-format.md.")
+    files = ('<p>Data of this page: <a href="comparison.nc">comparison.nc</a> (waveforms on one time base, spectra, '
+             'SES and the table; <code>bearing_lab.compare.ComparisonResult.load</code>) and '
+             '<a href="summary.json">summary.json</a>')
+    if result.path is not None and result.path.resonances:
+        files += ('; the structural path: <a href="structural_path.json">structural_path.json</a> (reuse it with '
+                  '<code>[structural_path] file = ...</code>)')
+    report.add_html(files + ".</p>", "Files")
+    return report
+
+
+def write_case(case, result, out, *, wall) -> str:
+    """Write the case's files into ``out`` (atomically); returns "pass" or "fail"."""
+    from .._files import atomic_open
+    out.mkdir(parents=True, exist_ok=True)
+    report = build_report(case, result, wall)
+    info = {k: v for k, v in report.info.items() if k != "case TOML"}
+    result.comparison.dataset.attrs["provenance"] = json.dumps(clean(info), default=str)
+    result.comparison.to_netcdf(out / "comparison.nc")
+    if result.path is not None and result.path.resonances:
+        result.path.save(out / "structural_path.json")
+    report.save(out / "index.html")
+    s = summary(case, result, wall)
+    with atomic_open(out / "summary.json", "w", encoding="utf-8") as fh:
+        json.dump(s, fh, indent=1, default=str)
+    return s["status"]

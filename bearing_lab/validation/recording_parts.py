@@ -1,0 +1,201 @@
+"""The parts of a recording case around its main comparison: the ratio companion, the healthy
+reference, and the assembly of rows, signals and figures into a :class:`CaseResult`.
+
+The result lists its report sections as plain data ``(kind, title, payload)``; the page
+is rendered by :mod:`bearing_lab.validation.pages`.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..analysis.measurement import measure
+from ..compare import G0, align_by_impulse_phase, compare, shift
+from . import figures, simulation
+from .recording import open_spec
+from .speed import resolve_speed
+
+__all__ = ["context", "ratio_companion", "healthy_reference", "assemble", "model_details"]
+
+
+def model_details(ds) -> dict:
+    """What the simulation that ran assumed (fidelity, contact and cage models, load path, solver)."""
+    keys = ("bearing", "fidelity", "defect_contact_models", "cage_model", "load_path", "solver_method",
+            "solver_rtol", "sensor_resonator", "anti_alias")
+    return {k: ds.attrs.get(k) for k in keys if k in ds.attrs}
+
+
+def context(case, prep, path, background=None) -> dict:
+    sp = case.section("structural_path")
+    fitted_here = sp.get("method", "fit") == "fit" and not sp.get("from_case") and not sp.get("file")
+    rec = prep.recording
+    t0 = rec.spec.start_s
+    from_rec = background is not None and background.source.startswith("the recording")
+    return {"path": path, "path_fitted_here": fitted_here, "speed_estimated": case.speed == "estimate",
+            "background_from_recording": from_rec,
+            "span_text": {"record": f"recording: whole record ({rec.x.size / rec.fs:.3g} s)",
+                          "segment": f"recording: {t0:g}-{t0 + prep.n / rec.fs:g} s"}}
+
+
+def ratio_companion(case, prep, path, *, mirror=None) -> dict:
+    """Impulse strength of the ``[ratio]`` companion: its recording, and its scene through the same path."""
+    from .case import _ratio_spec
+    cfg = case.section("ratio")
+    spec = _ratio_spec(case, cfg)
+    spec.duration_s, spec.start_s = case.recording.duration_s, case.recording.start_s
+    rec = open_spec(spec, case.name, mirror)
+    speed = resolve_speed(spec.speed, rec.dataset, rec.x, bearing=prep.bearing, case_name=case.name,
+                          where="ratio.speed")
+    n = int(round(spec.duration_s * rec.fs))
+    m_exp = measure(rec.segment(n), rec.fs, bearing=prep.bearing, rpm=speed.rpm, shaft_hz=speed.rpm / 60,
+                    fault=prep.fault)
+    scene = simulation.scene_from(cfg["scene"], rpm=speed.rpm, fs=rec.fs, duration=n / rec.fs,
+                                  overrides={**(cfg.get("set") or {}), **simulation.SENSOR_OFF}, case_name=case.name)
+    xs = path.apply(simulation.signal(simulation.run(scene))[:n], rec.fs)
+    m_sim = measure(xs, rec.fs, bearing=prep.bearing, rpm=speed.rpm, shaft_hz=speed.rpm / 60, fault=prep.fault)
+    e, s = m_exp["impulse_strength"], m_sim["impulse_strength"]
+    this_e, this_s = prep.measured["segment"]["impulse_strength"], None
+    note = (f"median impact peaks (m s-2): recording {this_e:.3g} / {rec.path.name} {e:.3g}; the companion "
+            f"simulated ({cfg['scene']}, same fixed path) {s:.3g}")
+    return {"experiment": e, "simulation": s, "label": cfg.get("label", f"this / {rec.path.name}"), "note": note,
+            "recording": str(rec.path), "sha256": rec.sha256, "speed": speed.source, "scene": str(cfg["scene"]),
+            "simulation_this": this_s}
+
+
+def _decomposition(parts: dict) -> list:
+    total = parts.get("recording")
+    out = []
+    for label, rms in parts.items():
+        out.append({"signal": label, "RMS (m s-2)": rms, "RMS (g)": rms / G0,
+                    "share of the recording's RMS (%)": 100.0 * rms / total if total else float("nan")})
+    return out
+
+
+def healthy_reference(case, prep, path, background, reference) -> dict:
+    """The healthy bearing simulated against the healthy reference recording of the same rig."""
+    from .recording_case import evaluate_rows
+    spec_speed = reference.spec.speed if reference.spec.speed is not None else case.speed
+    speed = resolve_speed(spec_speed, reference.dataset, reference.x, bearing=prep.bearing, case_name=case.name,
+                          where="reference.speed")
+    fs, n = prep.fs, prep.n
+    xr = reference.at_rate(fs)
+    scene = simulation.build_scene(case, rpm=speed.rpm, fs=fs, duration=n / fs, healthy=True,
+                                   overrides=simulation.SENSOR_OFF)
+    x = simulation.signal(simulation.run(scene))[:n]
+    sig = {"model": x, "path": path.apply(x, fs)}
+    sig["path+background"] = sig["path"] + (background.synthesize(n, seed=1) if background is not None else 0.0)
+    kw = {"bearing": prep.bearing, "rpm": speed.rpm, "shaft_hz": speed.rpm / 60}
+    exp = {"record": measure(xr, fs, **kw), "segment": measure(xr[:n], fs, **kw)}
+    sim = {k: measure(v, fs, **kw) for k, v in sig.items()}
+    ctx = {"path": path, "path_fitted_here": False, "speed_estimated": spec_speed == "estimate",
+           "span_text": {"record": f"reference: whole record ({xr.size / fs:.3g} s)",
+                         "segment": f"reference: first {n / fs:g} s"}}
+    rows = evaluate_rows(case.reference_tolerances, exp, sim, context=ctx, group="healthy")
+    rms = _rms_parts({"experiment": xr[:n], **sig}, background, n)
+    return {"rows": rows, "decomposition": _decomposition(rms), "speed": speed.source, "signals": sig, "xr": xr[:n],
+            "recording": str(reference.path), "sha256": reference.sha256}
+
+
+def _rms_parts(signals, background, n) -> dict:
+    rms = {"recording": float(np.nanstd(signals["experiment"])),
+           "bearing model alone": float(np.nanstd(signals["model"])),
+           "bearing model through the structural path": float(np.nanstd(signals["path"]))}
+    if background is not None:
+        rms["rig background (tones and broadband)"] = background.rms
+        rms["model through the path + background"] = float(np.nanstd(signals["path+background"]))
+    return rms
+
+
+def _aligned(prep, signals):
+    xe = prep.recording.segment(prep.n)
+    m = prep.measured["record"]
+    period = m["excitation_period"]
+    k = (align_by_impulse_phase(xe, signals["path"], prep.fs, period, band=m["extras"]["band"])
+         if np.isfinite(period) else 0)
+    return {"experiment": xe, **{name: shift(v, k, prep.n) for name, v in signals.items()}}, k
+
+
+def _path_table(path) -> list:
+    rows = [{"parameter": f"resonance {i + 1}: frequency (Hz)", "value": r.frequency_hz} for i, r in
+            enumerate(path.resonances)]
+    rows += [{"parameter": f"resonance {i + 1}: damping ratio", "value": r.damping_ratio} for i, r in
+             enumerate(path.resonances)]
+    rows.append({"parameter": "gain (low-frequency)", "value": path.gain})
+    f = path.fit
+    if f.get("failed"):
+        rows.append({"parameter": "not identified", "value": "; ".join(path.problems)})
+    elif f:
+        rows += [{"parameter": "fit residual, RMS of log-amplitude residuals (dB)", "value": f["residual_db"]},
+                 {"parameter": "the same for the simulation without a path (dB)", "value": f["initial_db"]},
+                 {"parameter": "impacts pooled (recording / simulation)",
+                  "value": f"{f['n_impacts_recording']} / {f['n_impacts_simulation']}"}]
+        rows += [{"parameter": f"search bounds: {k}", "value": f"{v[0]:.4g} to {v[1]:.4g}"}
+                 for k, v in f["bounds"].items()]
+    return rows
+
+
+def _sections(case, prep, path, background, aligned, shift_k, result, healthy):
+    rec = prep.recording
+    secs = [("rows", "Comparison table", {"rows": result.rows})]
+    intro = f"{path.source}. Status: {path.status}."
+    if path.problems:
+        secs.append(("notice", "Structural path", (f"The structural path is {path.status}: " + "; ".join(path.problems)
+                                                   + ". Rows after the path are not trusted and fail.", "bad")))
+    secs.append(("table", "Structural path", {"rows": _path_table(path), "intro": intro
+                                              + " ".join(path.fit.get("notes", []) if path.fit else [])}))
+    if path.resonances:
+        secs.append(("figures", "Structural path", [figures.structural_path(path, prep.fs)]))
+    if background is not None:
+        bg = background.to_dict()
+        tones = ", ".join(f"{t['frequency_hz']:.2f} Hz ({t['amplitude_m_s2'] / G0:.3g} g)" for t in bg["tones"][:8])
+        secs.append(("table", "Background model", {"rows": [
+            {"measured on": bg["source"], "RMS (g)": bg["rms_m_s2"] / G0, "tones RMS (g)": bg["rms_tones_m_s2"] / G0,
+             "broadband RMS (g)": bg["rms_broadband_m_s2"] / G0, "strongest tones": tones or "none"}],
+            "intro": "Added to the simulation after the structural path (signal 'path+background'), so RMS, crest "
+                     "factor and kurtosis compare like with like (docs/validation.md, 'Background model')."}))
+        secs.append(("figures", "Background model", [figures.psd_overlay(
+            {"recording": aligned["experiment"], "simulation through the path": aligned["path"],
+             "background": background.synthesize(prep.n), "path + background": aligned["path+background"]},
+            prep.fs, "power spectral densities of the compared segment")]))
+    if healthy:
+        secs.append(("rows", "Healthy reference: what the bearing contributes and what the rig does",
+                     {"rows": healthy["rows"]}))
+        secs.append(("table", "Healthy reference: what the bearing contributes and what the rig does",
+                     {"rows": healthy["decomposition"], "intro": f"Healthy simulation at {healthy['speed']}."}))
+    secs.append(("table", "What the bearing contributes and what the rig does", {
+        "rows": _decomposition(_rms_parts(aligned, background, prep.n)),
+        "intro": "RMS over the compared segment of the recording and of each part of the simulation."}))
+    figs = [figures.waveforms(aligned, prep.fs, recording_label=f"{rec.path.name} ({rec.channel})", shift=shift_k),
+            figures.spectra(aligned, prep.fs), figures.envelope_spectra(result)]
+    secs.append(("figures", "Waveforms, spectra and squared envelope spectra", figs))
+    return secs
+
+
+def assemble(case, prep, path, background, signals, rows, err, healthy, ctx):
+    from .recording_case import CaseResult
+    aligned, k = _aligned(prep, signals)
+    m = prep.measured["record"]
+    ff = m["extras"]["analysis"]["fault_frequencies"]
+    result = compare(aligned, prep.fs, rows, n=prep.n, band=m["extras"]["band"], ses_fmax=1000.0,
+                     attrs={"case": case.name, "kind": "recording", "alignment_shift_samples": k,
+                            "bpfo_hz": ff["bpfo"]["expected_hz"], "bpfi_hz": ff["bpfi"]["expected_hz"],
+                            "shaft_hz": prep.speed.rpm / 60.0, "speed_source": prep.speed.source,
+                            "structural_path": path.to_dict()})
+    ds = prep.dataset
+    extra = {"speed": {"rpm": prep.speed.rpm, "source": prep.speed.source}, "model": model_details(ds),
+             "structural_path": path.to_dict(), "background": background.to_dict() if background else None,
+             "numerical_error": err, "ratio": {k_: v for k_, v in (ctx.get("ratio") or {}).items()},
+             "healthy": {"decomposition": healthy["decomposition"], "speed": healthy["speed"]} if healthy else None,
+             "compute": {"wall_time_s": float(ds.attrs["wall_time_s"]),
+                         "compile_time_s": float(ds.attrs.get("compile_time_s", 0.0)),
+                         "solver_rtol": float(ds.attrs.get("solver_rtol", float("nan"))),
+                         "solver_steps": int(ds.attrs.get("solver_steps", 0))}}
+    rec = prep.recording
+    prov = {"recording file": str(rec.path), "recording sha256": rec.sha256, "channel": rec.channel,
+            "reader": rec.dataset.attrs.get("reader", ""), "calibration factor": rec.spec.scale,
+            "speed": prep.speed.source, "structural path": path.source, "scene": prep.scene.to_toml()}
+    if healthy:
+        prov["healthy reference"] = f"{healthy['recording']} (sha256 {healthy['sha256']})"
+    if ctx.get("ratio"):
+        prov["ratio companion"] = f"{ctx['ratio']['recording']} (sha256 {ctx['ratio']['sha256']})"
+    sections = _sections(case, prep, path, background, aligned, k, result, healthy)
+    return CaseResult(rows, result, extra, prov, sections, path)

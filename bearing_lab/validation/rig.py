@@ -1,0 +1,130 @@
+"""What belongs to the rig, not to the defect: the structural path and the background, each obtained once.
+
+A case says how (``[structural_path]``, ``[background]``):
+
+- the path is *fitted* on this case's recording against its declared scene, taken from
+  *another case* of the same rig (``from_case``: that case's fit), read from a *file*
+  written by an earlier run, *fixed* to given values, or *none*;
+- the background is measured on the healthy ``[reference]`` recording of the same rig
+  when the case has one (independent of the compared recording), else between the
+  impacts of the recording itself (then the rows that include it are marked as not
+  independent evidence).
+
+Both are then held fixed for every simulation the case compares, so a different defect
+geometry shows as a different result instead of being absorbed by a re-fit.
+
+Public API
+----------
+identify_path(case, *, mirror=None) -> StructuralPath   -- (cached per case) the fitted path of a case
+path_for(case, rec, measured, sim_x, *, mirror=None) -> StructuralPath
+background_for(case, rec, measured, reference=None) -> Background | None
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..analysis.structural_path import Resonance, StructuralPath, fit_structural_path
+from ..errors import AnalysisError, ValidationCaseError
+
+__all__ = ["identify_path", "path_for", "background_for", "PATH_DEFAULT_BOUNDS"]
+
+#: default search bounds of the path fit: housing modes of bench rigs sit at 1-10 kHz; the
+#: damping ratio of bolted housings is 1-30 %; the gain is free over six decades
+PATH_DEFAULT_BOUNDS = {"frequency_hz": (500.0, None), "damping_ratio": (0.005, 0.5), "gain": (1e-3, 1e3)}
+
+_CACHE: dict = {}
+
+
+def _fixed(case, sp) -> StructuralPath:
+    freqs = sp["frequency_hz"] if isinstance(sp["frequency_hz"], list) else [sp["frequency_hz"]]
+    zetas = sp["damping_ratio"] if isinstance(sp["damping_ratio"], list) else [sp["damping_ratio"]]
+    path = StructuralPath(tuple(Resonance(float(f), float(z)) for f, z in zip(freqs, zetas)), float(sp["gain"]),
+                          "given by the case (method = \"fixed\")")
+    try:
+        path.check()
+    except AnalysisError as exc:
+        raise ValidationCaseError(f"validation case {case.name!r}: structural_path: {exc}") from None
+    return path
+
+
+def _fit(case, rec, measured, sim_x) -> StructuralPath:
+    sp = case.section("structural_path")
+    period = measured["excitation_period"]
+    if not np.isfinite(period):
+        raise AnalysisError("structural path: the recording shows no impact train to fit the path on "
+                            f"({measured['extras']['notes'].get('excitation_period', '')}); use method = "
+                            "\"fixed\", from_case or \"none\"")
+    bounds = {k: tuple(sp.get(k, v)) for k, v in PATH_DEFAULT_BOUNDS.items()}
+    return fit_structural_path(rec.x, sim_x, rec.fs, period, band=measured["extras"]["band"],
+                               n_resonances=int(sp.get("resonances", 1)), frequency_bounds=bounds["frequency_hz"],
+                               damping_bounds=bounds["damping_ratio"], gain_bounds=bounds["gain"],
+                               source=f"fitted on {rec.path.name} ({rec.channel}) against the scene of case "
+                                      f"{case.name!r}, pooled over all impacts")
+
+
+def _fit_or_fail(case, rec, measured, sim_x) -> StructuralPath:
+    try:
+        return _fit(case, rec, measured, sim_x)
+    except AnalysisError as exc:
+        return StructuralPath.failed(f"the path could not be identified: {exc}",
+                                     f"fit on {rec.path.name} ({rec.channel}) for case {case.name!r}")
+
+
+def identify_path(case, *, mirror=None) -> StructuralPath:
+    """The path a case fits on its own recording (simulating its declared scene); cached per case."""
+    key = (case.source, mirror)
+    if key not in _CACHE:
+        from .recording_case import prepare
+        prep = prepare(case, mirror=mirror)
+        _CACHE[key] = _fit_or_fail(case, prep.recording, prep.measured["record"], prep.simulated["model"])
+    return _CACHE[key]
+
+
+def path_for(case, rec, measured, sim_x, *, mirror=None) -> StructuralPath:
+    """The structural path this case compares through (see the module docstring)."""
+    sp = case.section("structural_path")
+    method = sp.get("method", "fit")
+    if method == "none":
+        return StructuralPath.identity()
+    if method == "fixed":
+        return _fixed(case, sp)
+    if sp.get("file"):
+        p = Path(str(sp["file"]))
+        p = p if p.is_absolute() or case.base_dir is None else Path(str(case.base_dir)) / p
+        path = StructuralPath.load(p)
+        path.source = f"read from {p.name} ({path.source})"
+        return path
+    if sp.get("from_case"):
+        from .case import load_case
+        other = load_case(sp["from_case"])
+        path = identify_path(other, mirror=mirror)
+        return StructuralPath(path.resonances, path.gain, f"identified by case {other.name!r}: {path.source}",
+                              dict(path.fit), dict(path.curves))
+    path = _fit_or_fail(case, rec, measured, sim_x)
+    _CACHE[(case.source, mirror)] = path
+    return path
+
+
+def background_for(case, rec, measured, reference=None):
+    """The rig's background (tones and broadband), or None when ``[background] enabled = false``."""
+    from ..analysis.background import estimate_background
+    cfg = case.section("background")
+    if not cfg.get("enabled", True):
+        return None
+    src = cfg.get("source", "auto")
+    opts = {"max_tones": int(cfg.get("max_tones", 20)), "tone_snr_db": float(cfg.get("tone_snr_db", 15.0))}
+    fr = measured["extras"]["shaft_hz_used"]
+    if reference is not None and src in ("auto", "reference"):
+        x = reference.at_rate(rec.fs)
+        return estimate_background(x, rec.fs, shaft_hz=fr, source=(
+            f"the healthy reference recording {reference.path.name} ({reference.channel}), whole record"
+            + (f", resampled from {reference.fs:g} Hz" if abs(reference.fs - rec.fs) > 1e-6 else "")), **opts)
+    period = measured["excitation_period"]
+    times = measured["extras"]["impact_times"] if np.isfinite(period) else None
+    rates = [measured[k] for k in ("bpfo", "bpfi") if np.isfinite(measured[k])]
+    where = "between impacts" if times is not None and len(times) >= 3 else "whole record (no impact train)"
+    return estimate_background(rec.x, rec.fs, times=times, period=period if times is not None else None,
+                               exclude_hz=rates, shaft_hz=fr,
+                               source=f"the recording {rec.path.name} ({rec.channel}), {where}", **opts)

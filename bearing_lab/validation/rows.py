@@ -1,0 +1,122 @@
+"""Tolerances and table rows: every compared number, how close counts as agreement, and why.
+
+Why strict rules: a validation table is evidence only if each row can fail.  So a
+row with a missing or NaN value on either side fails (a quantity the model or the
+recording does not show is a disagreement to report, not an agreement), ratios are
+compared with a tolerance (never by their ordering alone), and a failing row says
+whether it is a known model limitation (with the reason given in the case) or not.
+
+Public API
+----------
+Tolerance(kind, value, reason, known_limitation="") -- "pct" (|sim - exp| <= value % of |exp|) or
+                                                       "factor" (1/value <= sim/exp <= value)
+make_row(quantity, simulation, experiment, tolerance, ...) -> dict
+row_status(row) -> "pass" | "known limitation" | "fail"
+ROW_KEYS                                            -- the keys every row has (summary.json, netCDF)
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from ..errors import ValidationCaseError
+
+__all__ = ["Tolerance", "make_row", "row_status", "ROW_KEYS", "TOLERANCE_KINDS"]
+
+TOLERANCE_KINDS = ("pct", "factor")
+
+#: keys of a row, in table order
+ROW_KEYS = ("quantity", "label", "units", "simulation", "experiment", "reference_value", "reference_label",
+            "difference", "difference_pct", "tolerance_pct", "tolerance", "rule", "pass", "status", "reason",
+            "known_limitation", "note", "simulated_signal", "experiment_span", "independent", "paper_simulation")
+
+
+@dataclass(frozen=True)
+class Tolerance:
+    """A pass rule with its reason, and optionally why a failure is a known model limitation.
+
+    ``kind`` "pct": ``|sim - exp| <= value % of |exp|``; "factor": ``1/value <= sim/exp <= value``
+    (both of the same sign).  Any NaN fails.
+    """
+
+    kind: str
+    value: float
+    reason: str
+    known_limitation: str = ""
+
+    def __post_init__(self):
+        if self.kind not in TOLERANCE_KINDS:
+            msg = (f"Invalid value for the tolerance kind. Allowed values are 'pct' and 'factor', but got "
+                   f"{self.kind!r} instead")
+            raise ValidationCaseError(msg)
+        if not (self.reason or "").strip():
+            raise ValidationCaseError("every tolerance needs a reason (key 'reason')")
+        try:
+            v = float(self.value)
+        except (TypeError, ValueError):
+            raise ValidationCaseError(f"tolerance {self.kind} = {self.value!r} is not a number") from None
+        if not (math.isfinite(v) and v > 0):
+            raise ValidationCaseError(f"tolerance {self.kind} = {self.value!r} must be a positive finite number")
+        if self.kind == "factor" and v <= 1:
+            raise ValidationCaseError(f"tolerance factor = {self.value!r} must be greater than 1")
+        object.__setattr__(self, "value", v)
+
+    @property
+    def pct(self) -> float:
+        """The tolerance as a percentage of the experiment (factor f -> (f - 1) * 100, high side)."""
+        return self.value if self.kind == "pct" else (self.value - 1.0) * 100.0
+
+    def text(self) -> str:
+        return f"±{self.value:g} %" if self.kind == "pct" else f"factor {self.value:g}"
+
+    def check(self, sim: float, exp: float) -> bool:
+        if not (math.isfinite(sim) and math.isfinite(exp)):
+            return False
+        if self.kind == "pct":
+            return abs(sim - exp) <= self.value / 100.0 * abs(exp) * (1 + 1e-12)
+        if exp == 0 or sim == 0 or (sim > 0) != (exp > 0):
+            return False
+        return 1.0 / self.value <= sim / exp <= self.value
+
+
+def _f(v) -> float:
+    try:
+        return float(v) if v is not None else float("nan")
+    except (TypeError, ValueError):
+        return float("nan")
+
+
+def row_status(row: dict) -> str:
+    """"pass", "known limitation" (a failure the case explains) or "fail"."""
+    if row["pass"]:
+        return "pass"
+    return "known limitation" if row.get("known_limitation") else "fail"
+
+
+def make_row(quantity: str, simulation, experiment, tolerance: Tolerance, *, label, units, note="",
+             reference_value=None, reference_label="", signal="", span="", independent=True,
+             paper_simulation=None, untrusted="") -> dict:
+    """One table row: simulation, experiment, difference, % difference, tolerance, pass, status.
+
+    ``untrusted`` (a reason) makes the row fail whatever its numbers: used when a number
+    depends on a structural-path fit that is degraded.
+    """
+    s, e = _f(simulation), _f(experiment)
+    ok = tolerance.check(s, e)
+    notes = [note] if note else []
+    if not (math.isfinite(s) and math.isfinite(e)):
+        missing = " and ".join(w for w, v in (("simulation", s), ("experiment", e)) if not math.isfinite(v))
+        notes.insert(0, f"missing value ({missing}): counts as a failure")
+    if untrusted:
+        ok = False
+        notes.insert(0, f"not trusted: {untrusted}")
+    diff = s - e
+    pct = 100.0 * diff / abs(e) if (math.isfinite(diff) and e != 0) else float("nan")
+    row = {"quantity": quantity, "label": label, "units": units, "simulation": s, "experiment": e,
+           "reference_value": _f(reference_value), "reference_label": reference_label,
+           "difference": diff, "difference_pct": pct, "tolerance_pct": tolerance.pct,
+           "tolerance": tolerance.text(), "rule": tolerance.kind, "pass": bool(ok), "reason": tolerance.reason,
+           "known_limitation": tolerance.known_limitation, "note": "; ".join(notes), "simulated_signal": signal,
+           "experiment_span": span, "independent": bool(independent), "paper_simulation": _f(paper_simulation)}
+    row["status"] = row_status(row)
+    return row

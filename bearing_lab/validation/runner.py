@@ -1,0 +1,171 @@
+"""Run cases and write the index: one broken case never loses the others' reports.
+
+Public API
+----------
+CaseOutcome                                  -- name, title, status (pass/fail/error/skip), rows, wall time
+check_case(case, mirror=None)                -- raise ValidationCaseError if a recording the case needs is missing
+default_set(mirror=None) -> (cases, skipped) -- the shipped cases marked default (skipped: recordings missing)
+run_case(case, out_dir, *, progress, mirror) -> CaseOutcome
+run_validation(specs, out_dir, *, strict, progress, mirror) -> (outcomes, exit status)
+"""
+from __future__ import annotations
+
+import os
+import sys
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ..errors import BearingLabError, ValidationCaseError
+from .case import DEFAULT_CASE, load_case, shipped_cases
+
+__all__ = ["CaseOutcome", "check_case", "default_set", "run_case", "run_validation"]
+
+
+class _Steps:
+    """A tqdm bar over a case's steps (silent when progress is off)."""
+
+    def __init__(self, desc, total, progress, position=1):
+        self.bar = None
+        if progress:
+            from tqdm.auto import tqdm
+            self.bar = tqdm(total=total, desc=desc, leave=False, position=position, unit="step")
+
+    def step(self, what):
+        if self.bar is not None:
+            self.bar.set_postfix_str(what)
+            self.bar.update(1)
+
+    def close(self):
+        if self.bar is not None:
+            self.bar.close()
+
+
+@dataclass
+class CaseOutcome:
+    name: str
+    title: str
+    status: str                    # pass | fail | error | skip
+    rows: list = field(default_factory=list)
+    wall_time_s: float = 0.0
+    out_dir: Path | None = None
+    reason: str = ""
+    extra: dict = field(default_factory=dict)
+
+    @property
+    def n_pass(self):
+        return sum(bool(r["pass"]) for r in self.rows)
+
+
+def check_case(case, mirror=None) -> None:
+    """Raise ValidationCaseError when a recording the case needs is not available."""
+    from .recording import locate, missing_reason
+    for spec in case.recording_labels:
+        if locate(spec, mirror) is None:
+            raise ValidationCaseError(f"validation case {case.name!r}: {missing_reason(spec, mirror)}")
+
+
+def default_set(mirror=None):
+    """The embedded default set: every shipped case marked ``default = true`` whose recordings are
+    available (the paper case first).  Returns (cases, skipped) with skipped = [(name, title, reason)]."""
+    cases, skipped = [], []
+    for name in shipped_cases():
+        c = load_case(name)
+        if not c.default and name != DEFAULT_CASE:
+            continue
+        try:
+            check_case(c, mirror)
+        except ValidationCaseError as exc:
+            skipped.append((c.name, c.title, str(exc)))
+            continue
+        cases.append(c)
+    cases.sort(key=lambda c: (c.name != DEFAULT_CASE, c.name))
+    return cases, skipped
+
+
+def run_case(case, out_dir, *, progress=True, mirror=None, position=1) -> CaseOutcome:
+    """Run one case and write ``out_dir/<case>/{index.html, comparison.nc, summary.json}``."""
+    from .pages import write_case
+    t0 = time.perf_counter()
+    out = Path(out_dir) / case.name
+    out.mkdir(parents=True, exist_ok=True)
+    steps = _Steps(case.name, 3 if case.kind == "paper" else 4, progress, position=position)
+    try:
+        if case.kind == "paper":
+            from .paper import run_paper_case
+            result = run_paper_case(case, out, steps=steps)
+        else:
+            from .recording_case import run_recording_case
+            result = run_recording_case(case, steps=steps, mirror=mirror)
+    finally:
+        steps.close()
+    wall = time.perf_counter() - t0
+    status = write_case(case, result, out, wall=wall)
+    return CaseOutcome(case.name, case.title, status, result.rows, wall, out, extra=result.extra)
+
+
+def _load_named(specs, mirror):
+    cases = [load_case(s) for s in specs]
+    for c in cases:
+        check_case(c, mirror)
+    return cases
+
+
+def _index_entry(oc) -> dict:
+    failing = [r for r in oc.rows if not r["pass"]]
+    return {"case": oc.name, "title": oc.title, "status": oc.status, "n_pass": oc.n_pass, "n_rows": len(oc.rows),
+            "wall_time_s": oc.wall_time_s, "failing": [r["label"] for r in failing if not r.get("known_limitation")],
+            "known": [r["label"] for r in failing if r.get("known_limitation")],
+            "link": f"{oc.name}/index.html" if oc.status in ("pass", "fail") else None, "reason": oc.reason}
+
+
+def _run_one(c, out_dir, progress, mirror):
+    try:
+        return run_case(c, out_dir, progress=progress, mirror=mirror)
+    except Exception as exc:  # one broken case must not lose the others' reports: listed as "error"
+        msg = f"{exc}" if isinstance(exc, BearingLabError) else f"{type(exc).__name__}: {exc}"
+        msg = msg.splitlines()[0] if msg else type(exc).__name__
+        print(f"bearing-lab validate: case {c.name!r} failed to run: {msg}", file=sys.stderr)
+        return CaseOutcome(c.name, c.title, "error", reason=msg)
+
+
+def run_validation(specs=None, out_dir="reports", *, strict=False, progress=True, mirror=None):
+    """Run cases (default: the embedded default set) and write ``out_dir/index.html``.
+
+    Bad input (an unknown case, an invalid file, a missing recording of a named case) raises
+    ValidationCaseError before anything runs.  A case that fails while running is listed as an
+    error in the index and the others still run.  Returns (outcomes, exit status): 0, or 1 with
+    ``strict`` when a row fails or a case errors.
+    """
+    from ..report import write_index
+    out_dir = Path(out_dir)
+    notes, skipped = [], []
+    if specs:
+        cases = _load_named(specs, mirror)
+    else:
+        cases, skipped = default_set(mirror)
+        if skipped:
+            m = mirror or os.environ.get("BEARING_LAB_MIRROR")
+            notes.append("Recording cases skipped: " + ", ".join(s[0] for s in skipped) + ". "
+                         + (f"They need the public recordings in the mirror {m}." if m else
+                            "BEARING_LAB_MIRROR is not set: set it to a directory holding the public recordings "
+                            "to add the CWRU cases."))
+    out_dir.mkdir(parents=True, exist_ok=True)
+    outcomes = []
+    bar = None
+    if progress:
+        from tqdm.auto import tqdm
+        bar = tqdm(total=len(cases), desc="validate", unit="case", position=0)
+    for c in cases:
+        if bar is not None:
+            bar.set_postfix_str(c.name)
+        outcomes.append(_run_one(c, out_dir, progress, mirror))
+        if bar is not None:
+            bar.update(1)
+    if bar is not None:
+        bar.close()
+    entries = [_index_entry(o) for o in outcomes]
+    entries += [{"case": n, "title": t, "status": "skip", "reason": r, "link": None} for n, t, r in skipped]
+    write_index(out_dir / "index.html", entries, notes=notes)
+    bad = any(o.status in ("fail", "error") for o in outcomes)
+    return outcomes, (1 if strict and bad else 0)

@@ -1,0 +1,95 @@
+"""Shaft speed checked against the bearing's kinematics: never a fault comb for the shaft.
+
+Kinematic ratios (Harris & Kotzalas 2007): 6308 BPFO = 3.0719 f_r, so BPFO/3 lies
+2.4 % above f_r, inside any +-5 % prior window; MFPT BPFO = 3.245 f_r.
+"""
+import numpy as np
+import pytest
+
+from analysis_synth import bearing_signal
+from bearing_lab import get_bearing
+from bearing_lab.analysis import analyze, shaft_speed
+from bearing_lab.analysis import _shaft
+
+
+def _impacts_only(fr=30.0, bearing="6308", seed=0, duration=5.0):
+    """Slip-free outer-race impacts and no shaft line at all (a simulation's signal)."""
+    bpfo = get_bearing(bearing).fault_frequencies(fr)["bpfo"]
+    return bearing_signal(bpfo, fs=20000.0, duration=duration, slip=0.0, decay=1500.0, noise=0.05, seed=seed)
+
+
+def test_prior_is_not_refined_onto_bpfo_over_three():
+    """The paper-slot trap: a 1800 r/min prior and a BPFO comb whose third sub-harmonic is
+    30.72 Hz.  Breaking it: without the sub-multiple rule (_primitive always True) the
+    estimate moves to 30.72 Hz."""
+    x, fs = _impacts_only()
+    sp = shaft_speed(x, fs, bearing="6308", rpm=1800)
+    assert sp["status"] == "unconfirmed"
+    assert sp["shaft_hz"] == 30.0
+    assert any("sub-multiple" in c["note"] for c in sp["candidates"])
+
+
+def test_blind_impact_comb_is_unresolved_and_read_three_ways():
+    x, fs = _impacts_only()
+    r = analyze(x, fs, bearing="6308")
+    assert r["speed_source"] == "unresolved"
+    assert r["diagnosis"] == "uncertain" and r["verdict"] == "uncertain"
+    readings = {i["diagnosis"]: i["shaft_hz"] for i in r["evidence"]["interpretations"]}
+    assert readings["outer_race"] == pytest.approx(30.0, rel=1e-3)
+    assert set(readings) == {"outer_race", "inner_race", "ball"}
+
+
+def test_blind_speed_from_the_1x_family_confirmed_by_the_fault():
+    """Shaft harmonics off the mains grid plus an outer-race fault: the speed is resolved
+    within 0.05 % and the fault family at that speed confirms it."""
+    fr = 29.37
+    bpfo = get_bearing("6205").fault_frequencies(fr)["bpfo"] * 0.995
+    x, fs = bearing_signal(bpfo, shaft_hz=fr, shaft_amp=0.3, seed=2)
+    sp = shaft_speed(x, fs, bearing="6205")
+    assert sp["source"] == "estimated"
+    assert sp["shaft_hz"] == pytest.approx(fr, rel=5e-4)
+    assert "BPFO" in sp["note"]
+
+
+def test_blind_fault_comb_stronger_than_the_shaft_points_to_the_shaft():
+    """The MFPT trap: the BPFO comb (80 Hz) outscores the 25 Hz shaft family; the comb is
+    recognised as BPFO of a shaft that has a 1x family of its own."""
+    fr = 24.8
+    bpfo = get_bearing("MFPT").fault_frequencies(fr)["bpfo"]
+    x, fs = bearing_signal(bpfo, fs=48828.0, duration=3.0, slip=0.0, decay=2500.0, f_res=9000.0, amp=3.0,
+                           shaft_hz=fr, shaft_amp=0.05, noise=0.3, seed=3)
+    raw = _shaft.RawLines(x, fs, top_hz=2100)
+    assert raw.candidates(5, 100, count=1)[0] == pytest.approx(bpfo, rel=2e-3)  # the trap is real
+    sp = shaft_speed(x, fs, bearing="MFPT")
+    assert sp["source"] == "estimated"
+    assert sp["shaft_hz"] == pytest.approx(fr, rel=1e-3)
+
+
+def test_chance_combs_in_a_sparse_short_record_do_not_name_a_speed():
+    """1 s records (1 Hz bins) with a few dozen random lines: some comb of 5 lines always
+    exists somewhere in 5-100 Hz; the chance test refuses it."""
+    rng = np.random.default_rng(4)
+    fs = 20480.0
+    t = np.arange(20480) / fs
+    x = rng.normal(0, 1, t.size)
+    for f in rng.uniform(20, 400, 12):
+        x += 0.3 * np.cos(2 * np.pi * round(f) * t)
+    sp = shaft_speed(x, fs, bearing="ZA-2115")
+    assert sp["source"] == "unresolved"
+
+
+def test_stored_speed_contradicted_by_the_signal():
+    """A stored 1500 r/min while the shaft turns at 29.37 Hz (1762 r/min) with an outer-race
+    fault: the prior is marked contradicted and no fault is named at the wrong speed."""
+    fr = 29.37
+    bpfo = get_bearing("6205").fault_frequencies(fr)["bpfo"] * 0.995
+    x, fs = bearing_signal(bpfo, shaft_hz=fr, shaft_amp=0.3, seed=2)
+    r = analyze(x, fs, bearing="6205", rpm=1500, rpm_source="file")
+    assert r["speed_source"] == "file" and r["speed"]["status"] == "contradicted"
+    assert r["verdict"] != "diagnosed"
+
+
+@pytest.mark.parametrize("hs, primitive", [([1, 2, 3, 4, 5], True), ([3, 6, 9, 12, 15], False),
+                                           ([2, 4, 6, 8, 10, 3], False), ([2, 4, 6, 3, 5, 7], True)])
+def test_primitive_family(hs, primitive):
+    assert _shaft._primitive(hs) is primitive
