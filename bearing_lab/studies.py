@@ -41,6 +41,8 @@ import time
 import numpy as np
 import xarray as xr
 
+from ._files import savefig, write_text
+
 G0 = 9.80665
 STUDY_FS = 100_000.0
 
@@ -166,7 +168,7 @@ def run_paper_studies(out_dir="reports/studies", *, progress=True, studies=None)
         for a in ax:
             a.grid(alpha=0.3)
         fig.tight_layout()
-        fig.savefig(out / f"{s}.png", dpi=110)
+        savefig(fig, out / f"{s}.png", dpi=110)
         figs[s] = fig
     # mechanism: defected ball's outer-race load through the passage
     fig, ax = plt.subplots(2, len(names), figsize=(4 * len(names), 6), squeeze=False, sharex="col")
@@ -183,7 +185,7 @@ def run_paper_studies(out_dir="reports/studies", *, progress=True, studies=None)
         for a in ax[:, i]:
             a.grid(alpha=0.3)
     fig.tight_layout()
-    fig.savefig(out / "mechanism.png", dpi=100)
+    savefig(fig, out / "mechanism.png", dpi=100)
     figs["mechanism"] = fig
     n = len(rows)
     table = xr.Dataset(
@@ -240,4 +242,4 @@ def _write_html(out, names, rows, figs):
     parts.append("<h2>Mechanism</h2>")
     parts.append(f"<img src='data:image/png;base64,{_png(figs['mechanism'])}'>")
     parts.append("</body></html>")
-    (out / "index.html").write_text("\n".join(parts), encoding="utf-8")
+    write_text(out / "index.html", "\n".join(parts))
