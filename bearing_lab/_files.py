@@ -5,11 +5,15 @@ all survive a crash, a kill or a second process writing the same name.  The rule
 same everywhere: write a temporary file in the target's directory, flush it to disk,
 then rename it over the target in one step (``os.replace`` is atomic on POSIX and on
 Windows within one volume).  On any failure the temporary file is removed and the old
-target, if any, is left exactly as it was.
+target, if any, is left exactly as it was.  A writer killed outright (SIGKILL) leaves its
+hidden temporary ``.<name>.<host>-<pid>.*``; the next successful write of the same file
+removes it once that process is gone.
 
 atomic_path(path)      -- context manager yielding a temporary path to write by name
                           (netCDF4, savefig, ...); renamed over ``path`` on success
 atomic_open(path, mode) -- context manager yielding an open file object ("w", "wb", ...)
+write_text(path, text)  -- atomic ``Path.write_text`` (UTF-8)
+savefig(fig, path, **kw) -- atomic ``Figure.savefig`` to a file name (format from its suffix)
 sha256_file(path)      -- hex digest of a file, read in 1 MiB blocks
 sha256_bytes(data)     -- hex digest of bytes
 cache_dir(kind)        -- per-user cache folder for ``kind`` ("tables", ...), created on use;
@@ -21,9 +25,33 @@ from contextlib import contextmanager
 import hashlib
 import os
 from pathlib import Path
+import socket
+import stat
 import tempfile
+import threading
 
-__all__ = ["atomic_path", "atomic_open", "sha256_file", "sha256_bytes", "cache_dir"]
+__all__ = ["atomic_path", "atomic_open", "write_text", "savefig", "sha256_file", "sha256_bytes",
+           "cache_dir"]
+
+
+_UMASK_LOCK = threading.Lock()
+_HOST = "".join(c for c in socket.gethostname() if c.isalnum())[:16] or "host"
+
+
+def _new_file_mode(path: Path) -> int:
+    """The mode a plain ``open(path, "w")`` would give: the old file's, else 0o666 & ~umask.
+
+    (``mkstemp`` creates 0o600 files; a result file must not become private by being
+    written atomically.)
+    """
+    try:
+        return stat.S_IMODE(os.stat(path).st_mode)
+    except OSError:
+        pass
+    with _UMASK_LOCK:
+        mask = os.umask(0o022)
+        os.umask(mask)
+    return 0o666 & ~mask
 
 
 def _fsync_dir(directory: Path) -> None:
@@ -59,8 +87,12 @@ def atomic_path(path, *, suffix: str | None = None):
     """
     path = Path(path)
     directory = path.parent if str(path.parent) else Path(".")
-    fd, tmp_name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix or path.suffix or ".tmp",
-                                    dir=directory)
+    fd, tmp_name = tempfile.mkstemp(prefix=f".{path.name}.{_HOST}-{os.getpid()}.",
+                                    suffix=suffix or path.suffix or ".tmp", dir=directory)
+    try:
+        os.fchmod(fd, _new_file_mode(path))
+    except (OSError, AttributeError):  # no fchmod (Windows): keep mkstemp's mode
+        pass
     os.close(fd)
     tmp = Path(tmp_name)
     try:
@@ -76,6 +108,38 @@ def atomic_path(path, *, suffix: str | None = None):
             pass
         raise
     _fsync_dir(directory)
+    _remove_stale(directory, path.name)
+
+
+def _remove_stale(directory: Path, name: str) -> None:
+    """Delete temporaries of ``name`` left by killed writers of this host (their process is gone).
+
+    A writer killed by SIGKILL cannot remove its temporary; the next successful write of the
+    same file does, when the temporary's process id no longer runs here.
+    """
+    prefix = f".{name}.{_HOST}-"
+    try:
+        entries = [e for e in os.scandir(directory) if e.name.startswith(prefix)]
+    except OSError:
+        return
+    for e in entries:
+        pid = e.name[len(prefix):].split(".", 1)[0]
+        if not pid.isdigit() or int(pid) == os.getpid() or _alive(int(pid)):
+            continue
+        try:
+            os.unlink(e.path)
+        except OSError:
+            pass
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OSError):
+        return True
+    return True
 
 
 @contextmanager
@@ -86,6 +150,21 @@ def atomic_open(path, mode: str = "w", **kwargs):
     with atomic_path(path) as tmp:
         with open(tmp, mode.replace("x", "w"), **kwargs) as fh:
             yield fh
+
+
+def write_text(path, text: str, *, encoding: str = "utf-8") -> Path:
+    """Write ``text`` to ``path`` atomically; return the path."""
+    with atomic_open(path, "w", encoding=encoding) as fh:
+        fh.write(text)
+    return Path(path)
+
+
+def savefig(fig, path, **kwargs) -> Path:
+    """``fig.savefig`` to ``path`` atomically (the temporary name keeps the suffix, so the
+    format is still chosen by it); return the path."""
+    with atomic_path(path) as tmp:
+        fig.savefig(str(tmp), **kwargs)
+    return Path(path)
 
 
 def sha256_file(path, *, block: int = 1 << 20) -> str:

@@ -29,6 +29,7 @@ import time
 import numpy as np
 import xarray as xr
 
+from ._files import savefig, write_text
 from .sim import load_scene
 from .sim.assembly import assemble
 from .sim.integrate import METHODS, _decimate_acc, _run, _warm_up, anti_alias_taps
@@ -202,7 +203,7 @@ def run_bench(out_dir="reports/performance", *, duration=0.3, scipy_duration=0.0
     from .io_netcdf import write_netcdf
     write_netcdf(ds, out / "performance.nc")
     rules = _rules(rows)
-    (out / "auto_rules.toml").write_text(rules)
+    write_text(out / "auto_rules.toml", rules)
     _report(out, rows, notes)
     return ds
 
@@ -304,7 +305,7 @@ def _report(out, rows, notes):
         ax.legend(fontsize=7)
         ax.grid(alpha=0.3, which="both")
         fig.tight_layout()
-        fig.savefig(out / f"work_precision_{sc.replace('/', '_').replace('=', '')}.png", dpi=100)
+        savefig(fig, out / f"work_precision_{sc.replace('/', '_').replace('=', '')}.png", dpi=100)
         best = fastest_within_tolerance(rows, sc)
         sp = [r for r in rs if r["solver"] == "scipy" and math.isfinite(r["err_peak"]) and r["err_peak"] <= TOL_PEAK]
         html.append(f"<h2>{sc}</h2><p>reference self-check (rtol 1e-10 vs 1e-9): "
@@ -326,7 +327,7 @@ def _report(out, rows, notes):
                         f"<td>{f(r['err_period'])}</td><td>{f(r['err_duration'])}</td></tr>")
         html.append("</table>")
     html.append("</body></html>")
-    (out / "index.html").write_text("\n".join(html), encoding="utf-8")
+    write_text(out / "index.html", "\n".join(html))
 
 
 def rows_of(ds: xr.Dataset) -> list:

@@ -15,7 +15,8 @@ load_registry()                     -- {name: Recording} from data/recordings.cs
 get(name)                           -- one Recording (name, or a unique suffix such as "130_OR007@6_0.mat")
 cwru_record(number)                 -- the Recording of a CWRU record number, or None
 cwru_sampling_rate(number)          -- its rate in Hz, or None if unknown
-fetch(name, mirror=None, dest=None) -- Path of a hash-checked local copy
+fetch(name, mirror=None, dest=None) -- Path of a hash-checked local copy (never deletes, never
+                                       writes outside dest or through a symbolic link)
 locate(name, mirror=None)           -- Path in a mirror or the cache, without copying, or None
 pooch_registry()                    -- {name: "sha256:..."} for pooch.create
 data_dir()                          -- where fetch puts files by default
@@ -24,9 +25,7 @@ from __future__ import annotations
 
 import csv
 import functools
-import hashlib
 import os
-import shutil
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -142,11 +141,8 @@ def data_dir() -> Path:
 
 
 def _sha256(path: Path) -> str:
-    h = hashlib.sha256()
-    with open(path, "rb") as fh:
-        for chunk in iter(lambda: fh.read(1 << 22), b""):
-            h.update(chunk)
-    return h.hexdigest()
+    from ._files import sha256_file
+    return sha256_file(path)
 
 
 def _mirror_dir(mirror) -> Path | None:
@@ -175,6 +171,52 @@ def locate(name: str, mirror=None) -> Path | None:
     return None
 
 
+class UnverifiedWarning(UserWarning):
+    """A recording was fetched that the registry has no checksum for: it could not be verified."""
+
+
+def _safe_target(dest: Path, rec: Recording) -> Path:
+    """``dest/<name>``, refusing any path that would write outside ``dest`` or through a link."""
+    target = dest / rec.name
+    root = dest.resolve()
+    parts = Path(rec.name).parts
+    if Path(rec.name).is_absolute() or ".." in parts:
+        raise RecordingError(f"registry name {rec.name!r} is not a relative path inside --dest")
+    p = dest
+    for part in parts:
+        p = p / part
+        if not p.is_symlink():
+            continue
+        where = os.readlink(p)
+        if not p.exists():
+            raise RecordingError(f"{p}: is a dangling symbolic link (to {where}); refusing to write "
+                                 "through it: remove it, or fetch into another --dest")
+        if not p.resolve().is_relative_to(root):
+            raise RecordingError(f"{p}: is a symbolic link to {where}, outside --dest {dest}; "
+                                 "refusing to write there")
+    if not target.resolve().is_relative_to(root):
+        raise RecordingError(f"{target}: resolves outside --dest {dest}; refusing to write there")
+    return target
+
+
+def _install(src_copy, target: Path, rec: Recording, verify: bool, where: str) -> Path:
+    """Copy ``src_copy`` (a path) to ``target`` atomically after checking its hash."""
+    import shutil
+    import warnings
+    from ._files import atomic_path
+    if verify and rec.sha256:
+        _check(rec, Path(src_copy), where)
+    elif verify:
+        warnings.warn(f"{rec.name}: the registry has no sha256 for this recording, so the copy "
+                      f"from {where} is not verified", UnverifiedWarning, stacklevel=3)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    with atomic_path(target) as tmp:  # the old file, good or bad, stays until this succeeds
+        shutil.copyfile(src_copy, tmp)
+        if verify and rec.sha256:
+            _check(rec, tmp, f"copy of {where}")
+    return target
+
+
 def fetch(name: str, mirror=None, dest=None, *, download: bool = True, verify: bool = True) -> Path:
     """Bring a registered recording into ``dest`` (default :func:`data_dir`), hash-checked.
 
@@ -189,8 +231,8 @@ def fetch(name: str, mirror=None, dest=None, *, download: bool = True, verify: b
     download : bool
         Try the publisher's URL (pooch) when no mirror holds the file.
     verify : bool
-        Check the sha256 (files without a registered checksum are copied with a note
-        in the return value's log only).
+        Check the sha256; a recording without a registered checksum is copied with an
+        :class:`UnverifiedWarning`.
 
     Returns
     -------
@@ -200,42 +242,59 @@ def fetch(name: str, mirror=None, dest=None, *, download: bool = True, verify: b
     Raises
     ------
     RecordingError
-        Unknown name, checksum mismatch, or the file is neither in a mirror nor downloadable.
+        Unknown name, checksum mismatch, a path that would leave ``dest`` or pass through a
+        symbolic link, or the file is neither in a mirror nor downloadable.
+
+    Notes
+    -----
+    Nothing is deleted: a new copy replaces the target in one rename once it is complete
+    and verified, and an existing copy that fails its check stays where it is until a
+    verified one replaces it.
     """
     rec = get(name)
     dest = Path(dest) if dest else data_dir()
-    target = dest / rec.name
+    target = _safe_target(dest, rec)
+    stale = None
     if target.is_file():
         try:
             if verify:
                 _check(rec, target, "existing copy")
             return target
-        except RecordingError:
-            target.unlink()
+        except RecordingError as exc:
+            stale = exc  # replaced below if a verified copy can be had; never deleted
     m = _mirror_dir(mirror)
     if m is not None:
         src = m / rec.name
         if src.is_file():
-            if verify:
-                _check(rec, src, f"mirror {m}")
             if src.resolve() == target.resolve():
+                if verify:
+                    _check(rec, src, f"mirror {m}")
                 return target
-            target.parent.mkdir(parents=True, exist_ok=True)
-            shutil.copyfile(src, target)
-            return target
+            return _install(src, target, rec, verify, f"mirror {m}")
     if not download or not rec.url:
         where = f"mirror {m}" if m else "no mirror (pass --mirror DIR or set BEARING_LAB_MIRROR)"
         how = f"download it from {rec.page or rec.url}" if (rec.page or rec.url) else "get it"
         msg = (f"recording {rec.name!r} is not in {where}"
                + ("" if rec.url else " and has no direct download URL")
                + f"; {how} and place it under <mirror>/{rec.name}")
+        if stale is not None:
+            msg = f"{stale}; the existing copy is left in place, and no replacement: {msg}"
         raise RecordingError(msg)
+    return _download(rec, target, verify, stale)
+
+
+def _download(rec: Recording, target: Path, verify: bool, stale) -> Path:
+    import tempfile
     import pooch
-    try:
-        got = pooch.retrieve(rec.url, known_hash=f"sha256:{rec.sha256}" if rec.sha256 else None,
-                             fname=Path(rec.name).name, path=target.parent, progressbar=False)
-    except Exception as exc:  # network down, 404, hash mismatch
-        msg = (f"recording {rec.name!r}: download from {rec.url} failed ({type(exc).__name__}: "
-               f"{exc}); without network, copy it from a mirror with --mirror DIR")
-        raise RecordingError(msg) from exc
-    return Path(got)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory(dir=target.parent, prefix=".fetch-") as tmp:
+        try:
+            got = pooch.retrieve(rec.url, known_hash=f"sha256:{rec.sha256}" if rec.sha256 else None,
+                                 fname=Path(rec.name).name, path=tmp, progressbar=False)
+        except Exception as exc:  # network down, 404, hash mismatch
+            msg = (f"recording {rec.name!r}: download from {rec.url} failed ({type(exc).__name__}: "
+                   f"{exc}); without network, copy it from a mirror with --mirror DIR")
+            if stale is not None:
+                msg = f"{stale}; the existing copy is left in place: {msg}"
+            raise RecordingError(msg) from exc
+        return _install(got, target, rec, verify, rec.url)

@@ -1,42 +1,71 @@
-"""Lossless, compressed netCDF4 writing shared by simulations, recordings and reports."""
+"""Lossless, compressed, atomic netCDF4 writing shared by simulations, recordings and reports.
+
+Why one writer: every ``.nc`` bearing_lab writes must survive a failure, a kill or a
+second process writing the same name (the file is written beside the target and
+renamed over it in one step, :func:`bearing_lab._files.atomic_path`), must carry
+checksums (HDF5's Fletcher-32 on every numeric chunk, so a damaged chunk cannot be
+read as data), and must read back bit for bit.
+"""
 from __future__ import annotations
 
 from pathlib import Path
 
 import numpy as np
 
+from ._files import atomic_path
 from .errors import BearingLabError
 
 
+def _text(v: str) -> str:
+    """A string netCDF can store: undecodable bytes of a file name become U+FFFD."""
+    try:
+        v.encode("utf-8")
+        return v
+    except UnicodeEncodeError:
+        return v.encode("utf-8", "surrogateescape").decode("utf-8", "replace")
+
+
+def _attr(v):
+    if isinstance(v, (bool, np.bool_)):
+        return int(v)
+    if isinstance(v, (list, tuple)):
+        return _text("; ".join(map(str, v)))
+    if v is None:
+        return ""
+    if isinstance(v, str):
+        return _text(v)
+    return v
+
+
 def write_netcdf(ds, path, *, complevel: int = 4, error=BearingLabError) -> Path:
-    """Write ``ds`` to netCDF4 (zlib + shuffle); reading it back is bit-for-bit equal.
+    """Write ``ds`` to netCDF4 (zlib + shuffle + Fletcher-32), atomically.
 
     Floats keep their dtype and get no fill value (a NaN-free Dataset stays NaN-free);
-    attributes netCDF cannot store (bools, lists, None) are written as ints / "; "-joined
-    strings / "".  A failure raises ``error`` naming the path.
+    attributes netCDF cannot store (bools, lists, None, undecodable file names) are
+    written as ints / "; "-joined strings / "" / repaired text.  The target is replaced
+    only once the new file is complete and on disk; a failure leaves an existing file
+    untouched and raises ``error`` naming the path.
     """
     path = Path(path)
     enc = {}
     for name, var in ds.variables.items():
         if var.dtype.kind in "iufc":
-            enc[name] = {"zlib": True, "complevel": int(complevel), "shuffle": True}
+            enc[name] = {"zlib": True, "complevel": int(complevel), "shuffle": True,
+                         "fletcher32": True}
             if var.dtype.kind in "fc":
                 enc[name]["_FillValue"] = None
-    attrs = {}
-    for k, v in ds.attrs.items():
-        if isinstance(v, (bool, np.bool_)):
-            v = int(v)
-        elif isinstance(v, (list, tuple)):
-            v = "; ".join(map(str, v))
-        elif v is None:
-            v = ""
-        attrs[k] = v
     out = ds.copy()
-    out.attrs = attrs
+    out.attrs = {k: _attr(v) for k, v in ds.attrs.items()}
+    for name in out.variables:
+        out[name].attrs = {k: _attr(v) for k, v in out[name].attrs.items()}
+    if path.is_dir():
+        raise error(f"{path}: is a directory; give a file name ending in .nc")
     try:
-        out.to_netcdf(path, engine="netcdf4", format="NETCDF4", encoding=enc)
-    except (OSError, ValueError, TypeError, RuntimeError) as exc:
-        raise error(f"{path}: cannot write netCDF4 ({type(exc).__name__}: {exc})") from exc
+        with atomic_path(path) as tmp:
+            out.to_netcdf(tmp, engine="netcdf4", format="NETCDF4", encoding=enc)
+    except (OSError, ValueError, TypeError, RuntimeError, UnicodeError) as exc:
+        raise error(f"{path}: cannot write netCDF4 ({type(exc).__name__}: {exc}); an existing "
+                    "file of that name is left as it was") from exc
     return path
 
 
@@ -47,4 +76,6 @@ def check_output_path(text: str) -> Path:
         raise BearingLabError(f"-o {text}: the output must be a netCDF file ending in .nc")
     if not out.parent.exists():
         raise BearingLabError(f"-o {text}: directory {out.parent} does not exist")
+    if out.is_dir():
+        raise BearingLabError(f"-o {text}: is a directory; give a file name ending in .nc")
     return out

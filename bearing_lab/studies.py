@@ -46,6 +46,8 @@ import time
 import numpy as np
 import xarray as xr
 
+from ._files import savefig, write_text
+
 G0 = 9.80665
 STUDY_FS = 100_000.0
 
@@ -196,7 +198,7 @@ def run_paper_studies(out_dir="reports/studies", *, progress=True, studies=None)
     figs = {s: _pulse_figure(s, results) for s in names}
     figs["mechanism"] = _mechanism_figure(names, results)
     for name, fig in figs.items():
-        fig.savefig(out / f"{name}.png", dpi=110 if name != "mechanism" else 100)
+        savefig(fig, out / f"{name}.png", dpi=110 if name != "mechanism" else 100)
     table = _table(rows, time.perf_counter() - t0)
     from .io_netcdf import write_netcdf
     write_netcdf(table, out / "studies.nc")
@@ -332,4 +334,4 @@ def _write_html(out, names, rows, figs):
     parts.append("<h2>Mechanism</h2>")
     parts.append(f"<img src='data:image/png;base64,{_png(figs['mechanism'])}'>")
     parts.append("</body></html>")
-    (out / "index.html").write_text("\n".join(parts), encoding="utf-8")
+    write_text(out / "index.html", "\n".join(parts))

@@ -39,7 +39,11 @@ Every scene runs through the same function on every path and the results are
 placed by index, so a Dask sweep is bit for bit equal to a serial one.
 
 Cache: a finished scene is written to ``cache_dir/<hash>.nc`` (netCDF4,
-uncompressed, float64 kept exactly) where the hash is the sha256 of the resolved scene TOML
+uncompressed, float64 kept exactly, written atomically) with its checksum in
+``<hash>.nc.sha256``; on reading, the file must match its checksum and hold the
+scene's variables and shapes with finite values, else it is computed again, the
+sweep warns (:class:`CacheWarning`) and says so in ``sweep_cache_rejected`` and
+``sweep_cache_rejected_entries``.  The hash is the sha256 of the resolved scene TOML
 (:meth:`Scene.to_toml`), the bearing_lab version (with a fingerprint of the
 simulator's source, so a development install never reuses results of older
 code) and the simulate keywords.  A
@@ -64,7 +68,8 @@ from . import __version__
 from .schema import DEFAULT_CHANNEL
 from .errors import BearingLabError, SceneError
 
-__all__ = ["sweep", "scene_hash", "code_fingerprint", "default_cache_dir", "dim_name", "key_units"]
+__all__ = ["sweep", "scene_hash", "code_fingerprint", "default_cache_dir", "dim_name", "key_units",
+           "CacheWarning"]
 
 # units of the --set key suffixes (scene.py's _SUFFIX), as CF/UDUNITS strings
 _UNIT_STRINGS = {
@@ -77,6 +82,12 @@ _SIM_KW = {"duration": "output.duration_s", "fs": "output.sample_rate_hz", "rtol
            "method": "solver.method", "step": "solver.step_s", "fidelity": "fidelity"}
 _METRICS = ("rms", "peak", "crest_factor", "kurtosis")
 _METRIC_SIGNAL = DEFAULT_CHANNEL  # the simulator's accelerometer signal
+_REQUIRED = ("outer_ring_acc_y", "outer_ring_acc_x", "outer_ring_disp_y", "outer_ring_disp_x",
+             "inner_ring_disp_y", "inner_ring_disp_x")
+
+
+class CacheWarning(UserWarning):
+    """A sweep-cache entry was damaged or incomplete and its scene was computed again."""
 
 
 # ---------------------------------------------------------------- helpers
@@ -208,35 +219,78 @@ def _metrics(x: np.ndarray) -> dict:
 
 
 # ---------------------------------------------------------------- one scene (runs on workers)
+def _checksum_path(path: Path) -> Path:
+    return path.with_name(path.name + ".sha256")
+
+
 def _write_cache(ds, path: Path) -> None:
     """Write one scene to the cache: netCDF4, float64 as is, *uncompressed* (zlib costs
-    ~0.12 s per 1 s scene, a third of its simulation, to save a third of 3.5 MB)."""
+    ~0.12 s per 1 s scene, a third of its simulation, to save a third of 3.5 MB), then its
+    checksum file ``<hash>.nc.sha256`` (``sha256sum -c`` format).  Both are written
+    atomically; an entry without its checksum is incomplete and is never read."""
+    from ._files import atomic_open, atomic_path, sha256_file
     path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.stem}.{uuid.uuid4().hex}.tmp.nc")
     out = ds.copy(deep=False)
     out.attrs = {k: (int(v) if isinstance(v, (bool, np.bool_)) else "" if v is None else v)
                  for k, v in ds.attrs.items()}
     try:
-        out.to_netcdf(tmp, engine="netcdf4", format="NETCDF4")
-        os.replace(tmp, path)  # atomic: a stopped sweep never leaves a half-written scene
+        with atomic_path(path) as tmp:
+            out.to_netcdf(tmp, engine="netcdf4", format="NETCDF4")
+            digest = sha256_file(tmp)
+        with atomic_open(_checksum_path(path), "w") as fh:
+            fh.write(f"{digest}  {path.name}\n")
     except (OSError, ValueError, RuntimeError) as exc:
         raise BearingLabError(f"sweep: cannot write the cache file {path}: {exc}") from None
-    finally:
-        if tmp.exists():
-            tmp.unlink()
 
 
-def _read_cache(path: Path, digest: str):
-    import xarray as xr
-    if not path.is_file():
-        return None
-    try:
-        ds = xr.load_dataset(path, engine="netcdf4")
-    except (OSError, ValueError, RuntimeError):
-        return None  # unreadable: recompute
+def _cache_problem(ds, digest: str, expect: dict) -> str | None:
+    """What is wrong with a cache entry's content, or None (shape, names, finite values)."""
     if ds.attrs.get("sweep_scene_hash") != digest:
-        return None
-    return ds
+        return "it belongs to another scene"
+    for name in _REQUIRED:
+        if name not in ds.data_vars:
+            return f"variable {name} is missing"
+    for dim, n in expect.items():
+        if ds.sizes.get(dim) != n:
+            return f"dimension {dim} has {ds.sizes.get(dim)} entries, the scene needs {n}"
+    for name, var in ds.data_vars.items():
+        if var.dtype.kind in "fc" and not np.all(np.isfinite(var.values)):
+            return f"variable {name} holds NaN/Inf"
+    return None
+
+
+def _read_cache(path: Path, digest: str, expect: dict):
+    """Return (Dataset or None, problem or None): None/None when there is no entry.
+
+    The file's bytes are checked against its checksum file before netCDF reads them
+    (a damaged file never reaches the C library), then the content is validated.
+    """
+    import xarray as xr
+    from ._files import sha256_file
+    if not path.is_file():
+        return None, None
+    sums = _checksum_path(path)
+    try:
+        recorded = sums.read_text().split()[0] if sums.is_file() else None
+    except (OSError, IndexError, UnicodeDecodeError):
+        recorded = None
+    if recorded is None:
+        return None, "no checksum file (an interrupted write)"
+    try:
+        if sha256_file(path) != recorded:
+            return None, "its sha256 does not match the checksum file"
+        ds = xr.load_dataset(path, engine="netcdf4")
+    except (OSError, ValueError, RuntimeError, KeyError) as exc:
+        return None, f"unreadable ({type(exc).__name__}: {exc})"
+    return (None, problem) if (problem := _cache_problem(ds, digest, expect)) else (ds, None)
+
+
+def _drop_entry(path: Path) -> None:
+    for p in (path, _checksum_path(path)):
+        try:
+            p.unlink()
+        except OSError:
+            pass
 
 
 def _simulate_scene(scene_toml: str, digest: str, cache_path: str | None):
@@ -260,14 +314,13 @@ def _resolve(scene, params: dict, simulate_kwargs: dict):
     from .sim import load_scene
     if not isinstance(params, dict) or not params:
         raise SceneError("sweep: give the swept parameters as a dict {key: [values, ...]}")
-    fixed = {}
+    from .sim.scene import merge_overrides
     unknown_kw = {"progress"} & set(simulate_kwargs)
     if unknown_kw:
         raise BearingLabError("sweep: 'progress' is the sweep's own progress bar, not a simulate option")
-    for kw, v in simulate_kwargs.items():
-        if v is None:
-            continue
-        fixed[_SIM_KW.get(kw, kw)] = v
+    named = {_SIM_KW[k]: v for k, v in simulate_kwargs.items() if k in _SIM_KW}
+    fixed = merge_overrides({k: v for k, v in simulate_kwargs.items()
+                             if k not in _SIM_KW and v is not None}, **named)
     keys, values, seen = [], [], {}
     for key, vals in params.items():
         if not isinstance(key, str) or not key:
@@ -299,6 +352,13 @@ def _resolve(scene, params: dict, simulate_kwargs: dict):
             scenes.append(base.replace(**ov))
         except SceneError as exc:
             what = ", ".join(f"{k}={v!r}" for k, v in ov.items())
+            raise SceneError(f"sweep scene {what}: {exc}") from None
+    from .sim.budget import check_budget
+    for combo, sc in zip(itertools.product(*values), scenes):
+        try:
+            check_budget(sc)  # every scene, before any runs
+        except SceneError as exc:
+            what = ", ".join(f"{k}={v!r}" for k, v in zip(keys, combo))
             raise SceneError(f"sweep scene {what}: {exc}") from None
     shape = tuple(len(v) for v in values)
     for what, get in (("output.duration_s", lambda s: s.duration),
@@ -332,17 +392,22 @@ def _client_for(scheduler, n_workers):
         import logging
         import dask
         # the workers' statistical profiler samples the running task every 10 ms: ~5 % of a scene
-        with dask.config.set({"distributed.worker.profile.enabled": False}):
-            cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                                   dashboard_address=None, silence_logs=logging.ERROR)
-        return Client(cluster), cluster, True, f"local cluster, {n} worker processes x 1 thread"
+        try:
+            with dask.config.set({"distributed.worker.profile.enabled": False}):
+                cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                                       dashboard_address=None, silence_logs=logging.ERROR)
+            return Client(cluster), cluster, True, f"local cluster, {n} worker processes x 1 thread"
+        except Exception as exc:  # noqa: BLE001 - Dask raises RuntimeError, OSError, TimeoutError...
+            raise BearingLabError(f"sweep: the local Dask cluster of {n} worker(s) did not start "
+                                  f"({type(exc).__name__}: {exc}); run in this process with "
+                                  "scheduler='serial' (CLI --scheduler serial)") from None
     if isinstance(scheduler, str):
         if n_workers is not None:
             raise BearingLabError(f"sweep: n_workers applies to the local cluster; the cluster at "
                                   f"{scheduler} has its own workers")
         try:
             client = Client(scheduler, timeout="10s")
-        except (OSError, TimeoutError, ValueError) as exc:
+        except Exception as exc:  # noqa: BLE001 - OSError, TimeoutError, ValueError, RuntimeError
             raise BearingLabError(f"sweep: cannot connect to the Dask scheduler {scheduler!r}: {exc}") from None
         return client, None, True, f"scheduler {scheduler}"
     raise BearingLabError(f"sweep: scheduler={scheduler!r}: use None (local cluster), 'serial', "
@@ -396,15 +461,7 @@ def sweep(scene, params: dict, *, scheduler=None, n_workers: int | None = None, 
     n = len(scenes)
 
     acc = _Stack(shape, n)
-    hits = 0
-    todo = []
-    for i, dg in enumerate(digests):
-        ds = _read_cache(cdir / f"{dg}.nc", dg) if cdir is not None else None
-        if ds is None:
-            todo.append(i)
-        else:
-            acc.put(i, ds, cached=True)
-            hits += 1
+    hits, todo, rejected = _from_cache(cdir, scenes, digests, acc)
 
     bar = None
     if progress:
@@ -486,12 +543,14 @@ def sweep(scene, params: dict, *, scheduler=None, n_workers: int | None = None, 
     out["wall_time_s"] = (sdims, acc.wall.reshape(shape),
                           {"units": "s", "long_name": "compute time of the scene (simulate's wall_time_s, "
                                                       "without compilation; from the run that filled the cache)"})
-    out["solver_steps"] = (sdims, acc.steps.reshape(shape), {"long_name": "accepted solver steps"})
+    out["solver_steps"] = (sdims, acc.steps.reshape(shape), {"units": "1",
+                                                             "long_name": "accepted solver steps"})
     out["cached"] = (sdims, acc.cached.reshape(shape).astype(np.int8),
-                     {"long_name": "1: the scene was read from the sweep cache", "flag_values": "0 1"})
+                     {"units": "1", "long_name": "1: the scene was read from the sweep cache",
+                      "flag_values": "0 1"})
     out["scene_hash"] = (sdims, np.asarray(digests, dtype=object).reshape(shape),
-                         {"long_name": "sha256 of the resolved scene TOML, version and simulate options "
-                                       "(the cache file name)"})
+                         {"units": "1", "long_name": "sha256 of the resolved scene TOML, version and "
+                                                     "simulate options (the cache file name)"})
     out.attrs.update(acc.common_attrs)
     # attributes that differ between scenes (e.g. the fidelity "auto" picked) become variables
     for name, vals in acc.scene_attrs.items():
@@ -502,8 +561,9 @@ def sweep(scene, params: dict, *, scheduler=None, n_workers: int | None = None, 
         arr = (np.asarray(vals, dtype=float) if kinds <= {int, float} and kinds != {int}
                else np.asarray(vals, dtype=np.int64) if kinds == {int}
                else np.asarray([str(v) for v in vals], dtype=object))
-        out[var] = (sdims, arr.reshape(shape), {"long_name": f"simulation attribute {name!r} of each scene "
-                                                             "(it differs across the sweep)"})
+        out[var] = (sdims, arr.reshape(shape), {"units": key_units(name) or "1",
+                                                "long_name": f"simulation attribute {name!r} of each "
+                                                             "scene (it differs across the sweep)"})
     out.attrs.update({
         "title": f"bearing_lab sweep of scene {base.name!r}",
         "scene_name": base.name,
@@ -513,6 +573,8 @@ def sweep(scene, params: dict, *, scheduler=None, n_workers: int | None = None, 
         "sweep_dims": " ".join(sdims),
         "sweep_n_scenes": int(n),
         "sweep_cache_hits": int(hits),
+        "sweep_cache_rejected": int(len(rejected)),
+        "sweep_cache_rejected_entries": "; ".join(rejected),
         "sweep_computed": int(n - hits),
         "sweep_cache_dir": str(cdir) if cdir is not None else "",
         "sweep_scheduler": desc if todo else "none (all scenes cached)",
@@ -521,6 +583,34 @@ def sweep(scene, params: dict, *, scheduler=None, n_workers: int | None = None, 
     })
     out.attrs.setdefault("Conventions", "CF-1.8")
     return out
+
+
+def _from_cache(cdir, scenes, digests, acc):
+    """Put every valid cached scene into ``acc``; return (hits, indices to compute, rejected).
+
+    A damaged or incomplete entry is deleted, listed in ``rejected`` and warned about
+    (:class:`CacheWarning`): its scene is computed again.
+    """
+    hits, todo, rejected = 0, [], []
+    for i, dg in enumerate(digests):
+        ds, problem = (None, None)
+        if cdir is not None:
+            expect = {"time": int(round(scenes[i].duration * scenes[i].fs_out)),
+                      "ball": scenes[i].bearing.n_balls}
+            ds, problem = _read_cache(cdir / f"{dg}.nc", dg, expect)
+        if problem is not None:
+            rejected.append(f"{dg[:12]} ({problem})")
+            _drop_entry(cdir / f"{dg}.nc")
+        if ds is None:
+            todo.append(i)
+        else:
+            acc.put(i, ds, cached=True)
+            hits += 1
+    if rejected:
+        import warnings
+        warnings.warn(f"sweep: {len(rejected)} damaged cache entr{'y' if len(rejected) == 1 else 'ies'} "
+                      f"in {cdir} computed again: {'; '.join(rejected)}", CacheWarning, stacklevel=3)
+    return hits, todo, rejected
 
 
 # attributes that differ per scene or are replaced by the sweep's own

@@ -67,3 +67,37 @@ def test_sha256_and_cache_dir(tmp_path, monkeypatch):
     monkeypatch.setenv("BEARING_LAB_CACHE", str(tmp_path / "c"))
     d = cache_dir("tables")
     assert d == tmp_path / "c" / "tables" and d.is_dir() and os.access(d, os.W_OK)
+
+
+def test_atomic_write_keeps_the_usual_file_mode(tmp_path):
+    """A new file gets 0o666 & ~umask like open(); a replaced file keeps its mode."""
+    mask = os.umask(0o022)
+    os.umask(mask)
+    new = tmp_path / "new.txt"
+    with atomic_open(new) as fh:
+        fh.write("x")
+    assert (new.stat().st_mode & 0o777) == 0o666 & ~mask
+    old = tmp_path / "old.txt"
+    old.write_text("a")
+    old.chmod(0o640)
+    with atomic_open(old) as fh:
+        fh.write("b")
+    assert (old.stat().st_mode & 0o777) == 0o640
+
+
+def test_temporaries_of_killed_writers_are_removed_by_the_next_write(tmp_path):
+    """A SIGKILLed writer cannot clean up; the next successful write of the file does."""
+    target = tmp_path / "out.nc"
+    code = textwrap.dedent(f"""
+        import os, signal
+        from bearing_lab._files import atomic_path
+        with atomic_path({str(target)!r}) as tmp:
+            tmp.write_bytes(b"partial")
+            os.kill(os.getpid(), signal.SIGKILL)
+    """)
+    for _ in range(2):
+        subprocess.run([sys.executable, "-c", code], capture_output=True)
+    assert len([p for p in tmp_path.iterdir() if p.name.startswith(".out.nc.")]) == 2
+    with atomic_open(target, "w") as fh:
+        fh.write("whole")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.nc"]

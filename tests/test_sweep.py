@@ -173,3 +173,47 @@ def test_text_parameter_and_per_scene_attributes():
     assert ds["scene_fidelity"].values.tolist() == ["multibody", "quasi-static"]
     assert "fidelity" not in ds.attrs and ds.attrs["bearing"] == "6308"
     assert not np.array_equal(ds.outer_ring_acc_y[0], ds.outer_ring_acc_y[1])
+
+
+@pytest.mark.parametrize("damage", ["nan", "bytes", "no_checksum", "shape"])
+def test_damaged_cache_entry_is_recomputed_and_reported(serial, cache, tmp_path, damage):
+    """NaN written into a cache file, a flipped byte, a lost checksum file or a wrong shape:
+    the scene is computed again (never used), the sweep warns and says how many."""
+    import shutil
+    from bearing_lab.sweeps import CacheWarning, _checksum_path, _write_cache
+    own = tmp_path / "cache"
+    shutil.copytree(cache, own)
+    victim = own / f"{serial.scene_hash.values[0, 1]}.nc"
+    if damage == "nan":      # re-written consistently (valid checksum), but with a NaN inside
+        ds = xr.load_dataset(victim)
+        ds["outer_ring_acc_y"][5] = np.nan
+        _write_cache(ds, victim)
+    elif damage == "shape":
+        _write_cache(xr.load_dataset(victim).isel(time=slice(0, 10)), victim)
+    elif damage == "bytes":
+        b = bytearray(victim.read_bytes())
+        b[len(b) // 2] ^= 0xFF
+        victim.write_bytes(bytes(b))
+    else:
+        _checksum_path(victim).unlink()
+    with pytest.warns(CacheWarning, match="1 damaged cache entry"):
+        res = bearing_lab.sweep(SCENE, PARAMS, scheduler="serial", cache_dir=own, progress=False,
+                                duration=DUR)
+    assert res.attrs["sweep_cache_hits"] == 3 and res.attrs["sweep_computed"] == 1
+    assert res.attrs["sweep_cache_rejected"] == 1
+    assert np.all(np.isfinite(res["outer_ring_acc_y"].values))
+    assert np.all(np.isfinite(res["kurtosis"].values))
+    xr.testing.assert_equal(res.drop_vars(VOLATILE), serial.drop_vars(VOLATILE))
+    again = bearing_lab.sweep(SCENE, PARAMS, scheduler="serial", cache_dir=own, progress=False,
+                              duration=DUR)
+    assert again.attrs["sweep_cache_hits"] == 4 and again.attrs["sweep_cache_rejected"] == 0
+
+
+def test_sweep_output_reads_back_through_info(serial, tmp_path, capsys):
+    """`bearing-lab info` refused sweep files: per-scene variables had no units."""
+    from bearing_lab.cli import main
+    from bearing_lab.io_netcdf import write_netcdf
+    p = write_netcdf(serial, tmp_path / "sweep.nc")
+    assert main(["info", str(p)]) == 0
+    out = capsys.readouterr().out
+    assert "sweep of scene 'paper-O1'" in out and "dims (defect_offset_mm, speed_rpm, time)" in out

@@ -442,7 +442,8 @@ def plot_analysis(x, fs, *, bearing, rpm=None, shaft_hz=None, channel="", units=
             xlim=(0, fs / 2))
     _plot_envelope(ax3, ex, result, units)
     if path is not None:
-        fig.savefig(str(path), dpi=110)
+        from .._files import savefig
+        savefig(fig, path, dpi=110)  # atomic: an existing figure survives a failed write
     return fig, result
 
 

@@ -12,7 +12,7 @@ once-per-rev), is used first.
 """
 from __future__ import annotations
 
-import json
+import sys
 import re
 from pathlib import Path
 
@@ -163,14 +163,24 @@ def run(args) -> int:
     kw = dict(bearing=bearing, rpm=rpm, rpm_source=rpm_source, channel=str(name), units=units,
               pulses_per_rev=args.pulses_per_rev,
               tacho=None if tacho_name is None else np.asarray(ds[tacho_name].values, float))
-    if args.plot:
-        _, result = plot_analysis(x, fs, path=args.plot, **kw)
-    else:
-        result = analyze(x, fs, **kw)
+    import warnings
+    with np.errstate(all="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # overflow is reported once, below
+        if args.plot:
+            _, result = plot_analysis(x, fs, path=args.plot, **kw)
+        else:
+            result = analyze(x, fs, **kw)
     if note:
         result["notes"] = [note]
+    bad = [k for k, v in result.get("metrics", {}).items()
+           if not isinstance(v, (int, float)) or not np.isfinite(v)]
+    if bad:
+        print(f"bearing-lab analyze: warning: {path.name} [{name}]: metrics {', '.join(bad)} are not "
+              f"finite (the largest |value| is {np.max(np.abs(x)):.3g} {units}): reported as null",
+              file=sys.stderr)
     if args.json:
-        print(json.dumps(result, indent=1))
+        from .._json import dumps
+        print(dumps(result, indent=1))  # no NaN/Infinity tokens: strict parsers read it
         return 0
     _print(result, path, name, fs, bearing, units, tacho_name, note, args.plot)
     return 0

@@ -42,7 +42,8 @@ def _add_read_options(p):
     p.add_argument("--units", default=None,
                    help="unit of the stored values where the file has none or an unknown one (e.g. g)")
     p.add_argument("--allow-truncated", action="store_true",
-                   help="keep the points present when a UFF header promises more")
+                   help="keep what a truncated file holds (UFF, IMS, TDMS, WAV) instead of refusing it; "
+                        "the recording then says so in its warnings and attributes")
     p.add_argument("--full-scale", default=None, help="WAV calibration, e.g. '5 V' or '50 g'")
     p.add_argument("--record", type=int, default=None, help="CWRU record number in a multi-record file")
 
@@ -73,6 +74,8 @@ def _open(args):
 
 def _cmd_import(args) -> int:
     from ..io import get_warnings, to_netcdf
+    from ..io_netcdf import check_output_path
+    check_output_path(args.output)  # before reading: a bad -o is said at once
     ds = _open(args)
     if args.rpm is not None:
         import math
@@ -92,27 +95,70 @@ def _cmd_import(args) -> int:
     return 0
 
 
-def describe(ds) -> dict:
-    """Return the summary ``bearing-lab info`` prints (also used for ``--json``)."""
+_QUANTITY_OF_UNITS = {"m s-2": "acceleration", "m": "displacement", "N": "force",
+                      "rad s-1": "angular speed", "m s-1": "velocity", "Pa": "pressure", "V": "voltage"}
+
+
+def _kind(ds) -> str:
+    if "reader" in ds.attrs:
+        return "recording"
+    if "scene_toml" in ds.attrs or "fidelity" in ds.attrs:
+        return "sweep" if "sweep_n_scenes" in ds.attrs else "simulation"
+    return "dataset"
+
+
+def _rms(values) -> float | None:
+    import numpy as np
+    x = np.asarray(values, dtype=float).ravel()
+    if not x.size:
+        return None
+    scale = float(np.max(np.abs(x)))
+    if not np.isfinite(scale) or scale == 0.0:
+        return scale if np.isfinite(scale) else None
+    return float(scale * np.sqrt(np.mean(np.square(x / scale))))  # no overflow for huge values
+
+
+def describe(ds, path=None) -> dict:
+    """Return the summary ``bearing-lab info`` prints (also used for ``--json``).
+
+    Works for recordings, simulation outputs and sweeps (``kind``); fields a Dataset
+    does not have are None.
+    """
     from ..io import get_warnings
     n = ds.sizes.get("time", 0)
-    fs = float(ds.attrs.get("sampling_rate_hz", 0.0))
+    fs = float(ds.attrs.get("sampling_rate_hz", 0.0) or 0.0)
+    kind = _kind(ds)
+    default = ds.attrs.get("default_channel")
+    if default is None and "outer_ring_acc_y" in ds.data_vars:
+        default = "outer_ring_acc_y"
+    channels = {}
+    for k, v in ds.data_vars.items():
+        units = v.attrs.get("units")
+        channels[str(k)] = {
+            "units": units, "original_units": v.attrs.get("original_units"),
+            "quantity": v.attrs.get("quantity") or _QUANTITY_OF_UNITS.get(str(units)),
+            "dims": [str(d) for d in v.dims],
+            "rms": _rms(v.values) if v.dtype.kind in "iuf" else None}
     return {
-        "file": ds.attrs.get("source_file"),
-        "reader": ds.attrs.get("reader"),
+        "file": ds.attrs.get("source_file") or (str(path) if path is not None else None),
+        "kind": kind,
+        "reader": ds.attrs.get("reader") or kind,
         "sampling_rate_hz": fs,
         "samples": int(n),
         "duration_s": (n / fs) if fs else None,
         "start_time_s": float(ds["time"].values[0]) if n else None,
         "shaft_speed_rpm": ds.attrs.get("shaft_speed_rpm"),
-        "default_channel": ds.attrs.get("default_channel"),
-        "channels": {k: {"units": v.attrs.get("units"), "original_units": v.attrs.get("original_units"),
-                         "quantity": v.attrs.get("quantity"),
-                         "rms": float((v.values.astype(float) ** 2).mean() ** 0.5) if v.size else None}
-                     for k, v in ds.data_vars.items()},
+        "bearing": ds.attrs.get("bearing"),
+        "scene": ds.attrs.get("scene_name"),
+        "default_channel": default,
+        "channels": channels,
         "sha256": ds.attrs.get("source_sha256"),
         "warnings": get_warnings(ds),
     }
+
+
+def _fmt(v, spec="", none="-"):
+    return none if v is None else format(v, spec)
 
 
 def _cmd_info(args) -> int:
@@ -125,21 +171,25 @@ def _cmd_info(args) -> int:
         from ..errors import RecordingError
         raise RecordingError("info: give a FILE (or --formats)")
     ds = _open(args)
-    d = describe(ds)
+    d = describe(ds, args.file)
     if args.json:
-        print(json.dumps(d, indent=1, default=str))
+        from .._json import dumps
+        print(dumps(d, indent=1))
         return 0
     print(f"file:      {d['file']}")
-    print(f"reader:    {d['reader']}    sha256 {d['sha256'][:16]}…" if d["sha256"] else
-          f"reader:    {d['reader']}")
+    what = d["reader"] if d["kind"] == "recording" else \
+        f"{d['kind']} of scene {d['scene']!r}" if d["scene"] else d["kind"]
+    print(f"reader:    {what}    sha256 {d['sha256'][:16]}…" if d["sha256"] else f"reader:    {what}")
     print(f"rate:      {d['sampling_rate_hz']:g} Hz, {d['samples']} samples, "
-          f"{d['duration_s']:.4g} s from {d['start_time_s']:.6g} s")
+          f"{_fmt(d['duration_s'], '.4g')} s from {_fmt(d['start_time_s'], '.6g')} s")
     if d["shaft_speed_rpm"] is not None:
-        print(f"shaft:     {d['shaft_speed_rpm']:g} rpm")
-    print(f"channels:  (default {d['default_channel']})")
+        print(f"shaft:     {d['shaft_speed_rpm']:g} rpm" + (f", bearing {d['bearing']}" if d["bearing"]
+                                                          else ""))
+    print(f"channels:  (default {_fmt(d['default_channel'])})")
     for k, c in d["channels"].items():
-        print(f"  {k:12s} {c['units']:6s} (file: {c['original_units'] or '-'}) {c['quantity']:13s} "
-              f"rms {c['rms']:.4g}")
+        dims = "" if c["dims"] == ["time"] else f" dims ({', '.join(c['dims'])})"
+        print(f"  {k:18s} {_fmt(c['units']):6s} (file: {c['original_units'] or '-'}) "
+              f"{_fmt(c['quantity']):13s} rms {_fmt(c['rms'], '.4g')}{dims}")
     print(f"warnings:  {len(d['warnings'])}")
     for w in d["warnings"]:
         print(f"  - {w}")

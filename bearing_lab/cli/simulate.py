@@ -16,11 +16,12 @@ def _scenes(args) -> int:
 
 def _simulate(args) -> int:
     from ..sim import simulate
-    from ..sim.scene import parse_set
-    overrides = parse_set(args.set)
+    from ..sim.scene import merge_overrides, parse_set
+    overrides = merge_overrides(parse_set(args.set), **{"output.duration_s": args.duration,
+                                                        "output.sample_rate_hz": args.fs})
     from ..io_netcdf import check_output_path
     out = check_output_path(args.output)
-    ds = simulate(args.scene, duration=args.duration, fs=args.fs, progress=not args.quiet, **overrides)
+    ds = simulate(args.scene, progress=not args.quiet, **overrides)
     from ..io_netcdf import write_netcdf
     write_netcdf(ds, out)
     print(f"wrote {out}: {ds.sizes['time']} samples at {ds.attrs['sampling_rate_hz']:g} Hz, "

@@ -35,14 +35,22 @@ def _sweep(args) -> int:
     from ..io_netcdf import check_output_path
     out = check_output_path(args.output)
     cache = False if args.no_cache else args.cache_dir
-    ds = sweep(args.scene, params, scheduler=args.scheduler, n_workers=args.workers, cache_dir=cache,
-               progress=not args.quiet, duration=args.duration, fs=args.fs, **overrides)
+    import warnings
+    from ..sweeps import CacheWarning
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", CacheWarning)  # said below, in one line
+        ds = sweep(args.scene, params, scheduler=args.scheduler, n_workers=args.workers,
+                   cache_dir=cache, progress=not args.quiet, duration=args.duration, fs=args.fs,
+                   **overrides)
     from ..io_netcdf import write_netcdf
     write_netcdf(ds, out)
     dims = " x ".join(f"{d}={ds.sizes[d]}" for d in ds.attrs["sweep_dims"].split())
     print(f"wrote {out}: {ds.attrs['sweep_n_scenes']} scenes ({dims}), {ds.attrs['sweep_computed']} computed, "
           f"{ds.attrs['sweep_cache_hits']} from the cache, {ds.attrs['sweep_wall_time_s']:.1f} s; "
           f"scheduler: {ds.attrs['sweep_scheduler']}", file=sys.stderr)
+    if ds.attrs.get("sweep_cache_rejected"):
+        print(f"warning: {ds.attrs['sweep_cache_rejected']} damaged cache entries were computed "
+              f"again: {ds.attrs['sweep_cache_rejected_entries']}", file=sys.stderr)
     return 0
 
 

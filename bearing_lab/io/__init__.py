@@ -141,11 +141,19 @@ def open_recording(path, format=None, **options):
         raise RecordingError(f"{path}: file not found")
     if path.is_dir():
         raise RecordingError(f"{path}: is a directory, not a recording file")
-    size = path.stat().st_size
+    try:
+        size = path.stat().st_size
+        with open(path, "rb"):  # unreadable (permissions, a device): one clear line, here
+            pass
+    except OSError as exc:
+        raise RecordingError(f"{path}: cannot read the file ({exc.strerror or exc})") from None
     if size == 0:
         raise RecordingError(f"{path}: file is empty (0 bytes)")
     if format is None:
-        format = guess_format(path)
+        try:
+            format = guess_format(path)
+        except OSError as exc:
+            raise RecordingError(f"{path}: cannot read the file ({exc.strerror or exc})") from None
     if format not in ENGINES:
         msg = (f"{path}: invalid value for the 'format' parameter. Allowed values are "
                f"{', '.join(repr(n) for n in ENGINES)}, but got {format!r} instead")
@@ -171,6 +179,8 @@ def open_recording(path, format=None, **options):
     except MemoryError as exc:
         raise RecordingError(f"{path}: corrupt sizes in the file ask for more memory than "
                              "there is") from exc
+    except OSError as exc:
+        raise RecordingError(f"{path}: cannot read the file ({exc.strerror or exc})") from exc
     except Exception as exc:  # the safety net: no library exception escapes
         msg = (f"{path}: the {format!r} reader failed on unexpected or corrupt content "
                f"({type(exc).__name__}: {exc})")

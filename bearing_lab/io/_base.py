@@ -14,6 +14,12 @@ dropped sets, truncated data kept on request) are issued with
 global attribute ``warnings`` as one string, the messages joined by ``"; "``
 (empty string when there are none).  :func:`get_warnings` splits it again.
 
+Shortfalls are never silent: when a file declares more samples than it holds
+(a header's point count, a segment's size, a fixed row count), the reader calls
+:meth:`RecordingBuilder.shortfall`, which refuses the file unless the user opted
+in (``allow_truncated=True``); then the recording says so in ``warnings`` and in
+the attributes ``truncated = 1`` and ``declared_samples`` (what the file promised).
+
 Channel naming rule (all readers):
 
 1. a channel is named after the file's own channel identity (UFF: response
@@ -43,6 +49,9 @@ import numpy as np
 
 from ..errors import BearingLabError, RecordingError
 from .. import units as _units
+
+MIN_RATE_HZ = 1e-3   # slower than a sample every 17 minutes: not a vibration recording
+MAX_RATE_HZ = 1e9    # faster than any vibration data-acquisition front end
 
 ENGINES: dict[str, type["RecordingReader"]] = {}
 """Format name -> reader class, in sniffing order (registered by each format module)."""
@@ -203,6 +212,21 @@ class RecordingBuilder:
         msg = str(msg).replace("; ", ", ")
         self.warnings.append(msg)
         warnings.warn(f"{self.path.name}: {msg}", RecordingWarning, stacklevel=4)
+
+    def shortfall(self, what: str, declared: int, present: int, allow: bool, *,
+                  unit: str = "points", declares: str = "the file declares"):
+        """A file holds fewer samples than it declares: refuse, or keep them when allowed.
+
+        ``what`` names the part of the file (``"set 2 ('acc')"``); with ``allow`` the
+        recording keeps ``present`` samples, warns and records ``declared_samples``.
+        """
+        what = f"{what}: {declares} {declared} {unit}, {present} present"
+        if not allow:
+            self.fail(f"{what}: truncated file; pass allow_truncated=True (CLI --allow-truncated) "
+                      f"to keep the {present} {unit}")
+        self.warn(f"{what}: truncated, kept the {present} {unit} present")
+        self.attrs["truncated"] = 1
+        self.attrs["declared_samples"] = max(int(self.attrs.get("declared_samples", 0)), int(declared))
 
     # -- channels -------------------------------------------------------------------
     def unique_name(self, name: str) -> str:
@@ -389,7 +413,10 @@ class RecordingBuilder:
         if n < 2:
             self.fail(f"only {n} sample(s): not a time history")
         if time is None:
-            fs = float(fs)
+            try:
+                fs = float(fs)
+            except (TypeError, ValueError):
+                self.fail(f"sampling rate {fs!r} is not a number; pass fs=<Hz>")
             if not (np.isfinite(fs) and fs > 0):
                 self.fail(f"sampling rate {fs!r} Hz is not positive; pass fs=<Hz>")
             t = float(t0) + np.arange(n, dtype=np.float64) / fs
@@ -403,6 +430,10 @@ class RecordingBuilder:
                 self.fail(f"time values are not strictly increasing (at sample {k + 1}); "
                           "sort or repair the time column, or pass fs= and drop it")
             fs = 1.0 / float(np.median(dt))
+        if not MIN_RATE_HZ <= fs <= MAX_RATE_HZ:
+            self.fail(f"sampling rate {fs:.6g} Hz is outside {MIN_RATE_HZ:g} Hz .. {MAX_RATE_HZ:.0e} "
+                      "Hz: not a rate of a vibration recording (a damaged increment, or a wrong "
+                      "fs=/time unit)")
         if self.sha256 is None:
             # after parsing, so the bytes come from the page cache (or the reader's map)
             self.sha256 = file_sha256(self.path, data) if self.checksum else ""

@@ -2,9 +2,11 @@
 
 Why: the three formats are all ``.mat`` files and are told apart only by their
 variable names, so sniffing lists variables (cheaply, cached) and reading turns
-both v5 (scipy.io) and v7.3 (HDF5, h5py) into the same plain Python structure:
-structs -> dict, char arrays -> str, numeric arrays -> squeezed ndarray.  Field
-order differs between files, so readers always look fields up by name.
+both v5 (our bounds-checked :mod:`._mat5`) and v7.3 (HDF5, h5py) into the same
+plain Python structure: structs -> dict, char arrays -> str, numeric arrays ->
+squeezed ndarray.  Field order differs between files, so readers always look
+fields up by name.  v5 files are not handed to ``scipy.io.loadmat``: its
+compiled reader crashes the process (segmentation fault) on some corrupt files.
 """
 from __future__ import annotations
 
@@ -14,6 +16,8 @@ import zlib
 from pathlib import Path
 
 import numpy as np
+
+from ..errors import RecordingError
 
 HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 
@@ -27,29 +31,54 @@ def mat_version(head: bytes) -> str | None:
     return "5"
 
 
+def _h5_names(path: str) -> tuple[str, ...]:
+    """Variable names of a v7.3 file (runs in the guarded child)."""
+    import h5py
+    try:
+        with h5py.File(path, "r") as f:
+            return tuple(k for k in f.keys() if not k.startswith("#"))
+    except _ERRORS as exc:
+        raise _corrupt(path, exc) from None
+
+
+def _h5_load(path: str, variable_names) -> dict:
+    """Variables of a v7.3 file as plain Python (runs in the guarded child)."""
+    import h5py
+    out = {}
+    try:
+        with h5py.File(path, "r") as f:
+            for k in f.keys():
+                if k.startswith("#") or (variable_names and k not in variable_names):
+                    continue
+                out[k] = _h5_plain(f, f[k])
+    except (*_ERRORS, RecursionError) as exc:
+        raise _corrupt(path, exc) from None
+    return out
+
+
 @functools.lru_cache(maxsize=64)
-def _variables(path: str, mtime: int, size: int) -> tuple[str, ...]:
+def _variables(path: str, mtime: int, size: int, inode: int) -> tuple[str, ...]:
     with open(path, "rb") as fh:
         head = fh.read(1024)
     v = mat_version(head)
-    if v == "7.3":
-        import h5py
-        with h5py.File(path, "r") as f:
-            return tuple(k for k in f.keys() if not k.startswith("#"))
+    if v == "7.3":  # libhdf5 reads the file in a child process: damage cannot crash us
+        from ._guard import guarded
+        return guarded(path, "HDF5", _h5_names, path)
     if v == "5":
-        import scipy.io
-        return tuple(name for name, _, _ in scipy.io.whosmat(path))
+        from . import _mat5
+        return tuple(_mat5.variable_names(Path(path).read_bytes()))
     return ()
 
 
 def _corrupt(path, exc):
-    from ..errors import RecordingError
-    return RecordingError(f"{path}: the MATLAB file is truncated or corrupt "
-                          f"({type(exc).__name__}: {exc}); export or download it again")
+    from ._mat5 import Mat5Error
+    why = str(exc) if isinstance(exc, Mat5Error) else f"{type(exc).__name__}: {exc}"
+    return RecordingError(f"{path}: the MATLAB file is truncated or corrupt ({why}); export or "
+                          "download it again")
 
 
 _ERRORS = (OSError, ValueError, TypeError, KeyError, IndexError, EOFError, AttributeError,
-           NotImplementedError, zlib.error, struct.error, UnicodeDecodeError)
+           NotImplementedError, zlib.error, struct.error, UnicodeDecodeError, OverflowError)
 
 
 def mat_variables(path) -> tuple[str, ...]:
@@ -63,29 +92,11 @@ def mat_variables(path) -> tuple[str, ...]:
     p = Path(path)
     st = p.stat()
     try:
-        return _variables(str(p), st.st_mtime_ns, st.st_size)
+        return _variables(str(p), st.st_mtime_ns, st.st_size, st.st_ino)
+    except RecordingError:
+        raise
     except _ERRORS as exc:
         raise _corrupt(p, exc) from exc
-
-
-def _plain(obj):
-    """scipy.io.loadmat output (struct_as_record=False, squeeze_me=True) -> plain Python."""
-    from scipy.io.matlab import mat_struct
-    if isinstance(obj, mat_struct):
-        return {k: _plain(getattr(obj, k)) for k in obj._fieldnames}
-    if isinstance(obj, np.ndarray):
-        if obj.dtype.kind == "U":
-            if obj.size == 0:
-                return ""
-            if obj.ndim <= 1 and all(len(s) <= 1 for s in obj.ravel()):
-                return "".join(obj.ravel().tolist())
-            return [str(s) for s in obj.ravel()]
-        if obj.dtype == object:
-            return [_plain(o) for o in obj.ravel()]
-        return obj
-    if isinstance(obj, str):
-        return obj
-    return obj
 
 
 def _h5_plain(f, obj):
@@ -129,6 +140,8 @@ def load_mat(path, variable_names=None) -> dict:
     """
     try:
         return _load_mat(path, variable_names)
+    except RecordingError:
+        raise
     except _ERRORS as exc:
         raise _corrupt(path, exc) from exc
 
@@ -138,15 +151,8 @@ def _load_mat(path, variable_names):
         head = fh.read(1024)
     v = mat_version(head)
     if v == "7.3":
-        import h5py
-        out = {}
-        with h5py.File(path, "r") as f:
-            for k in f.keys():
-                if k.startswith("#") or (variable_names and k not in variable_names):
-                    continue
-                out[k] = _h5_plain(f, f[k])
-        return out
-    import scipy.io
-    m = scipy.io.loadmat(path, squeeze_me=True, struct_as_record=False,
-                         variable_names=variable_names)
-    return {k: _plain(v) for k, v in m.items() if not k.startswith("__")}
+        from ._guard import guarded
+        names = tuple(variable_names) if variable_names else None
+        return guarded(path, "HDF5", _h5_load, str(path), names)
+    from . import _mat5
+    return _mat5.load(Path(path).read_bytes(), variable_names=variable_names)

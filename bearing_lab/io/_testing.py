@@ -58,7 +58,7 @@ def check_reader(path, *, format=None, tmp_path=None, **options):
 
 def uff58_block(values, *, binary=False, bo=1, double=True, num_pts=None, inc="1.00000E-03",
                 t0="0.00000E+00", unit="m/s2", ent="acc", node=1, direction=3, spacing=1,
-                x=None, func_type=1, nbytes=None, spec=12):
+                x=None, func_type=1, nbytes=None, spec=12, abscissa_spec=17):
     """Return the bytes of one UFF 58/58b set (header widths as pyuff writes them)."""
     v = np.asarray(values, dtype=float)
     if spacing == 0:
@@ -81,7 +81,7 @@ def uff58_block(values, *, binary=False, bo=1, double=True, num_pts=None, inc="1
            + "%5i%10i%5i%10i %10s%10i%4i %10s%10i%4i\n" % (func_type, 0, 0, 0, ent, node,
                                                           direction, "NONE", 0, 0)
            + "%10i%10i%10i%13s%13s%13s\n" % (odt, n, spacing, t0, inc, "0.00000E+00")
-           + "%10i%5i%5i%5i %-20s %-20s\n" % (17, 0, 0, 0, "Time", "s")
+           + "%10i%5i%5i%5i %-20s %-20s\n" % (abscissa_spec, 0, 0, 0, "Time", "s")
            + "%10i%5i%5i%5i %-20s %-20s\n" % (spec, 1, 0, 0, "Acceleration", unit)
            + "%10i%5i%5i%5i %-20s %-20s\n" % (0, 0, 0, 0, "NONE", "NONE")
            + "%10i%5i%5i%5i %-20s %-20s\n" % (0, 0, 0, 0, "NONE", "NONE"))

@@ -92,6 +92,9 @@ class CsvReader(RecordingReader):
         if looks_binary(raw[:65536]):
             b.fail("binary content: not a delimited text file (pass format= if you know it)")
         text, enc = decode(raw)
+        if not raw.endswith((b"\n", b"\r")):
+            b.warn("the last line has no line break: if the file was cut short, its last row is "
+                   "incomplete (a CSV declares no length, so this cannot be checked)")
         lines = [ln for ln in text.splitlines()]
         nonblank = [(i, ln) for i, ln in enumerate(lines) if ln.strip()]
         if not nonblank:

@@ -38,6 +38,28 @@ class CwruReader(RecordingReader):
     def guess_can_open(self, path, head):
         return mat_version(head) is not None and any(_CHAN.match(n) for n in mat_variables(path))
 
+    @staticmethod
+    def _check_unclaimed(b, m, found, rec, rpm_var):
+        """Refuse signals the CWRU names do not claim: a damaged name would drop a channel.
+
+        A variable as long as the record's channels that is not one of them (another
+        record's channel, or a name that lost a letter) is never dropped in silence; the
+        user can still read the named channels with ``channels=`` or pick ``record=``.
+        """
+        lengths = {np.size(m[v]) for v in found[rec].values() if v in m}
+        if len(lengths) != 1:
+            return
+        n = lengths.pop()
+        claimed = set(found[rec].values()) | {rpm_var}
+        for name, value in m.items():
+            if name in claimed or not isinstance(value, np.ndarray) or value.dtype.kind not in "iuf":
+                continue
+            if value.size == n:
+                b.fail(f"variable {name!r} holds {n} samples, as many as record {rec}'s channels "
+                       f"({', '.join(found[rec])}), but is not one of them: a damaged variable "
+                       "name or a second record; read the named channels with channels=[...] "
+                       "or pick record=<number>")
+
     def open_dataset(self, path, *, channels=None, fs=None, record=None, units="g",
                      checksum=True):
         """Read the drive-end, fan-end and base channels of one CWRU record.
@@ -95,7 +117,9 @@ class CwruReader(RecordingReader):
         rpm_vars = [n for n in names if _RPM.match(n)]
         rpm_var = f"X{rec:03d}RPM" if f"X{rec:03d}RPM" in names else (
             f"X{rec}RPM" if f"X{rec}RPM" in names else (rpm_vars[0] if len(rpm_vars) == 1 else None))
-        m = load_mat(path, variable_names=wanted + ([rpm_var] if rpm_var else []))
+        m = load_mat(path)
+        if channels is None and record is None:
+            self._check_unclaimed(b, m, found, rec, rpm_var)
         # sampling rate: the file name's record first, then the variables' record
         cands = [n for n in dict.fromkeys([file_no, rec]) if n is not None]
         regs = {n: datasets.cwru_record(n) for n in cands}

@@ -63,7 +63,7 @@ def to_uff58b(ds, path, *, channels=None, units: str = "si", id1=None, id2=None,
     ds : xarray.Dataset
         Recording or simulation Dataset (uniform ``time`` coordinate).
     path : str or Path
-        Output ``.uff`` file (overwritten).
+        Output ``.uff`` file (replaced atomically: complete or not at all).
     channels : list of str, optional
         Variables to write (default: every variable with dimension ``time`` only).
     units : "si" or "original"
@@ -166,10 +166,12 @@ def to_uff58b(ds, path, *, channels=None, units: str = "si", id1=None, id2=None,
         out.append("".join(text).encode("utf-8"))
         out.append(y.astype(bo_char + "f8").tobytes())
         out.append(b"%6i\n" % -1)
+    from .._files import atomic_open
     try:
-        with open(path, "wb") as fh:
+        with atomic_open(path, "wb") as fh:  # an existing file survives any failure
             for chunk in out:
                 fh.write(chunk)
     except OSError as exc:
-        raise RecordingError(f"{path}: cannot write ({exc})") from exc
+        raise RecordingError(f"{path}: cannot write ({exc.strerror or exc}); an existing file of "
+                             "that name is left as it was") from exc
     return path

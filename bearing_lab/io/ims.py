@@ -10,6 +10,11 @@ the values are taken as g (``units=`` overrides), stated in ``unit_source``.
 
 Channels: 4 columns (sets 2, 3) -> ``b1`` .. ``b4``; 8 columns (set 1, two
 accelerometers a bearing) -> ``b1x``, ``b1y`` .. ``b4y``.  Shaft speed 2000 rpm.
+
+Length: every snapshot of the three IMS test sets holds 20 480 rows, each ended by a
+line break.  A file with fewer rows, or whose last row has no line break (its last
+number may be cut short), is truncated: refused, or kept with ``allow_truncated=True``
+(the incomplete last row dropped; ``truncated`` and ``declared_samples`` say so).
 """
 from __future__ import annotations
 
@@ -24,6 +29,7 @@ import numpy as np
 from ._base import ENGINES, RecordingBuilder, RecordingReader
 
 IMS_FS = 20480.0
+IMS_ROWS = 20480
 _NAME = re.compile(r"^(\d{4})\.(\d{2})\.(\d{2})\.(\d{2})\.(\d{2})\.(\d{2})$")
 _NUMLINE = re.compile(rb"^\s*[-+0-9.eE]+(?:[\t ]+[-+0-9.eE]+){3,7}\s*$")
 
@@ -61,7 +67,8 @@ class ImsReader(RecordingReader):
                    "truncated or corrupt file")
         return vals.reshape(-1, ncol)
 
-    def open_dataset(self, path, *, channels=None, fs=None, units="g", checksum=True):
+    def open_dataset(self, path, *, channels=None, fs=None, units="g", allow_truncated=False,
+                     checksum=True):
         """Read one IMS snapshot.
 
         Parameters
@@ -72,6 +79,8 @@ class ImsReader(RecordingReader):
             Sampling rate, Hz; default 20 480 (see the module docstring).
         units : str
             Unit of the values (default ``"g"``).
+        allow_truncated : bool
+            Keep the complete rows of a snapshot with fewer than 20 480 (warning).
         checksum : bool
             Compute ``source_sha256``.
 
@@ -85,6 +94,12 @@ class ImsReader(RecordingReader):
         body = raw.strip()
         if not body:
             b.fail("no data rows")
+        cut_row = not raw.endswith((b"\n", b"\r"))
+        if cut_row:  # the last row may have lost digits: never read it as data
+            raw = raw[:raw.rfind(b"\n") + 1]
+            body = raw.strip()
+            if not body:
+                b.fail("no complete data row (no line break)")
         nl = body.find(b"\n")
         ncol = len((body if nl < 0 else body[:nl]).split())
         if ncol not in (4, 8):
@@ -97,8 +112,13 @@ class ImsReader(RecordingReader):
                 raise ValueError("column count")
         except ValueError:
             vals = self._slow_parse(body, body.splitlines(), ncol, b)
-        if vals.shape[0] != 20480:
-            b.warn(f"{vals.shape[0]} rows (IMS snapshots have 20480): cut or partial file")
+        rows = vals.shape[0]
+        if rows < IMS_ROWS or cut_row:
+            what = "the last row has no line break (cut short)" if cut_row else "rows"
+            b.shortfall(f"IMS snapshot ({what})", IMS_ROWS, rows, allow_truncated, unit="rows",
+                        declares="snapshots hold")
+        elif rows > IMS_ROWS:
+            b.warn(f"{rows} rows (IMS snapshots have {IMS_ROWS}): not a plain IMS snapshot")
         names = [f"b{i + 1}" for i in range(4)] if ncol == 4 else \
             [f"b{i // 2 + 1}{'xy'[i % 2]}" for i in range(8)]
         for j, nm in enumerate(names):

@@ -2,14 +2,57 @@
 
 Why: the contract lets every command take a recording *or* a ``.nc`` written by
 :func:`bearing_lab.io.to_netcdf` (or by the simulator); this reader loads it
-eagerly, unchanged, and only checks the contract.
+eagerly, unchanged, and checks it:
+
+- netCDF-C runs in a guarded child process (:mod:`._guard`): on some damaged files
+  it loops for ever or crashes, and that must not take the caller with it;
+- the writer stores floats without a fill value and with HDF5's Fletcher-32 chunk
+  checksums, so a damaged chunk fails to read, and a value equal to netCDF's
+  default fill value (9.97e36) means a chunk was never written (an interrupted
+  writer of another program): such a file is refused, never read as valid;
+- non-finite values are refused as in every reader;
+- recordings are checked against the recording contract, simulation outputs
+  against the common one (``time`` and ``sampling_rate_hz``).
 """
 from __future__ import annotations
 
 from pathlib import Path
 
-from ..errors import BearingLabError
+import numpy as np
+
+from ..errors import BearingLabError, RecordingError
 from ._base import ENGINES, RecordingReader
+
+NC_FILL_DOUBLE = 9.969209968386869e36   # netCDF's default _FillValue for doubles
+NC_FILL_FLOAT = np.float32(9.96921e36)
+
+
+def _load(path: str):
+    """Read the whole file (runs in the guarded child)."""
+    import xarray as xr
+    try:
+        return xr.load_dataset(path, engine="netcdf4")
+    except (OSError, ValueError, RuntimeError, KeyError, IndexError, TypeError, AttributeError,
+            UnicodeDecodeError) as exc:
+        raise RecordingError(f"{path}: not a readable netCDF4 file ({type(exc).__name__}: "
+                             f"{exc})") from None
+
+
+def _check_values(ds, path):
+    for name, var in ds.variables.items():
+        if var.dtype.kind != "f":
+            continue
+        x = np.asarray(var.values)
+        fill = NC_FILL_FLOAT if x.dtype == np.float32 else NC_FILL_DOUBLE
+        n_fill = int(np.count_nonzero(x == fill))
+        if n_fill:
+            raise RecordingError(f"{path}: variable {name!r} holds {n_fill} netCDF fill values "
+                                 f"({float(fill):.4g}) where data should be: the file was not "
+                                 "completely written; write it again")
+        bad = ~np.isfinite(x)
+        if bad.any():
+            raise RecordingError(f"{path}: variable {name!r} holds {int(bad.sum())} NaN/Inf "
+                                 "values: damaged or not a bearing_lab file")
 
 
 class NetcdfReader(RecordingReader):
@@ -30,15 +73,12 @@ class NetcdfReader(RecordingReader):
         -------
         xarray.Dataset
         """
-        import xarray as xr
         from .. import schema
-        from ..errors import RecordingError
+        from ._guard import guarded
 
         path = Path(path)
-        try:
-            ds = xr.load_dataset(path, engine="netcdf4")
-        except (OSError, ValueError) as exc:
-            raise RecordingError(f"{path}: not a readable netCDF4 file ({exc})") from exc
+        ds = guarded(path, "netCDF-C", _load, str(path))
+        _check_values(ds, path)
         kind = "recording" if "reader" in ds.attrs else None
         try:
             schema.check_dataset(ds, kind=kind)

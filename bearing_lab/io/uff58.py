@@ -32,6 +32,10 @@ import numpy as np
 from ._base import ENGINES, RecordingBuilder, RecordingReader, clean_name, map_file
 
 _DELIM = re.compile(rb"^[ \t]*-1[ \t]*\r?$", re.M)
+_MAX_PAD = 64  # bytes of blanks/NULs a writer may leave after a binary payload
+# Universal File dataset numbers seen in test and modal files (others are refused as damage)
+_KNOWN_DATASETS = {15, 18, 55, 58, 82, 151, 164, 773, 780, 781, 1710, 1858, 2400, 2411, 2412,
+                   2414, 2420, 2429, 2430, 2431, 2432, 2435, 2437, 2467, 2477}
 _DIRS = {1: "+X", 2: "+Y", 3: "+Z", -1: "-X", -2: "-Y", -3: "-Z", 4: "+RX", 5: "+RY", 6: "+RZ",
          -4: "-RX", -5: "-RY", -6: "-RZ"}
 # UFF specific data type -> quantity (for channels whose label does not say)
@@ -69,6 +73,7 @@ class _Set:
         self.header = {}
         self.data_start = self.data_end = None
         self.truncated = False
+        self.unclosed = False  # no closing '-1': the file ends inside or right after the set
 
 
 class Uff58Reader(RecordingReader):
@@ -188,6 +193,9 @@ class Uff58Reader(RecordingReader):
                 if st.type == 58:
                     self._parse_header58(st, b)
                     need = st.n_values * st.itemsize
+                    if nbytes < need:
+                        b.fail(f"set {st.index}: the binary header declares {nbytes} data bytes "
+                               f"but {st.header['num_pts']} points need {need}: corrupt header")
                 else:
                     need = nbytes
                 shift = self._leading_break(mm, pos, need)
@@ -209,13 +217,16 @@ class Uff58Reader(RecordingReader):
             else:
                 m2 = _DELIM.search(mm, pos)
                 if m2 is None:
-                    st.truncated = True
+                    st.unclosed = True
                     end = len(mm)
                     pos = len(mm)
                 else:
                     end = m2.start()
                     pos = m2.end()
                 st.block = (nxt + len(tline), end)
+                if b"\x00" in mm[st.block[0]:min(end, st.block[0] + (1 << 20))]:
+                    b.fail(f"set {st.index} (dataset {st.type}) is declared as text but holds binary "
+                           "bytes: a damaged 58b header?")
                 if st.type == 58:
                     hdr_lines = []
                     p = st.block[0]
@@ -248,10 +259,15 @@ class Uff58Reader(RecordingReader):
         return 0
 
     def _after_binary(self, mm, b, st, pos):
-        """Return the position after the closing delimiter of a binary set."""
+        """Return the position after the closing delimiter of a binary set.
+
+        Between the declared payload and the closing ``-1`` only line breaks, blanks and
+        NUL bytes (writers' padding) are accepted; anything else means the point count
+        or the payload is damaged, and reading on would swallow the next set as padding.
+        """
         line, nxt = self._line(mm, pos)
         if line is None:
-            b.warn(f"set {st.index}: closing '-1' delimiter missing at the end of the file")
+            st.unclosed = True
             return len(mm)
         if line.strip() == b"-1":
             return nxt
@@ -260,11 +276,18 @@ class Uff58Reader(RecordingReader):
             if line2 is not None and line2.strip() == b"-1":
                 return nxt2
         m = _DELIM.search(mm, pos)
+        end = m.start() if m is not None else len(mm)
+        pad = bytes(mm[pos:end])
+        junk = pad.translate(None, b" \r\n\t\x00")
+        if junk or len(pad) > max(_MAX_PAD, st.nbytes - st.n_values * st.itemsize):
+            b.fail(f"set {st.index}: {len(pad)} bytes that are not padding ({pad[:16]!r}...) "
+                   f"follow the {st.n_values * st.itemsize} data bytes the header declares "
+                   f"({st.header['num_pts']} points) before the closing '-1': the point count "
+                   "or the data are damaged")
         if m is None:
-            b.warn(f"set {st.index}: closing '-1' delimiter missing after the data")
+            st.unclosed = True
             return len(mm)
-        pad = m.start() - pos
-        b.warn(f"set {st.index}: {pad} bytes of padding after the binary data ignored")
+        b.warn(f"set {st.index}: {len(pad)} bytes of padding after the binary data ignored")
         return m.end()
 
     def _parse_header58(self, st, b):
@@ -349,21 +372,29 @@ class Uff58Reader(RecordingReader):
                 if fixed is not None and fixed.size == st.n_values:
                     vals = fixed
         got, want = vals.size, st.n_values
+        if st.unclosed and not st.binary and got and not bytes(mm[st.data_start:st.data_end]) \
+                .rstrip(b" \t").endswith((b"\n", b"\r")):
+            # the file ends inside the data: the last number may be cut short
+            got -= st.per_point
+            vals = vals[:got]
+        what = f"set {st.index} ({h.get('rsp_ent_name') or h.get('id1')!r})"
+        if got > want:
+            b.fail(f"{what}: header promises {h['num_pts']} points, {got // st.per_point} present "
+                   "(more values than promised): corrupt header or data")
         if got != want:
             pts = got // st.per_point
-            what = (f"set {st.index} ({h.get('rsp_ent_name') or h.get('id1')!r}): header promises "
-                    f"{h['num_pts']} points, {pts} present")
-            if got > want:
-                b.fail(f"{what} (more values than promised): corrupt header or data")
             if pts < 2:
-                b.fail(f"{what}: truncated, nothing to keep")
-            if not allow_truncated:
-                b.fail(f"{what}: truncated file; pass allow_truncated=True (CLI --allow-truncated) "
-                       f"to keep the {pts} points")
-            b.warn(f"{what}: truncated, kept the {pts} points present")
+                b.fail(f"{what}: header promises {h['num_pts']} points, {pts} present: truncated, "
+                       "nothing to keep")
+            b.shortfall(what, h["num_pts"], pts, allow_truncated, declares="header promises")
             vals = vals[:pts * st.per_point]
-        elif st.truncated and not st.binary:
-            b.warn(f"set {st.index}: closing '-1' delimiter missing at the end of the file")
+        elif st.unclosed:
+            msg = (f"{what}: no closing '-1' delimiter: the file ends inside or right after this "
+                   "set (later sets may be missing)")
+            if not allow_truncated:
+                b.fail(msg + "; pass allow_truncated=True (CLI --allow-truncated) to read it as it is")
+            b.warn(msg + ": truncated file read as it is")
+            b.attrs["truncated"] = 1
         return vals
 
     @staticmethod
@@ -456,12 +487,21 @@ class Uff58Reader(RecordingReader):
                     b.attrs["uff_program"] = _dec(lines[5]).strip()
             elif st.type == 58:
                 h = st.header
-                if h["func_type"] != 1 or h.get("abscissa_spec_data_type") not in (17, 0, 1):
-                    nontime.append(f"{st.index} (function type {h['func_type']})")
-                else:
+                is_time = h["func_type"] == 1
+                time_axis = h.get("abscissa_spec_data_type") in (17, 0, 1)
+                if is_time != time_axis:  # the header contradicts itself: never drop in silence
+                    b.fail(f"set {st.index}: function type {h['func_type']} with abscissa data type "
+                           f"{h.get('abscissa_spec_data_type')}: a time history (type 1) has a time "
+                           "abscissa (17) and other functions do not; the header is damaged")
+                if is_time:
                     times.append(st)
-            else:
+                else:
+                    nontime.append(f"{st.index} (function type {h['func_type']})")
+            elif st.type in _KNOWN_DATASETS:
                 others.append(st.type)
+            else:
+                b.fail(f"set {st.index} at byte {st.start} has dataset type {st.type}, which is not a "
+                       "Universal File dataset: the file is damaged")
         if not times:
             found = sorted({s.type for s in sets})
             extra = f"; 58 sets that are not time responses: {', '.join(nontime)}" if nontime else ""

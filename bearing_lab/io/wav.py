@@ -7,9 +7,14 @@ scale means, either physically (``full_scale="50 g"``) or electrically
 ``scipy.io.wavfile`` (no extra dependency); integer samples are scaled by
 2**(bits-1) (8-bit: offset 128), float samples are taken as ±1 full scale.
 Samples at the converter's limits are reported as clipping.
+
+Length: the RIFF header and the ``data`` chunk declare their sizes; scipy reads a
+shorter file with only a warning, so :func:`_declared_frames` checks the chunk
+chain first and a shortfall is refused (or kept with ``allow_truncated=True``).
 """
 from __future__ import annotations
 
+import struct
 import warnings
 from pathlib import Path
 
@@ -18,6 +23,35 @@ import numpy as np
 from .. import units as _units
 from ..errors import RecordingError
 from ._base import ENGINES, RecordingBuilder, RecordingReader
+
+
+def _declared_frames(data: bytes):
+    """Return (frames the data chunk declares, problem or None).
+
+    The chunks must tile the RIFF body exactly (a damaged size field would otherwise
+    make scipy read fewer frames and ignore the rest as an unknown chunk).
+    """
+    order = ">" if data[:4] == b"RIFX" else "<"
+    if data[:4] == b"RF64" or len(data) < 12:
+        return None, None  # 64-bit sizes: left to scipy
+    riff_end = struct.unpack_from(order + "I", data, 4)[0] + 8
+    problem = None
+    if riff_end > len(data):
+        problem = f"the RIFF header declares {riff_end} bytes, the file has {len(data)}"
+    elif riff_end < len(data) - 1:
+        problem = f"{len(data) - riff_end} bytes after the {riff_end} the RIFF header declares"
+    pos, align, frames, end = 12, None, None, min(riff_end, len(data))
+    while pos + 8 <= end:
+        cid, size = data[pos:pos + 4], struct.unpack_from(order + "I", data, pos + 4)[0]
+        if cid == b"fmt " and size >= 14 and pos + 22 <= len(data):
+            align = struct.unpack_from(order + "H", data, pos + 20)[0]
+        if cid == b"data" and align:
+            frames = size // align
+        pos += 8 + size + (size & 1)
+    if problem is None and pos not in (end, end + 1):
+        problem = (f"the chunk sizes add up to {pos} bytes, the RIFF header declares {riff_end}: "
+                   "a damaged size field")
+    return frames, problem
 
 
 class WavReader(RecordingReader):
@@ -32,7 +66,7 @@ class WavReader(RecordingReader):
         return head[:4] in (b"RIFF", b"RIFX", b"RF64") and head[8:12] == b"WAVE"
 
     def open_dataset(self, path, *, full_scale=None, sensitivity=None, channels=None,
-                     checksum=True):
+                     allow_truncated=False, checksum=True):
         """Read a WAV file and calibrate it.
 
         Parameters
@@ -45,6 +79,8 @@ class WavReader(RecordingReader):
             ``"9.91mV/g"`` when ``full_scale`` is a voltage.
         channels : str or list of str, optional
             ``ch1``, ``ch2`` ...
+        allow_truncated : bool
+            Keep the frames of a file shorter than its header declares (warning).
         checksum : bool
 
         Returns
@@ -70,11 +106,18 @@ class WavReader(RecordingReader):
                 rate, data = wavfile.read(path)
             except (ValueError, EOFError, OSError, IndexError) as exc:
                 b.fail(f"not a readable WAV file ({exc})")
-        for w in caught:
-            b.warn(f"WAV: {w.message}")
         data = np.asarray(data)
         if data.ndim == 1:
             data = data[:, None]
+        declared, problem = _declared_frames(path.read_bytes())
+        if declared is not None and data.shape[0] < declared:
+            b.shortfall("WAV data chunk", declared, data.shape[0], allow_truncated, unit="frames")
+        elif problem is not None:
+            b.shortfall(f"WAV ({problem})", data.shape[0], data.shape[0], allow_truncated,
+                        unit="frames")
+        for w in caught:
+            if "EOF" not in str(w.message):  # a short file is reported above
+                b.warn(f"WAV: {w.message}")
         kind = data.dtype.kind
         if kind == "u":
             scale, offset = 2.0 ** (8 * data.dtype.itemsize - 1), 2.0 ** (8 * data.dtype.itemsize - 1)

@@ -28,7 +28,7 @@ import xarray as xr
 from scipy import signal
 
 from .. import __version__
-from ..errors import SolverError
+from ..errors import BearingLabError, SolverError
 from . import _kernels as K
 from .assembly import assemble
 from .scene import load_scene
@@ -223,6 +223,19 @@ def _decimate_acc(res):
     return win[s0:s0 + res["R"] * (res["n_out"] - 1) + 1:res["R"]] @ taps[::-1]
 
 
+def _assemble(sc):
+    """assemble(), with a failure to find the static equilibrium said in one line."""
+    try:
+        with np.errstate(all="ignore"):
+            return assemble(sc)
+    except (ValueError, ArithmeticError, RuntimeError) as exc:
+        if isinstance(exc, BearingLabError):  # already one clear line (a SceneError, ...)
+            raise
+        raise SolverError(f"scene {sc.name!r}: no static equilibrium found for the initial state "
+                          f"({type(exc).__name__}: {exc}); the load, speed, clearance or support "
+                          "stiffness are beyond what the model can start from") from exc
+
+
 def simulate(scene, *, fidelity: str | None = None, duration: float | None = None,
              fs: float | None = None, rtol: float | None = None, method: str | None = None,
              step: float | None = None, progress: bool = True, **overrides) -> xr.Dataset:
@@ -245,16 +258,16 @@ def simulate(scene, *, fidelity: str | None = None, duration: float | None = Non
     without the defect tables), ``table_time_s`` (building or loading the defect contact
     tables), ``compile_time_s``, ``sampling_rate_hz``, ``shaft_speed_rpm``.
     """
-    ov = dict(overrides)
-    for key, value in (("output.duration_s", duration), ("output.sample_rate_hz", fs),
-                       ("solver.rtol", rtol), ("solver.method", method), ("solver.step_s", step),
-                       ("fidelity", fidelity)):
-        if value is not None:
-            ov[key] = value
+    from .scene import merge_overrides
+    ov = merge_overrides(overrides, **{"output.duration_s": duration, "output.sample_rate_hz": fs,
+                                       "solver.rtol": rtol, "solver.method": method,
+                                       "solver.step_s": step, "fidelity": fidelity})
     sc = load_scene(scene, **ov)
+    from .budget import check_budget
+    check_budget(sc)  # before any work: a scene that would run for days is refused here
     compile_s = _warm_up()
     t_start = _time.perf_counter()
-    asm = assemble(sc)
+    asm = _assemble(sc)
     d = sc.data
     from .auto import resolve
     choice = resolve(sc)

@@ -48,6 +48,10 @@ import numpy as np
 from ..bearings import BearingGeometry, CATALOG, get_bearing
 from ..errors import SceneError
 
+
+class SceneWarning(UserWarning):
+    """A valid scene that probably does not say what was meant (e.g. a defect off the track)."""
+
 STEEL_DENSITY = 7850.0
 G0 = 9.80665
 
@@ -218,6 +222,12 @@ SCHEMA: dict[str, dict[str, tuple]] = {
         "max_step_s": (None, _NUM, "pos", "largest step of the adaptive methods (default: the rule's, or 25 µs)"),
         "defect_steps": (40, int, "pos", "at least this many steps while a ball crosses a defect"),
     },
+    "budget": {
+        "max_steps": (5e8, _NUM, "pos", "refuse a scene that needs more integration steps (estimated "
+                      "before it runs, see sim/budget.py): ~20 min of computing"),
+        "max_fine_samples": (1e9, _NUM, "pos", "refuse more samples on the anti-aliasing grid"),
+        "max_memory_mb": (4000.0, _NUM, "pos", "refuse a scene whose output needs more memory, MB"),
+    },
 }
 DEFECT_KEYS = {"race", "shape", "length_mm", "width_mm", "depth_mm", "offset_mm", "skew_deg",
                "angle_deg", "vertices_mm", "diameter_mm", "contact_model"}
@@ -330,6 +340,8 @@ class Scene:
             defects.append(defect)
         scene = cls(d, bearing, tuple(defects))
         scene._check_physics()
+        from .limits import warn_off_track
+        warn_off_track(scene)
         return scene
 
     def replace(self, **overrides) -> "Scene":
@@ -367,6 +379,8 @@ class Scene:
             raise SceneError(f"output.sample_rate_hz={self.fs_out:g} is below 1 kHz: too coarse for bearing vibration")
         if d["output"]["duration_s"] > 600:
             raise SceneError(f"output.duration_s={d['output']['duration_s']:g} s exceeds 600 s; split the run")
+        from .limits import check_limits
+        check_limits(self)
 
     # ---- SI accessors
     @property
@@ -507,13 +521,45 @@ def _apply_override(raw: dict, key: str, value):
 
 
 def parse_set(items) -> dict:
-    """Turn ``["load.radial_n=480", ...]`` into a dict, refusing malformed items."""
-    out = {}
+    """Turn ``["load.radial_n=480", ...]`` into a dict, refusing malformed items.
+
+    Aliases (``fs``, ``duration``, ``speed_rpm`` ...) become their scene keys, so
+    ``--set fs=40000`` is ``output.sample_rate_hz`` like everywhere else; a key given
+    twice (also through an alias) is refused.
+    """
+    out, given = {}, {}
     for item in items or []:
         if "=" not in item:
             raise SceneError(f"--set {item!r}: expected KEY=VALUE")
         k, v = item.split("=", 1)
-        out[k.strip()] = v
+        k = k.strip()
+        if not k:
+            raise SceneError(f"--set {item!r}: no key before '='")
+        key = _ALIASES.get(k, k)
+        if key in out:
+            raise SceneError(f"--set {k}: the key {key} is already given (--set {given[key]}); give "
+                             "it once")
+        out[key], given[key] = v, item
+    return out
+
+
+def merge_overrides(overrides: dict, **named) -> dict:
+    """``overrides`` plus keyword settings such as ``{"output.duration_s": 0.1}`` (None: unset).
+
+    All keys are taken through the aliases; one key set to two values is refused.
+    """
+    out = {}
+    for k, v in overrides.items():
+        key = _ALIASES.get(k, k)
+        if key in out and out[key] != v:
+            raise SceneError(f"{k}={v!r}: the key {key} is already set to {out[key]!r}")
+        out[key] = v
+    for key, v in named.items():
+        if v is None:
+            continue
+        if key in out and _parse_value(out[key]) != _parse_value(v):
+            raise SceneError(f"{key} is given twice, as {out[key]!r} and {v!r}; give it once")
+        out[key] = v
     return out
 
 

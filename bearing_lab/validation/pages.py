@@ -9,7 +9,6 @@ MODEL_ASSUMPTIONS                                  -- the assumptions listed on 
 from __future__ import annotations
 
 import json
-import math
 
 import numpy as np
 
@@ -33,21 +32,7 @@ MODEL_ASSUMPTIONS = [
 ]
 
 
-def clean(v):
-    """JSON-safe: NaN/inf -> None, numpy scalars -> Python."""
-    if isinstance(v, dict):
-        return {str(k): clean(x) for k, x in v.items()}
-    if isinstance(v, (list, tuple)):
-        return [clean(x) for x in v]
-    if isinstance(v, (np.bool_, bool)):
-        return bool(v)
-    if isinstance(v, np.integer):
-        return int(v)
-    if isinstance(v, (float, np.floating)):
-        return float(v) if math.isfinite(v) else None
-    if isinstance(v, np.ndarray):
-        return clean(v.tolist())
-    return v
+from .._json import clean  # noqa: E402  (NaN/inf -> null: one rule for every JSON output)
 
 
 def summary(case, result, wall) -> dict:

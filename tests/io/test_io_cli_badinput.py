@@ -112,3 +112,12 @@ def test_cli_data(datafile, mirror, tmp_path, capsys):
     assert main(["data", "list", "--dataset", "cwru-de"]) == 0
     assert "130_OR007@6_0.mat" in capsys.readouterr().out
     assert main(["data", "fetch", "nothing.mat", "--no-download"]) == 2
+
+
+def test_import_output_checked_before_reading(tmp_path, capsys, datafile):
+    from bearing_lab.cli import main
+    src = datafile("lms/binary8byte_g.uff")
+    assert main(["import", str(src), "-o", str(tmp_path / "out.txt")]) == 2
+    assert main(["import", str(src), "-o", str(tmp_path / "no" / "out.nc")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 2 and "must be a netCDF file" in err[0] and "does not exist" in err[1]

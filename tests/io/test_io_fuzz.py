@@ -1,94 +1,88 @@
-"""Fuzz every reader with corrupted copies of real files: flipped bytes and cut lengths.
+"""Fuzz every reader with seeded mutants of real recordings, each read in a guarded subprocess.
 
-Only :class:`RecordingError` may escape, and its message names the file.  Kept
-fast: few derandomized examples, small copies written to a temporary directory.
+Per source a few hundred to a few thousand mutants (flipped bytes, cut lengths, deleted and
+inserted spans, damaged size words, edited text tokens): MATLAB v5 3 200 (CWRU, MFPT,
+Testlab), v7.3 300 (HDF5, 30 ms each), UFF 58/58b 5 400 (six real files), IMS text 1 000,
+TDMS 2 500, WAV 2 000, MDF4 1 000, netCDF 200, CSV and Testlab text 500 each: 16 600 in
+all.  A worker process reads them under a time and memory limit; the parent survives its
+crashes.  The rule, for every mutant: only a RecordingError naming the file may escape; no
+crash, hang or runaway memory; what reads has the original's channels and length (a format
+that declares its length) and valid values; a pure truncation never reads as changed data.
+``benchmarks/fuzz_readers.py`` runs the same harness over more than 20 000 mutants.
 """
-import tempfile
-import warnings
-from pathlib import Path
+import os
 
-import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings, strategies as st
 
-from bearing_lab import RecordingError, check_dataset, open_recording
+from bearing_lab.io import _fuzz
 
-SETTINGS = settings(max_examples=12, deadline=None, derandomize=True,
-                    suppress_health_check=[HealthCheck.too_slow,
-                                           HealthCheck.function_scoped_fixture])
-
-# (mirror path, bytes kept before fuzzing (None = whole file), options)
-REAL = [
-    ("lms/binary8byte_g.uff", None, {}),
-    ("lms/catman_58_ascii_short.uff", None, {}),
-    ("lms/truncated_58_ascii.uff", None, {"allow_truncated": True}),
-    ("lms/mpstd_set001_58b_4ch.uff", 12000, {"allow_truncated": True}),
-    ("lms/testlab_geometry_only.uff", None, {}),
-    ("lms/testlab_acceler.mat", None, {}),
-    ("cwru/130_OR007@6_0.mat", None, {}),
-    ("mfpt/OuterRaceFault_vload_1.mat", None, {}),
-    ("ims/2004.02.12.10.32.39", 60000, {}),
-]
+# mutants per source: about 1 s of CPU each for the small ones, the format totals in the
+# module docstring; the seed changes with nothing (a failure is reproducible by index:
+# python -m bearing_lab.io._fuzz repro SOURCE 2026 INDEX)
+SEED = 2026
+PLAN = {"cwru": 600, "cwru_48k": 1000, "mfpt": 600, "testlab_v5": 1000, "testlab_v73": 300,
+        "uff58b_4ch": 600, "uff58b_mic": 1000, "uff58b_g": 1500, "uff58_ascii": 300,
+        "uff58_catman": 1000, "uff58_truncated": 1000, "ims": 1000, "tdms": 2500, "wav": 2000,
+        "netcdf": 200, "csv": 500, "testlab_text": 500, "mdf": 1000}
 
 
-def _synthetic():
-    import io
-    import scipy.io.wavfile
-    t = np.arange(400) / 1000.0
-    x = np.sin(2 * np.pi * 30 * t)
-    csv = "time,a [g],b [m/s2]\n" + "\n".join(f"{a:.4f},{b:.6f},{-b:.6f}" for a, b in zip(t, x))
-    txt = "Name\tP1\nRun\tR1\nProject\tX\nIncrement\t0.001\nP1\tP2\ng\tg\nReal\tReal\n" + \
-        "\n".join(f"{b:.6f}\t{2 * b:.6f}" for b in x)
-    buf = io.BytesIO()
-    scipy.io.wavfile.write(buf, 1000, (x * 3000).astype(np.int16))
-    return [("rig.csv", csv.encode(), {}), ("export.txt", txt.encode(), {}),
-            ("rec.wav", buf.getvalue(), {"full_scale": "5 g"})]
+@pytest.fixture(autouse=True)
+def _mirror_env(mirror, monkeypatch, datafile):
+    datafile("lms/binary8byte_g.uff")  # fails in CI, skips elsewhere, when there is no mirror
+    monkeypatch.setenv("BEARING_LAB_MIRROR", str(mirror))
 
 
-def _check(name, data, opts):
-    with tempfile.TemporaryDirectory() as d:
-        p = Path(d) / name
-        p.write_bytes(data)
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            try:
-                ds = open_recording(p, **opts)
-            except RecordingError as exc:
-                assert p.name in str(exc), str(exc)
-                return
-        check_dataset(ds, kind="recording")
+def _report(res):
+    lines = [f"{res['source']}: {res['counts']}"]
+    for verdict, examples in res["examples"].items():
+        for e in examples[:5]:
+            lines.append(f"  {verdict} #{e['i']} ({e['op']}): {e['detail']}")
+    return "\n".join(lines)
 
 
-def _mutate(data, cut, flips):
-    b = bytearray(data[:max(1, int(len(data) * cut))])
-    for pos, val in flips:
-        b[int(pos * (len(b) - 1))] = val
-    return bytes(b)
+@pytest.mark.parametrize("name", sorted(PLAN))
+def test_fuzz_source(name):
+    res = _fuzz.fuzz_source(name, PLAN[name], seed=SEED, timeout=60.0)
+    bad = {v: res["counts"][v] for v in _fuzz.BAD if res["counts"][v]}
+    assert not bad, _report(res)
+    # the mutants must reach both outcomes, or the test exercises nothing
+    assert res["counts"]["refused"] > 0 and res["counts"]["ok"] + res["counts"]["renamed"] > 0, \
+        _report(res)
 
 
-flips = st.lists(st.tuples(st.floats(0, 1), st.integers(0, 255)), max_size=6)
-cuts = st.one_of(st.just(1.0), st.floats(0.0, 1.0))
+def test_harness_sees_every_kind_of_failure(monkeypatch):
+    """Injected faults: a segfault, a hang, a foreign exception and a silent shortening."""
+    monkeypatch.setenv("BEARING_LAB_FUZZ_FAULTS", "crash=2,hang=4,uncaught=6,silent=8")
+    res = _fuzz.fuzz_source("uff58b_g", 10, seed=SEED, timeout=4.0)
+    c = res["counts"]
+    assert (c["crash"], c["hang"], c["uncaught"], c["silent"]) == (1, 1, 1, 1), _report(res)
+    assert sum(c.values()) == 10
+    assert [e["i"] for e in res["examples"]["crash"]] == [2]
 
 
-@pytest.mark.parametrize("rel, keep, opts", REAL, ids=[r[0].split("/")[-1] for r in REAL])
-def test_fuzz_real(datafile, rel, keep, opts):
-    src = datafile(rel)
-    data = src.read_bytes()[:keep] if keep else src.read_bytes()
-    name = src.name
-
-    @SETTINGS
-    @given(cut=cuts, fl=flips)
-    def run(cut, fl):
-        _check(name, _mutate(data, cut, fl), opts)
-
-    run()
+def test_mutants_are_reproducible():
+    source = _fuzz.SOURCES["uff58b_g"]
+    data = bytes(range(256)) * 8
+    hot = _fuzz.hot_spots(data, source.fmt)
+    a = _fuzz.mutant(source, data, hot, SEED, 17)
+    assert a == _fuzz.mutant(source, data, hot, SEED, 17)
+    assert a != _fuzz.mutant(source, data, hot, SEED, 18)
 
 
-@pytest.mark.parametrize("name, data, opts", _synthetic(), ids=["csv", "testlab_text", "wav"])
-def test_fuzz_synthetic(name, data, opts):
-    @SETTINGS
-    @given(cut=cuts, fl=flips)
-    def run(cut, fl):
-        _check(name, _mutate(data, cut, fl), opts)
+def test_verdicts_judge_against_the_original(tmp_path, datafile):
+    """A shortened file that reads is 'silent'; the original itself is 'ok'."""
+    import numpy as np
+    from bearing_lab.io import open_recording
+    src = datafile("lms/binary8byte_g.uff")
+    ref = open_recording(src)
+    source = _fuzz.SOURCES["uff58b_g"]
+    assert _fuzz.verdict(src, source, ref, truncation=False) == ("ok", "")
+    short = ref.isel(time=slice(0, 100))
 
-    run()
+    class Fake:
+        name, options, declared_length = "x", {}, True
+
+    verdict, detail = _fuzz.verdict(src, Fake, short, truncation=False)
+    assert verdict == "silent" and "250 samples instead of 100" in detail
+    assert os.environ.get("BEARING_LAB_MIRROR")
+    assert np.isfinite(ref[list(ref.data_vars)[0]].values).all()

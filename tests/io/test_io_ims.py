@@ -23,11 +23,31 @@ def test_ims_rate_override(datafile):
 
 
 def test_ims_eight_columns_and_short(tmp_path):
+    """A snapshot with 100 of its 20 480 rows is truncated: refused, or kept when allowed."""
     p = tmp_path / "2003.10.22.12.06.24"
     np.savetxt(p, np.random.default_rng(0).normal(size=(100, 8)), delimiter="\t", fmt="%.3f")
-    ds = open_recording(p)
+    with pytest.raises(RecordingError, match=r"2003.10.22.12.06.24: IMS snapshot \(rows\): "
+                                             r"snapshots hold 20480 rows, 100 present"):
+        open_recording(p)
+    ds = open_recording(p, allow_truncated=True)
     assert list(ds.data_vars)[:3] == ["b1x", "b1y", "b2x"]
-    assert "100 rows" in ds.attrs["warnings"]
+    assert "100 rows present" in ds.attrs["warnings"]
+    assert ds.attrs["truncated"] == 1 and ds.attrs["declared_samples"] == 20480
+
+
+@pytest.mark.parametrize("cut", [1, 3])
+def test_ims_cut_inside_the_last_number(datafile, tmp_path, cut):
+    """The last value of a cut file ('-0.029' -> '-0.0') must never be read as data."""
+    src = datafile("ims/2004.02.12.10.32.39").read_bytes()
+    p = tmp_path / "2004.02.12.10.32.39"
+    p.write_bytes(src[:-cut])
+    with pytest.raises(RecordingError, match="no line break"):
+        open_recording(p)
+    ds = open_recording(p, allow_truncated=True)
+    ref = open_recording(datafile("ims/2004.02.12.10.32.39"))
+    assert ds.sizes["time"] == 20479
+    for c in ref.data_vars:
+        np.testing.assert_array_equal(ds[c].values, ref[c].values[:-1])
 
 
 def test_ims_ragged(tmp_path):

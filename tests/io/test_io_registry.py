@@ -57,3 +57,99 @@ def test_pooch_registry():
     reg = datasets.pooch_registry()
     assert reg["cwru/130_OR007@6_0.mat"].startswith("sha256:")
     assert reg["cwru/131_OR007@6_1.mat"] is None
+
+
+def test_every_mirrored_registry_file_has_its_true_sha256(mirror):
+    """A registry row without a checksum lets a mirror serve anything: every row whose file is in
+    the mirror must carry the sha256 of that file."""
+    from bearing_lab._files import sha256_file
+    if mirror is None:
+        pytest.skip("no mirror")
+    checked = 0
+    for name, rec in datasets.load_registry().items():
+        p = Path(mirror) / name
+        if p.is_file():
+            assert rec.sha256 == sha256_file(p), name
+            checked += 1
+    assert checked >= 18
+
+
+def _fake_mirror(tmp_path, content=None):
+    src = Path(__file__)  # any bytes; the registry row's hash is patched to match
+    m = tmp_path / "mirror" / "lms"
+    m.mkdir(parents=True)
+    (m / "binary8byte_g.uff").write_bytes(content if content is not None else src.read_bytes())
+    return tmp_path / "mirror"
+
+
+@pytest.fixture
+def patched_hash(monkeypatch):
+    """The lms/binary8byte_g.uff row with the sha256 of this test file (no mirror needed)."""
+    from dataclasses import replace
+    from bearing_lab._files import sha256_file
+    reg = dict(datasets.load_registry())
+    name = "lms/binary8byte_g.uff"
+    reg[name] = replace(reg[name], sha256=sha256_file(Path(__file__)))
+    monkeypatch.setattr(datasets, "load_registry", lambda path=None: reg)
+    return name
+
+
+def test_fetch_never_deletes_what_it_cannot_replace(tmp_path, patched_hash):
+    """A copy failing its check was deleted even when nothing could replace it."""
+    dest = tmp_path / "d"
+    (dest / "lms").mkdir(parents=True)
+    old = dest / patched_hash
+    old.write_bytes(b"my local edit")
+    with pytest.raises(RecordingError, match="does not match.*left in place"):
+        datasets.fetch(patched_hash, mirror=tmp_path / "empty", dest=dest, download=False)
+    assert old.read_bytes() == b"my local edit"
+    # a verified copy replaces it, in one step
+    p = datasets.fetch(patched_hash, mirror=_fake_mirror(tmp_path), dest=dest, download=False)
+    assert p == old and p.read_bytes() == Path(__file__).read_bytes()
+    assert sorted(x.name for x in (dest / "lms").iterdir()) == ["binary8byte_g.uff"]
+
+
+def test_fetch_refuses_links_that_leave_dest(tmp_path, patched_hash):
+    """A dangling link in --dest made fetch write a file outside it."""
+    dest = tmp_path / "d"
+    (dest / "lms").mkdir(parents=True)
+    outside = tmp_path / "outside.uff"
+    (dest / patched_hash).symlink_to(outside)
+    mirror = _fake_mirror(tmp_path)
+    with pytest.raises(RecordingError, match="dangling symbolic link .*refusing to write"):
+        datasets.fetch(patched_hash, mirror=mirror, dest=dest, download=False)
+    assert not outside.exists()
+    (dest / patched_hash).unlink()
+    (dest / "lms").rmdir()
+    other = tmp_path / "elsewhere"
+    other.mkdir()
+    (dest / "lms").symlink_to(other)
+    with pytest.raises(RecordingError, match="outside --dest"):
+        datasets.fetch(patched_hash, mirror=mirror, dest=dest, download=False)
+    assert not any(other.iterdir())
+
+
+def test_fetch_download_is_checked_before_it_lands(tmp_path, patched_hash, monkeypatch):
+    import pooch
+
+    def fake_retrieve(url, known_hash, fname, path, progressbar):
+        p = Path(path) / fname
+        p.write_bytes(b"tampered")
+        return str(p)
+
+    monkeypatch.setattr(pooch, "retrieve", fake_retrieve)
+    dest = tmp_path / "d"
+    with pytest.raises(RecordingError, match="does not match"):
+        datasets.fetch(patched_hash, mirror=tmp_path / "none", dest=dest)
+    assert not (dest / patched_hash).exists()
+    assert [p.name for p in (dest / "lms").iterdir()] == []  # no temporary left behind
+
+
+def test_fetch_of_an_unhashed_row_warns(tmp_path, monkeypatch):
+    from dataclasses import replace
+    reg = dict(datasets.load_registry())
+    name = "lms/binary8byte_g.uff"
+    reg[name] = replace(reg[name], sha256="")
+    monkeypatch.setattr(datasets, "load_registry", lambda path=None: reg)
+    with pytest.warns(datasets.UnverifiedWarning, match="not verified"):
+        datasets.fetch(name, mirror=_fake_mirror(tmp_path), dest=tmp_path / "d", download=False)

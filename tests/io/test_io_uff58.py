@@ -222,10 +222,48 @@ def test_voltage_clipping_flagged(write):
 
 
 def test_non_time_sets_dropped(write, sine):
-    raw = uff58_block(sine, func_type=4, ent="frf") + uff58_block(sine, ent="acc")
+    raw = uff58_block(sine, func_type=4, ent="frf", abscissa_spec=18) + uff58_block(sine, ent="acc")
     ds = open_recording(write("mixed.uff", raw))
     assert list(ds.data_vars) == ["acc"]
     assert "not time responses" in ds.attrs["warnings"]
+
+
+def test_contradicting_function_type_refused_not_dropped(write, sine):
+    """A time abscissa with a non-time function type (one damaged digit) loses no channel."""
+    raw = uff58_block(sine, func_type=4, ent="b") + uff58_block(sine, ent="acc")
+    with pytest.raises(RecordingError, match=r"odd.uff: set 1: function type 4 with abscissa data "
+                                             r"type 17.*damaged"):
+        open_recording(write("odd.uff", raw))
+
+
+@pytest.mark.parametrize("cut", [3, 8])
+def test_missing_closing_delimiter_refused_or_declared(write, sine, cut):
+    """A file cut inside the last set's closing '-1' (or inside its last number) is truncated."""
+    raw = uff58_block(sine, ent="a") + uff58_block(sine, ent="b")
+    p = write("cut.uff", raw[:-cut])
+    with pytest.raises(RecordingError, match=r"cut.uff: set 2 \('b'\).*(no closing '-1'|2000 points, "
+                                             r"1999 present)"):
+        open_recording(p)
+    one = write("cut1.uff", uff58_block(sine, ent="b")[:-cut])
+    ds = open_recording(one, allow_truncated=True)
+    assert ds.attrs["truncated"] == 1 and "truncated" in ds.attrs["warnings"]
+    np.testing.assert_allclose(ds["b"].values, sine[:ds.sizes["time"]], rtol=1e-5)
+
+
+def test_unknown_dataset_type_refused(write, sine):
+    raw = uff58_block(sine, ent="a", binary=True) + uff58_block(sine, ent="b", binary=True)
+    k = raw.index(b"58b", 100)
+    with pytest.raises(RecordingError, match=r"bad.uff: set 2 .*(not a Universal File dataset|binary)"):
+        open_recording(write("bad.uff", raw[:k] + b"  1" + raw[k + 3:]))
+
+
+def test_payload_shorter_than_header_is_not_padding(write, sine):
+    """Binary data 5 bytes short: the next set's delimiter must not be swallowed as padding."""
+    a = uff58_block(sine, ent="a", binary=True)
+    k = a.index(b"\n", a.index(b"NONE                 NONE", 800)) + 1 + 400
+    raw = a[:k] + a[k + 5:] + uff58_block(sine, ent="b", binary=True)
+    with pytest.raises(RecordingError, match=r"short.uff: set 1: .* bytes that are not padding"):
+        open_recording(write("short.uff", raw))
 
 
 def test_padding_and_crlf_after_payload(write, sine):
