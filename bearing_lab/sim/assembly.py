@@ -135,6 +135,25 @@ def _solve_relative(target, force_of, scale, where):
     return sol.x if sol.success else a * direction
 
 
+def _loaded_ring_positions(on, phases, z, phi_c0, forces_at, f_in, f_out, ks, km, scale):
+    """Ring positions (xi, xo stacked) with the loaded ring's spring unstressed, at
+    ``phases`` cage positions across one ball spacing."""
+    pos = []
+    for k in range(phases):
+        _, _, forces = forces_at(phi_c0 + 2 * math.pi * k / (phases * z))
+        if on == "outer":
+            # the mount unstressed: the balls hold the outer ring's load and weight
+            e = _solve_relative(-f_out, lambda e: forces(e)[1], scale, "load")
+            xi = (forces(e)[0] + f_in) / ks
+            pos.append(np.concatenate([xi, xi - e]))
+        else:
+            # the shaft spring unstressed: the balls hold the inner ring's load and weight
+            e = _solve_relative(f_in, lambda e: -forces(e)[0], scale, "load")
+            xo = (forces(e)[1] + f_out) / km
+            pos.append(np.concatenate([xo + e, xo]))
+    return pos
+
+
 def static_equilibrium(scene: Scene, phi_c0: float, k_in: float, k_out: float, *,
                        ball_mass: float = 0.0, omega_cage: float = 0.0, exponent: float = 1.5,
                        phases: int = 4) -> dict:
@@ -176,19 +195,8 @@ def static_equilibrium(scene: Scene, phi_c0: float, k_in: float, k_out: float, *
     rest_i, rest_o = np.zeros(2), np.zeros(2)
     x0 = np.concatenate([f_in / ks, f_out / km])
     if d["load"]["path"] == "bearing":
-        pos = []
-        for k in range(phases):
-            _, _, forces = forces_at(phi_c0 + 2 * math.pi * k / (phases * z))
-            if d["load"]["on"] == "outer":
-                # the mount unstressed: the balls hold the outer ring's load and weight
-                e = _solve_relative(-f_out, lambda e: forces(e)[1], scale, "load")
-                xi = (forces(e)[0] + f_in) / ks
-                pos.append(np.concatenate([xi, xi - e]))
-            else:
-                # the shaft spring unstressed: the balls hold the inner ring's load and weight
-                e = _solve_relative(f_in, lambda e: -forces(e)[0], scale, "load")
-                xo = (forces(e)[1] + f_out) / km
-                pos.append(np.concatenate([xo + e, xo]))
+        pos = _loaded_ring_positions(d["load"]["on"], phases, z, phi_c0, forces_at, f_in, f_out,
+                                     ks, km, scale)
         x0 = pos[0]
         if d["load"]["on"] == "outer":
             rest_o = np.mean(pos, axis=0)[2:]

@@ -355,6 +355,22 @@ def ratio_curve(defect: Defect, geom: RaceGeometry, delta: float, *, cells=TABLE
             for k in group[1:]:
                 solved[k] = solved[group[0]]
 
+    _refine(solve_round, solved, p_int, k_lo, k_hi, coarse_step, refine_tol)
+    ks = np.array(sorted(solved))
+    s_nodes = ks * dy
+    ratio = np.array([solved[k][0] for k in ks])
+    if _symmetry(defect) and ks[0] == 0:
+        s_nodes = np.concatenate([-s_nodes[:0:-1], s_nodes])
+        ratio = np.concatenate([ratio[:0:-1], ratio])
+    info = {"intact_force_n": base["force"], "semi_axes_m": (base["a"], base["b"]),
+            "cells": grid.shape, "cell_m": (grid.dx, grid.dy), "aligned": grid.aligned, **stats}
+    return s_nodes, ratio, info
+
+
+def _refine(solve_round, solved, p_int, k_lo, k_hi, coarse_step, refine_tol):
+    """Solve every ``coarse_step`` positions, then halve intervals while the solved
+    midpoint misses linear interpolation by more than ``refine_tol`` (``solved`` maps a
+    position to (ratio, pressure) and is filled by ``solve_round(ks, starts)``)."""
     coarse = list(range(k_lo, k_hi + 1, coarse_step))
     if coarse[-1] != k_hi:
         coarse.append(k_hi)
@@ -378,15 +394,6 @@ def ratio_curve(defect: Defect, geom: RaceGeometry, delta: float, *, cells=TABLE
             if abs(solved[m][0] - lin) > refine_tol:
                 nxt += [(a, m), (m, b)]
         intervals = [(a, b) for a, b in nxt if b - a >= 2]
-    ks = np.array(sorted(solved))
-    s_nodes = ks * dy
-    ratio = np.array([solved[k][0] for k in ks])
-    if _symmetry(defect) and ks[0] == 0:
-        s_nodes = np.concatenate([-s_nodes[:0:-1], s_nodes])
-        ratio = np.concatenate([ratio[:0:-1], ratio])
-    info = {"intact_force_n": base["force"], "semi_axes_m": (base["a"], base["b"]),
-            "cells": grid.shape, "cell_m": (grid.dx, grid.dy), "aligned": grid.aligned, **stats}
-    return s_nodes, ratio, info
 
 
 def halfspace_ratio_nodes(defect: Defect, geom: RaceGeometry, delta_nodes, **kw):
