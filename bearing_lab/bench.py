@@ -3,10 +3,10 @@
 For each benchmark scene every solver setting (fixed steps, adaptive tolerances),
 every fidelity (quasi-static balls, ball inertia, ball inertia with a dynamic
 cage) and every defect-contact model
-(along-track profile, rigid 2-D drop, 2-D with area loss) runs the same record; each
+(along-track profile, rigid 2-D drop, 2-D local law, elastic half-space) runs the same record; each
 is scored by its compute seconds per simulated second and its error in peak
 acceleration, RMS, excitation period and impulse duration against ONE converged
-reference per scene: the most complete model (multibody, "area" contact) with dp54 at
+reference per scene: the most complete model (multibody, "halfspace" contact) with dp54 at
 rtol 1e-9 and a 2 µs step ceiling.  Convergence of that reference is established by
 a second run at rtol 1e-10 with a 1 µs ceiling; their difference is reported as the
 reference's own error.  scipy's ``solve_ivp`` (LSODA, Radau) integrates the same numba
@@ -37,6 +37,10 @@ from .sim.integrate import METHODS, _decimate_acc, _run, _warm_up, anti_alias_ta
 G0 = 9.80665
 TOL_PEAK = 0.01
 TOL_PERIOD = 0.001
+#: the defect-contact model of the reference and of the solver rows (the default); the
+#: cheaper models run once each at dp54 rtol 1e-5
+REF_CONTACT = "halfspace"
+CHEAP_CONTACTS = ("area", "drop", "profile")
 
 SCENES = [
     ("paper-healthy", "paper-healthy", {}, "healthy"),
@@ -141,7 +145,7 @@ def run_bench(out_dir="reports/performance", *, duration=0.3, scipy_duration=0.0
     rows = []
     notes = {}
     for label, base, ov, kind in tqdm(chosen, desc="bench scenes", disable=not progress):
-        sc_ref = _scene(base, ov, duration, "multibody", "area" if kind != "healthy" else None)
+        sc_ref = _scene(base, ov, duration, "multibody", REF_CONTACT if kind != "healthy" else None)
         asm = assemble(sc_ref)
         fs = sc_ref.fs_out
         ref, _ = _timed(asm, "dp54", 1e-9, None, 2e-6)
@@ -149,12 +153,12 @@ def run_bench(out_dir="reports/performance", *, duration=0.3, scipy_duration=0.0
         m_ref = _measures(ref["acc"][:, 1], fs, sc_ref)
         m_ref2 = _measures(ref2["acc"][:, 1], fs, sc_ref)
         notes[label] = {k: _err(m_ref2[k], m_ref[k]) for k in m_ref}
-        jobs = [("multibody", "area", *s) for s in MB_SETTINGS]
-        jobs += [("quasi-static", "area", *s) for s in QS_SETTINGS]
-        jobs += [("multibody+dynamic cage", "area", m, r, None, None)
+        jobs = [("multibody", REF_CONTACT, *s) for s in MB_SETTINGS]
+        jobs += [("quasi-static", REF_CONTACT, *s) for s in QS_SETTINGS]
+        jobs += [("multibody+dynamic cage", REF_CONTACT, m, r, None, None)
                  for m, r in (("dp54", 1e-5), ("bs32", 1e-4), ("bs32", 1e-3))]
         if kind != "healthy":
-            jobs += [("multibody", m, "dp54", 1e-5, None, None) for m in ("drop", "profile")]
+            jobs += [("multibody", m, "dp54", 1e-5, None, None) for m in CHEAP_CONTACTS]
         for fid, model, method, rtol, step, mx in jobs:
             cage = "dynamic" if fid.endswith("dynamic cage") else "kinematic"
             sc = _scene(base, ov, duration, fid.split("+")[0], model if kind != "healthy" else None, cage)
@@ -168,7 +172,7 @@ def run_bench(out_dir="reports/performance", *, duration=0.3, scipy_duration=0.0
                              solver="bearing_lab", cost=cost, ref_period=m_ref["period"],
                              **{f"err_{k}": _err(m[k], m_ref[k]) for k in m_ref}))
         if scipy:
-            sc_s = _scene(base, ov, scipy_duration, "multibody", "area" if kind != "healthy" else None)
+            sc_s = _scene(base, ov, scipy_duration, "multibody", REF_CONTACT if kind != "healthy" else None)
             asm_s = assemble(sc_s)
             ref_s, _ = _timed(asm_s, "dp54", 1e-9, None, 2e-6)
             pk = float(np.max(np.abs(ref_s["acc"][:, 1])))
@@ -179,7 +183,7 @@ def run_bench(out_dir="reports/performance", *, duration=0.3, scipy_duration=0.0
                     *[(f"scipy {mm} rtol={rr:g}", mm, rr, *_scipy(asm_s, mm, rr)) for mm, rr in
                       (("LSODA", 1e-6), ("LSODA", 1e-8), ("Radau", 1e-8))]):
                 rows.append(dict(scene=label, kind=kind, fidelity="multibody",
-                                 contact="area" if kind != "healthy" else "none",
+                                 contact=REF_CONTACT if kind != "healthy" else "none",
                                  setting=f"{name} (short window)", method=method, rtol=rtol, step=0.0,
                                  max_step=2.5e-5, solver="scipy" if name.startswith("scipy") else "bearing_lab-short",
                                  cost=cost, ref_period=math.nan,
@@ -192,7 +196,7 @@ def run_bench(out_dir="reports/performance", *, duration=0.3, scipy_duration=0.0
     for k in ("err_peak", "err_rms", "err_period", "err_duration"):
         ds[k].attrs["units"] = "1"
     ds.attrs.update({"duration_s": duration, "scipy_duration_s": scipy_duration,
-                     "reference": "multibody + area contact, dp54 rtol 1e-9, max step 2e-6 s",
+                     "reference": f"multibody + {REF_CONTACT} contact, dp54 rtol 1e-9, max step 2e-6 s",
                      "reference_self_check": repr(notes), "tolerance_peak": TOL_PEAK,
                      "tolerance_period": TOL_PERIOD, "sampling_rate_hz": 0.0,
                      "bearing_lab_version": __import__("bearing_lab").__version__})
@@ -233,7 +237,7 @@ def _rules(rows) -> str:
         scenes = sorted({r["scene"] for r in rows if r["kind"] == kind})
         settings = {}
         for r in rows:
-            if (r["kind"] != kind or r["solver"] != "bearing_lab" or r["contact"] not in ("area", "none")
+            if (r["kind"] != kind or r["solver"] != "bearing_lab" or r["contact"] not in (REF_CONTACT, "none")
                     or r["method"] == "rk4" or "cage" in r["fidelity"]):
                 continue
             settings.setdefault((r["fidelity"], r["method"], r["rtol"], r["step"], r["max_step"]), []).append(r)
@@ -277,11 +281,11 @@ def _report(out, rows, notes):
         fig, ax = plt.subplots(figsize=(6.5, 4.2))
         groups = [(f"{fid} ({solver})", mk, col,
                    lambda r, fid=fid, solver=solver: (r["fidelity"] == fid and r["solver"] == solver
-                                                      and r["contact"] in ("area", "none")))
+                                                      and r["contact"] in (REF_CONTACT, "none")))
                   for fid, mk in (("multibody", "o"), ("quasi-static", "s"), ("multibody+dynamic cage", "^"))
                   for solver, col in (("bearing_lab", None), ("scipy", "k"))]
-        groups.append(("multibody, cheaper contact (drop, profile)", "x", "r",
-                       lambda r: r["contact"] in ("drop", "profile")))
+        groups.append((f"multibody, cheaper contact ({', '.join(CHEAP_CONTACTS)})", "x", "r",
+                       lambda r: r["contact"] in CHEAP_CONTACTS))
         for label, mk, col, keep in groups:
             sel = [r for r in rs if keep(r) and math.isfinite(r["err_peak"])]
             if sel:
@@ -289,7 +293,7 @@ def _report(out, rows, notes):
                            c=col, label=label, alpha=0.8)
                 for r in sel:
                     text = r["setting"].replace(" (short window)", "")
-                    if r["contact"] in ("drop", "profile"):
+                    if r["contact"] in CHEAP_CONTACTS:
                         text = f"{r['contact']} contact"
                     ax.annotate(text, (max(r["err_peak"], 1e-9), r["cost"]), fontsize=5, alpha=0.7)
         ax.axvline(TOL_PEAK, color="r", ls="--", lw=0.8)

@@ -614,7 +614,7 @@ def _from_cache(cdir, scenes, digests, acc):
 
 
 # attributes that differ per scene or are replaced by the sweep's own
-_PER_SCENE_ATTRS = {"title", "scene_toml", "wall_time_s", "compile_time_s", "solver_steps",
+_PER_SCENE_ATTRS = {"title", "scene_toml", "wall_time_s", "table_time_s", "compile_time_s", "solver_steps",
                     "solver_rejected_steps", "sweep_scene_hash", "scene_name"}
 
 

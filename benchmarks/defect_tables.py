@@ -1,14 +1,24 @@
-"""Defect contact tables on the paper's defects: build times and what each model predicts.
+"""Defect contact tables on the paper's defects: build time, accuracy, what each model predicts.
 
-Run:  .venv/bin/python benchmarks/defect_tables.py [--no-halfspace]
+Run:  .venv/bin/python benchmarks/defect_tables.py [--quick]
 
 Prints (markdown):
-1. the rigid drops against reference.md;
-2. per defect and contact model: table build time, the share of the intact load carried
-   at the most defected position (minimum over psi of G / delta^1.5) at the ball approach
-   delta = 8 µm (the most loaded ball of the 6308 at 480 N), and the stretch of track over
-   which more than 1 % of the load is lost;
-3. the local law against the elastic half-space (``halfspace.compare_local_law``).
+1. the rigid drops against the independent figures (exact sphere in torus);
+2. per paper defect (at the delta_max its scene uses): CPU time of a cold "halfspace"
+   table (one core, minimum of 3, numba already compiled) and of reading it back from the
+   disk cache, and the "area" table's cold time;
+3. the default half-space table against a converged one (cells 64 x 48, Richardson with
+   32 x 24 where the sides are grid-aligned, 32 approach nodes, ball positions refined to
+   2e-4): the error of the carried share G / delta^1.5 over delta in [0.1, 1] delta_max,
+   maximum and RMS over the positions where the load is reduced, and the part due to the
+   grid alone (same approach nodes as the default);
+4. the intact half-space force against Hertz (K delta^1.5) and the contact semi-axes from
+   the pressure's moments against Hertz's (Johnson 1985), at the default grid;
+5. the carried share at the static approach of the most loaded ball for each model;
+6. a fine direct solve (0.0125 x 0.004 mm cells) at 300 N against both tables;
+7. paper-O1's peak acceleration (H = 0, B/3, B/2; 20 and 100 kHz output) with the default
+   table and with the converged one.
+``--quick`` skips 3 and 7 (the converged tables take several minutes).
 """
 from __future__ import annotations
 
@@ -19,66 +29,170 @@ import time
 import numpy as np
 
 from bearing_lab.bearings import get_bearing
-from bearing_lab.sim.defects import Defect, rigid_drop
-from bearing_lab.sim.defects.contact import _build
+from bearing_lab.sim import load_scene
+from bearing_lab.sim.assembly import assemble
+from bearing_lab.sim.defects import RaceGeometry, rigid_drop
+from bearing_lab.sim.defects.contact import _MEMORY, _build, contact_table
+from bearing_lab.sim.defects.geometry import hertz_semi_axes
 from bearing_lab.sim.defects.halfspace import compare_local_law
+from bearing_lab.sim.defects._halfspace_kernels import warm_up
+from bearing_lab.sim.hertz import race_contact
 
 B = get_bearing("6308")
-DELTA = 8e-6
-DMAX = 25e-6
-
 REFERENCE = [("1x1 H=0", 1, 1, 0, 0, 0.9413), ("1x1 H=B/3", 1, 1, 1 / 3, 0, 0.1043),
              ("1x1 H=B/2", 1, 1, 0.5, 0, 0.0), ("3x1", 3, 1, 0, 0, 0.9413),
              ("6x1", 6, 1, 0, 0, 0.9413), ("3x1 30deg", 3, 1, 0, 30, 1.2275),
              ("3x1 60deg", 3, 1, 0, 60, 3.1287), ("slot 1x23", 1, 23, 0, 0, 13.473)]
-
-SCENES = [("O1 1x1", 1, 1, 0, 0), ("O1 H=B/3", 1, 1, 1 / 3, 0), ("O1 H=B/2", 1, 1, 0.5, 0),
-          ("O2 1x3", 3, 1, 0, 0), ("O2 30deg", 3, 1, 0, 30), ("O2 60deg", 3, 1, 0, 60),
-          ("O3 1x6", 6, 1, 0, 0), ("slot 1x23", 1, 23, 0, 0)]
-
-
-def _defect(L, Bw, hf, th, race="outer"):
-    return Defect(race=race, length=L * 1e-3, width=Bw * 1e-3, offset=hf * Bw * 1e-3,
-                  skew=math.radians(th))
+CASES = [("O1 H=0", "paper-O1", {}), ("O1 H=B/3", "paper-O1", {"defect.offset_mm": 1 / 3}),
+         ("O1 H=B/2", "paper-O1", {"defect.offset_mm": 0.5}), ("O2 θ=0", "paper-O2", {}),
+         ("O2 θ=30°", "paper-O2", {"defect.skew_deg": 30.0}),
+         ("O2 θ=60°", "paper-O2", {"defect.skew_deg": 60.0}), ("O3", "paper-O3", {}),
+         ("slot", "paper-slot", {})]
+CONVERGED = {"cells": (64, 48), "nodes": np.linspace(1 / 32, 1.0, 32), "refine_tol": 2e-4,
+             "tol": 1e-6, "coarse_step": 2}
 
 
-def main(halfspace: bool = True) -> None:
+def _scene_defect(name, ov):
+    """(defect, delta_max, static approach of the most loaded ball) as the scene uses them."""
+    sc = load_scene(name, **ov)
+    asm = assemble(sc)
+    t = asm.tables[0]
+    d_static = (float(np.max(asm.static["ball_loads"])) / asm.hertz_outer.stiffness) ** (2 / 3)
+    return sc.defects[0], t.delta_max, d_static
+
+
+def _cpu(fn, repeat=3):
+    best = math.inf
+    for _ in range(repeat):
+        _MEMORY.clear()
+        c = time.process_time()
+        out = fn()
+        best = min(best, time.process_time() - c)
+    return best, out
+
+
+def _share_error(T, Tref):
+    """max and RMS of |G - G_ref| / delta^1.5 over delta in [0.1, 1] delta_max where the
+    reference loses load."""
+    k = T.delta >= 0.1 * T.delta[-1]
+    d15 = T.delta[k] ** 1.5
+    a = T.G[:, k] / d15
+    b = Tref.G[:, k] / d15
+    m = b < 0.999
+    e = np.abs(a - b)
+    return float(e.max()), float(np.sqrt(np.mean(e[m] ** 2))) if m.any() else 0.0
+
+
+def drops() -> None:
     print("## Rigid drop (µm), 6308 outer race, 0.5 mm deep\n")
-    print("| defect | this code | reference.md | error |\n|---|---|---|---|")
+    print("| defect | this code | independent | error |\n|---|---|---|---|")
+    from bearing_lab.sim.defects import Defect
     for name, L, Bw, hf, th, ref in REFERENCE:
-        v = rigid_drop(_defect(L, Bw, hf, th), B) * 1e6
+        d = Defect(length=L * 1e-3, width=Bw * 1e-3, offset=hf * Bw * 1e-3, skew=math.radians(th))
+        v = rigid_drop(d, B) * 1e6
         print(f"| {name} | {v:.4f} | {ref} | {v - ref:+.4f} |")
 
-    models = ["profile", "drop", "area"] + (["halfspace"] if halfspace else [])
-    for race in ("outer", "inner"):
-        print(f"\n## {race} race: carried share min_psi G/delta^1.5 at delta = {DELTA*1e6:g} µm, "
-              f"loss > 1 % over s (mm); build time (s); delta_max = {DMAX*1e6:g} µm\n")
-        print("| defect | " + " | ".join(models) + " |\n" + "|---" * (len(models) + 1) + "|")
-        for name, L, Bw, hf, th in SCENES:
-            d = _defect(L, Bw, hf, th, race)
-            cells = []
-            for model in models:
-                T = _build(d, B, model=model, clearance=0.0, delta_max=DMAX, n_psi=None, n_delta=51)
-                k = int(np.argmin(np.abs(T.delta - DELTA)))
-                r = T.G[:, k] / T.delta[k] ** 1.5
-                lost = T.psi[r < 0.99] * T.track_radius
-                span = float(np.ptp(lost)) * 1e3 if lost.size else 0.0
-                cells.append(f"{r.min():.3f}, {span:.2f} mm ({T.info['build_time_s']:.2f} s)")
-            print(f"| {name} | " + " | ".join(cells) + " |")
 
-    if halfspace:
-        print("\n## Local law vs elastic half-space, centred 1x1 mm (share of intact load)\n")
-        for load in (300.0, 3.27e10 * DELTA ** 1.5):
-            t = time.perf_counter()
-            r = compare_local_law(load=load, s_positions=(0.0, 0.3e-3, 0.5e-3, 0.6e-3, 0.7e-3))
-            print(f"approach {r['approach']*1e6:.3f} µm: intact half-space force "
-                  f"{r['intact_force']:.2f} N (Hertz {load:.1f} N), semi-axes "
-                  f"{r['a']*1e3:.4f} x {r['b']*1e3:.4f} mm ({time.perf_counter() - t:.1f} s)\n")
-            print("| s (mm) | local law | half-space |\n|---|---|---|")
-            for p in r["positions"]:
-                print(f"| {p['s']*1e3:.1f} | {p['local_law']:.3f} | {p['halfspace']:.3f} |")
-            print()
+def timing_and_accuracy(converged: bool) -> None:
+    print("\n## Half-space tables of the paper's defects (CPU s, one core, machine shared)\n")
+    head = "| defect | δ_max (µm) | halfspace cold | from disk | area cold |"
+    if converged:
+        head += " error max / RMS | grid part max / RMS |"
+    print(head + "\n|" + "---|" * (head.count("|") - 1))
+    for label, name, ov in CASES:
+        d, dmax, _ = _scene_defect(name, ov)
+        t_hs, T = _cpu(lambda: contact_table(d, B, model="halfspace", delta_max=dmax, cache=False))
+        contact_table(d, B, model="halfspace", delta_max=dmax)          # make sure it is on disk
+        t_disk, _ = _cpu(lambda: contact_table(d, B, model="halfspace", delta_max=dmax))
+        t_area, _ = _cpu(lambda: contact_table(d, B, model="area", delta_max=dmax, cache=False))
+        row = f"| {label} | {dmax * 1e6:.2f} | {t_hs:.3f} | {t_disk:.4f} | {t_area:.3f} |"
+        if converged:
+            args = dict(model="halfspace", clearance=0.0, delta_max=dmax, n_psi=T.psi.size, n_delta=41)
+            Tref = _build(d, B, **args, halfspace_settings=CONVERGED)
+            Tgrid = _build(d, B, **args, halfspace_settings={**CONVERGED, "nodes": T.info["halfspace_delta_nodes"] / dmax})
+            em, er = _share_error(T, Tref)
+            gm, gr = _share_error(T, Tgrid)
+            row += f" {em:.4f} / {er:.4f} | {gm:.4f} / {gr:.4f} |"
+        print(row, flush=True)
+
+
+def intact_against_hertz() -> None:
+    print("\n## Intact half-space contact at the table grid against Hertz (outer race)\n")
+    print("| approach (µm) | force (N) | K δ^1.5 (N) | error | a (mm) | Hertz a | error | b (mm) | Hertz b | error |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
+    from bearing_lab.sim.defects import Defect
+    geom = RaceGeometry.from_bearing(B, "outer")
+    K = race_contact(B.ball_diameter, B.pitch_diameter, B.outer_conformity, "outer").stiffness
+    T = contact_table(Defect(length=1e-3, width=1e-3), B, model="halfspace", delta_max=12e-6)
+    a_h, b_h = hertz_semi_axes(geom, T.info["halfspace_delta_nodes"])
+    for dn, f, (a, b), ah, bh in zip(T.info["halfspace_delta_nodes"], T.info["halfspace_intact_force_n"],
+                                     T.info["halfspace_semi_axes_m"], a_h, b_h):
+        fk = K * dn ** 1.5
+        print(f"| {dn * 1e6:.2f} | {f:.2f} | {fk:.2f} | {f / fk - 1:+.2%} | {a * 1e3:.4f} | {ah * 1e3:.4f} | "
+              f"{a / ah - 1:+.2%} | {b * 1e3:.4f} | {bh * 1e3:.4f} | {b / bh - 1:+.2%} |")
+
+
+def models() -> None:
+    print("\n## Carried share min_ψ G/δ^1.5 at the static approach of the most loaded ball\n")
+    names = ("halfspace", "area", "drop", "profile")
+    print("| defect | δ_static (µm) | " + " | ".join(names) + " |\n|---|---|" + "---|" * len(names))
+    for label, name, ov in CASES:
+        d, dmax, ds = _scene_defect(name, ov)
+        cells = []
+        for m in names:
+            T = contact_table(d, B, model=m, delta_max=dmax)
+            cells.append(f"{float(np.min(T.lookup(T.psi, np.full(T.psi.size, ds)))) / ds ** 1.5:.3f}")
+        print(f"| {label} | {ds * 1e6:.2f} | " + " | ".join(cells) + " |")
+
+
+def fine_solve() -> None:
+    print("\n## Fine direct solve (0.0125 x 0.004 mm cells), centred 1 x 1 mm, share of intact load\n")
+    for load in (300.0, 3.27e10 * 8e-6 ** 1.5):
+        r = compare_local_law(load=load, s_positions=(0.0, 0.3e-3, 0.5e-3, 0.6e-3, 0.7e-3))
+        print(f"approach {r['approach'] * 1e6:.3f} µm: intact force {r['intact_force']:.2f} N (Hertz "
+              f"{load:.1f} N), semi-axes {r['a'] * 1e3:.4f} x {r['b'] * 1e3:.4f} mm\n")
+        print("| s (mm) | fine solve | halfspace table | area (local law) |\n|---|---|---|---|")
+        for p in r["positions"]:
+            print(f"| {p['s'] * 1e3:.1f} | {p['halfspace']:.3f} | {p['table']:.3f} | {p['local_law']:.3f} |")
+        print()
+
+
+def dynamics_with_converged_table(fs_list=(20_000.0, 100_000.0)) -> None:
+    """Peak acceleration (max |a| after 0.1 s of a 0.3 s record, as a user runs paper-O1 and
+    the O2 skews) with the default tables and with converged ones (module settings patched,
+    so the cache keys differ)."""
+    from bearing_lab.sim import simulate
+    from bearing_lab.sim.defects import contact as C, halfspace as H
+    print("\n## paper-O1 peak acceleration (g) with the default and the converged half-space table\n")
+    print("| output | defect | default table | converged table | difference |\n|---|---|---|---|---|")
+    saved = (C.HALFSPACE_NODES, H.TABLE_CELLS)
+    for fs in fs_list:
+        for label, ov in (("O1 H=0", {}), ("O1 H=B/3", {"defect.offset_mm": 1 / 3}),
+                          ("O1 H=B/2", {"defect.offset_mm": 0.5}),
+                          ("O2 θ=30°", {"defect.length_mm": 3.0, "defect.skew_deg": 30.0}),
+                          ("O2 θ=60°", {"defect.length_mm": 3.0, "defect.skew_deg": 60.0})):
+            peaks = []
+            for nodes, cells in (saved, (tuple(CONVERGED["nodes"]), CONVERGED["cells"])):
+                C.HALFSPACE_NODES, H.TABLE_CELLS = nodes, cells
+                C._MEMORY.clear()
+                ds = simulate("paper-O1", duration=0.3, fs=fs, progress=False, **ov)
+                a = ds.outer_ring_acc_y.values[ds.time.values > 0.1]
+                peaks.append(float(np.max(np.abs(a))) / 9.80665)
+            C.HALFSPACE_NODES, H.TABLE_CELLS = saved
+            print(f"| {fs / 1e3:.0f} kHz | {label} | {peaks[0]:.3f} | {peaks[1]:.3f} | "
+                  f"{peaks[0] / peaks[1] - 1:+.2%} |", flush=True)
+
+
+def main(quick: bool = False) -> None:
+    warm_up()
+    drops()
+    timing_and_accuracy(converged=not quick)
+    intact_against_hertz()
+    models()
+    fine_solve()
+    if not quick:
+        dynamics_with_converged_table()
 
 
 if __name__ == "__main__":
-    main(halfspace="--no-halfspace" not in sys.argv)
+    main(quick="--quick" in sys.argv)

@@ -3,11 +3,18 @@
 Real recordings come from the directory named by BEARING_LAB_MIRROR (CI sets it to
 ../shared/data).  Outside CI a missing mirror skips the data tests with the reason;
 in CI (CI=true) a missing file is a failure, never a skip.
+
+The per-user cache (contact tables, sweep results) is pointed at a fresh temporary folder
+for the whole session, so no test depends on, or writes to, a user's warm cache.
 """
 import os
 from pathlib import Path
+import tempfile
 
 import pytest
+
+_SESSION_CACHE = tempfile.TemporaryDirectory(prefix="bearing_lab_test_cache_")
+os.environ["BEARING_LAB_CACHE"] = _SESSION_CACHE.name
 
 IN_CI = os.environ.get("CI", "").lower() in ("1", "true", "yes")
 

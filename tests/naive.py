@@ -75,6 +75,81 @@ def interpolated_peak_frequency(x, fs, f_lo, f_hi, pad=8):
     return f[i] + p * (f[1] - f[0])
 
 
+# ----------------------------------------------------------------------------- half-space
+
+def torus_gap(s, z, *, ball_radius, groove_radius, track_radius, depth=0.0):
+    """Approach (m) at which a ball centred at s = 0 on the outer race's track centre line
+    first touches the groove point (s along the track, z across), the groove moved
+    ``depth`` outward.  Written from the geometry: the groove surface lies at radius
+    r(z) = R_c + sqrt(r_g^2 - z^2) + depth (R_c = R - r_g); the ball of radius r_b, its centre
+    at radius rho on the angle of s = 0, touches a point at angle phi = s / R when
+    (r cos phi - rho)^2 + (r sin phi)^2 + z^2 = r_b^2, first for rho = R - r_b + h."""
+    r = (track_radius - groove_radius) + np.sqrt(groove_radius ** 2 - z ** 2) + depth
+    phi = s / track_radius
+    inside = ball_radius ** 2 - z ** 2 - (r * np.sin(phi)) ** 2
+    return r * np.cos(phi) - np.sqrt(inside) - (track_radius - ball_radius)
+
+
+def boussinesq_matrix(iz, js, dz, ds, e_star, order=16):
+    """Dense influence matrix (m/Pa) of cells (iz, js) (integer indices on a uniform grid of
+    dz x ds cells): displacement at the centre of cell i under unit pressure on cell j.
+
+    Boussinesq's point load, 1/(pi E* r), integrated over the source cell with
+    ``order`` x ``order`` Gauss-Legendre points; the cell itself by the closed form at
+    the centre of a uniformly loaded 2a x 2b rectangle, (2/(pi E*)) [a asinh(b/a) +
+    b asinh(a/b)] (Johnson, Contact Mechanics, 1985, section 3.2)."""
+    x, w = np.polynomial.legendre.leggauss(order)
+    qz = (x[:, None] * np.ones(order)[None, :]).ravel() * dz / 2
+    qs = (np.ones(order)[:, None] * x[None, :]).ravel() * ds / 2
+    qw = (w[:, None] * w[None, :]).ravel() * dz * ds / 4
+    nz, ns = int(np.ptp(iz)) + 1, int(np.ptp(js)) + 1
+    oz = np.arange(nz)[:, None] * dz
+    os_ = np.arange(ns)[None, :] * ds
+    kern = np.zeros((nz, ns))
+    for a_, b_, c_ in zip(qz, qs, qw):
+        r = np.hypot(oz - a_, os_ - b_)
+        kern += c_ / r
+    a, b = dz / 2, ds / 2
+    kern[0, 0] = 4 * (a * math.asinh(b / a) + b * math.asinh(a / b))
+    kern /= math.pi * e_star
+    return kern[np.abs(iz[:, None] - iz[None, :]), np.abs(js[:, None] - js[None, :])]
+
+
+def contact_nnls(A, gap, approach):
+    """Pressures p >= 0 with A p + gap - approach >= 0, complementary (frictionless normal
+    contact at a fixed approach).  For a symmetric positive definite A this is the
+    minimum of p.A.p/2 - (approach - gap).p over p >= 0; with A = L L^T that is the
+    non-negative least-squares problem ||L^T p - L^-1 (approach - gap)|| (Lawson-Hanson,
+    scipy.optimize.nnls)."""
+    from scipy.linalg import cholesky, solve_triangular
+    from scipy.optimize import nnls
+    A = 0.5 * (A + A.T)
+    L = cholesky(A, lower=True)
+    b = solve_triangular(L, approach - gap, lower=True)
+    p, _ = nnls(L.T, b, maxiter=50 * gap.size)
+    return p
+
+
+def halfspace_share(geom_radii, approach, *, pit, cell_z, cell_s, half_z, half_s, e_star=114.3e9):
+    """F(pit) / F(intact) at the same approach, ball centred at s = 0, brute force.
+
+    ``pit(s, z)`` -> bool (the removed outline, floor never reached); cells centred at
+    ((i + 1/2) cell_z, (j + 1/2) cell_s) over |z| < half_z, |s| < half_s (so outline sides
+    at multiples of the cell sizes fall on cell boundaries)."""
+    nz, ns = round(half_z / cell_z), round(half_s / cell_s)
+    I, J = np.meshgrid(np.arange(-nz, nz), np.arange(-ns, ns), indexing="ij")
+    Z, S = (I + 0.5) * cell_z, (J + 0.5) * cell_s
+    gap = torus_gap(S, Z, **geom_radii)
+    keep = np.isfinite(gap) & (gap < approach)
+    forces = []
+    for removed in (np.zeros_like(keep), pit(S, Z)):
+        cells = keep & ~removed
+        A = boussinesq_matrix(I[cells], J[cells], cell_z, cell_s, e_star)
+        p = contact_nnls(A, gap[cells], approach)
+        forces.append(p.sum() * cell_z * cell_s)
+    return forces[1] / forces[0], forces[0]
+
+
 def spectral_coherence_at(x, fs, alpha, nw):
     """Cyclic spectral coherence magnitude at one cyclic frequency, averaged over f (brute force).
 

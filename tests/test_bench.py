@@ -13,11 +13,11 @@ def test_bench_writes_report_rules_and_rows(tmp_path):
         assert (tmp_path / name).stat().st_size > 0
     rows = rows_of(ds)
     assert {r["fidelity"] for r in rows} == {"multibody", "quasi-static", "multibody+dynamic cage"}
-    assert {r["contact"] for r in rows} == {"area", "drop", "profile"}
+    assert {r["contact"] for r in rows} == {"halfspace", "area", "drop", "profile"}
     assert all(r["cost"] > 0 for r in rows)
     assert all(math.isfinite(r["err_peak"]) for r in rows)
     # the tightest adaptive multibody setting sits close to the reference, the cheaper contact
-    # models far from it (benchmarks/README.md: +69 % on the slot)
+    # models far from it (benchmarks/README.md)
     tight = [r for r in rows if r["setting"] == "dp54 rtol=1e-06" and r["fidelity"] == "multibody"]
     assert tight and tight[0]["err_peak"] < 0.01
     assert min(r["err_peak"] for r in rows if r["contact"] == "profile") > 0.2

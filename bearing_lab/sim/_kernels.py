@@ -47,7 +47,9 @@ P_SPIN = 41
 P_CAGE, P_MU, P_VREF, P_KPOCK, P_CPOCK, P_DPOCK, P_IC, P_IB, P_RB, P_SENSOFF = 42, 43, 44, 45, 46, 47, 48, 49, 50, 51
 P_CDRAG = 52
 P_UNB = 53      # shaft unbalance U = m e (kg m): a force U omega^2 turning with the shaft on the inner ring
-P_SIZE = 54
+P_DRATE = 54    # damping rate over a defect: 0 the bodies' approach rate, 1 the rate of the
+                # contact law's equivalent penetration (including the rolling term)
+P_SIZE = 55
 
 # ---- defect table layout: dint[k] = race, kind, npsi, ndelta, h_off, g_off, ball
 #   race 0: outer race, 1: inner race, 2: ball defect meeting the outer race,
@@ -130,13 +132,14 @@ def _interp_h(k, psi, dint, dflt, hbuf):
 
 
 @njit(cache=True, error_model="numpy")
-def _interp_g(k, psi, delta, dint, dflt, gbuf):
-    """G(psi, delta) (m^1.5) of defect k.
+def _interp_g23(k, psi, delta, dint, dflt, gbuf):
+    """Equivalent penetration g = G^(2/3) (m) of defect k at (psi, delta), and its partial
+    derivatives dg/ddelta and dg/dpsi.
 
-    The table holds G^(2/3) (an approach-like quantity, m), interpolated bilinearly and
-    raised to 1.5: exact on intact surface (G^(2/3) = delta is linear) and for a rigid drop
-    (max(delta - h, 0)), where interpolating G itself would overstate the convex delta^1.5
-    between grid nodes.  Linear extrapolation above the grid's delta range.
+    The table holds G^(2/3) (an approach-like quantity, m), interpolated bilinearly: exact
+    on intact surface (g = delta) and for a rigid drop (max(delta - h, 0)), where
+    interpolating G itself would overstate the convex delta^1.5 between grid nodes.
+    Linear extrapolation above the grid's delta range.
     """
     npsi = dint[k, D_NPSI]
     nd = dint[k, D_NDEL]
@@ -144,9 +147,9 @@ def _interp_g(k, psi, delta, dint, dflt, gbuf):
     dd = dflt[k, F_DDEL]
     x = (psi - dflt[k, F_PSIF]) / dflt[k, F_DPSI]
     if delta <= 0.0:
-        return 0.0
+        return 0.0, 0.0, 0.0
     if x <= 0.0 or x >= npsi - 1:
-        return delta * math.sqrt(delta)
+        return delta, 1.0, 0.0
     i = int(x)
     fx = x - i
     yv = delta / dd
@@ -162,20 +165,42 @@ def _interp_g(k, psi, delta, dint, dflt, gbuf):
     g0 = a00 + fy * (a01 - a00)
     g1 = a10 + fy * (a11 - a10)
     g = g0 + fx * (g1 - g0)
+    dg_dd = ((1.0 - fx) * (a01 - a00) + fx * (a11 - a10)) / dd
+    dg_dpsi = (g1 - g0) / dflt[k, F_DPSI]
+    return g, dg_dd, dg_dpsi
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _interp_g(k, psi, delta, dint, dflt, gbuf):
+    """G(psi, delta) (m^1.5) of defect k: the equivalent penetration raised to 1.5."""
+    g, _, _ = _interp_g23(k, psi, delta, dint, dflt, gbuf)
     return g * math.sqrt(g) if g > 0.0 else 0.0
 
 
 @njit(cache=True, error_model="numpy")
 def defect_force(kk, rel, reld, delta, delta_rate, k, p, dint, dflt, hbuf, gbuf):
-    """Normal force of a ball at relative angle ``rel`` inside the zone of defect kk."""
-    h, dh = _interp_h(kk, rel, dint, dflt, hbuf)
-    pen = delta - h
-    pen_rate = delta_rate - dh * reld
-    if pen <= 0.0:
-        return 0.0
+    """Normal force of a ball at relative angle ``rel`` inside the zone of defect kk.
+
+    Elastic part from the defect's law at the approach ``delta``; IMPACT damping
+    ``STEP(pen, 0, 0, d, c_max) * rate`` with ``pen`` the law's own penetration (``delta
+    - h`` for a drop profile, ``G^(2/3)`` for a 2-D table) and ``rate`` the bodies'
+    approach rate ``delta_rate`` (``p[P_DRATE] == 0``, the default) or the rate of
+    ``pen`` itself, which adds the change of the contact as the ball rolls over the
+    outline (``p[P_DRATE] == 1``).  See docs/contact-model.md for the choice.
+    """
+    rolling = p[P_DRATE] > 0.5
     if dint[kk, D_KIND] == 0:
-        return impact(pen, pen_rate, k, p[P_EXP], p[P_CMAX], p[P_DPEN])
-    f = k * _interp_g(kk, rel, delta, dint, dflt, gbuf) + step_fn(pen, 0.0, 0.0, p[P_DPEN], p[P_CMAX]) * pen_rate
+        h, dh = _interp_h(kk, rel, dint, dflt, hbuf)
+        pen = delta - h
+        if pen <= 0.0:
+            return 0.0
+        rate = delta_rate - dh * reld if rolling else delta_rate
+        return impact(pen, rate, k, p[P_EXP], p[P_CMAX], p[P_DPEN])
+    g, dg_dd, dg_dpsi = _interp_g23(kk, rel, delta, dint, dflt, gbuf)
+    if g <= 0.0:
+        return 0.0
+    rate = dg_dd * delta_rate + dg_dpsi * reld if rolling else delta_rate
+    f = k * g * math.sqrt(g) + step_fn(g, 0.0, 0.0, p[P_DPEN], p[P_CMAX]) * rate
     return f if f > 0.0 else 0.0
 
 
@@ -216,13 +241,14 @@ def _qs_ball(kk, rel, reld, dtot, dtot_rate, p, dint, dflt, hbuf, gbuf):
     e = p[P_EXP]
     cser = 0.5 * p[P_CMAX]  # two equal dampers in series
     dpen = p[P_DPEN]
+    rolling = p[P_DRATE] > 0.5
     h, dh = _interp_h(kk, rel, dint, dflt, hbuf)
     pen = dtot - h
-    pen_rate = dtot_rate - dh * reld
     if pen <= 0.0:
         return 0.0
     if dint[kk, D_KIND] == 0:
-        return impact(pen, pen_rate, p[P_KEFF], e, cser, dpen)
+        rate = dtot_rate - dh * reld if rolling else dtot_rate
+        return impact(pen, rate, p[P_KEFF], e, cser, dpen)
     # 2-D table on one contact, Hertz on the other: split the approach by bisection
     outer = dint[kk, D_RACE] % 2 == 0
     k_def = p[P_KO] if outer else p[P_KI]
@@ -257,7 +283,19 @@ def _qs_ball(kk, rel, reld, dtot, dtot_rate, p, dint, dflt, hbuf, gbuf):
             break
     rem = dtot - x
     q = k_oth * rem * math.sqrt(rem)
-    f = q + step_fn(pen, 0.0, 0.0, dpen, cser) * pen_rate
+    # damping on the pair's equivalent penetration: the table's G^(2/3) at the split plus
+    # the other contact's penetration (dtot on intact surface, as for a healthy ball)
+    g, dg_dd, dg_dpsi = _interp_g23(kk, rel, x, dint, dflt, gbuf)
+    rate = dtot_rate
+    if rolling:
+        # d/dt (g + dtot - x), the split x following the series balance
+        # K_def g^1.5 = K_oth (dtot - x)^1.5 (implicit differentiation)
+        c_def = 1.5 * k_def * math.sqrt(max(g, 0.0))
+        w_oth = 1.5 * k_oth * math.sqrt(rem)
+        den = c_def * dg_dd + w_oth
+        x_rate = (w_oth * dtot_rate - c_def * dg_dpsi * reld) / den if den > 0.0 else 0.0
+        rate = dtot_rate + (dg_dd - 1.0) * x_rate + dg_dpsi * reld
+    f = q + step_fn(g + rem, 0.0, 0.0, dpen, cser) * rate
     return f if f > 0.0 else 0.0
 
 

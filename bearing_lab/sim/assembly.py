@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 import math
+import time
 
 import numpy as np
 from scipy.optimize import brentq, root
@@ -39,6 +40,7 @@ class Assembly:
     load_zone_angle: float
     hertz_inner: object
     hertz_outer: object
+    table_time_s: float = 0.0
 
     @property
     def sensor_index(self) -> int:
@@ -58,39 +60,122 @@ def bearing_force(e, phis, k_eff, pd, exponent=1.5):
     return np.array([np.sum(q * c), np.sum(q * s)]), q
 
 
-def _solve_relative(target, phis, k_eff, pd, z, where):
-    """Relative ring displacement e with bearing_force(e) == target (force on the outer ring)."""
+def ball_contact_loads(e, phis, k_in, k_out, pd, body_force, exponent=1.5):
+    """Inner- and outer-contact loads (N) of each ball for relative ring displacement
+    e = inner - outer, each ball in radial equilibrium under ``body_force`` (N, outward;
+    the centrifugal force of its orbit minus the outward component of its weight):
+    ``Q_o = Q_i + body_force``.  With no body force this is the two contacts in series.
+
+    The ball's total approach ``T = e.u - pd/2`` splits into ``d_i + d_o``; ``d_o`` solves
+    ``K_o d_o^n - K_i (T - d_o)^n = body_force`` (increasing in ``d_o``), by Newton's
+    method kept inside a bracket.  A ball that cannot touch both races rests on one.
+    """
+    n = exponent
+    u = np.stack([np.cos(phis), np.sin(phis)])
+    T = e @ u - pd / 2
+    fb = np.broadcast_to(np.asarray(body_force, dtype=float), T.shape)
+    lo = (np.maximum(fb, 0.0) / k_out) ** (1 / n)          # Q_i = 0: on the outer race only
+    hi = T - (np.maximum(-fb, 0.0) / k_in) ** (1 / n)       # Q_o = 0: on the inner race only
+    both = hi > lo
+    x = np.where(both, 0.5 * (lo + hi), lo)
+    lo_b, hi_b = lo.copy(), hi.copy()
+    for _ in range(60):
+        di = np.maximum(T - x, 0.0)
+        do = np.maximum(x, 0.0)
+        f = k_out * do ** n - k_in * di ** n - fb
+        df = n * (k_out * do ** (n - 1) + k_in * di ** (n - 1))
+        lo_b = np.where(f < 0, x, lo_b)
+        hi_b = np.where(f > 0, x, hi_b)
+        step = np.where(df > 0, f / np.where(df > 0, df, 1.0), 0.0)
+        xn = x - step
+        out = (xn <= lo_b) | (xn >= hi_b)
+        xn = np.where(out, 0.5 * (lo_b + hi_b), xn)
+        if np.all(np.abs(xn - x)[both] <= 1e-15 + 1e-13 * np.abs(x[both])):
+            x = xn
+            break
+        x = np.where(both, xn, x)
+    q_in = np.where(both, k_in * np.maximum(T - x, 0.0) ** n, np.maximum(-fb, 0.0) * (T > 0))
+    q_out = np.where(both, k_out * np.maximum(x, 0.0) ** n, np.maximum(fb, 0.0))
+    # a ball touching neither race (negative approach) carries nothing
+    q_in = np.where((~both) & (fb < 0) & (T <= 0), 0.0, q_in)
+    return q_in, q_out
+
+
+def _ring_forces(e, phis, k_in, k_out, pd, body_force, exponent=1.5):
+    """(force on the inner ring, force on the outer ring, Q_i, Q_o) for displacement e."""
+    q_in, q_out = ball_contact_loads(e, phis, k_in, k_out, pd, body_force, exponent)
+    c, s = np.cos(phis), np.sin(phis)
+    return (-np.array([np.sum(q_in * c), np.sum(q_in * s)]),
+            np.array([np.sum(q_out * c), np.sum(q_out * s)]), q_in, q_out)
+
+
+def _solve_relative(target, force_of, scale, where):
+    """Relative ring displacement e with force_of(e) == target (N, 2-vector).
+
+    ``force_of(e)`` grows along e (a bearing pushed further carries more); ``scale`` (m)
+    brackets the search: e.g. the displacement that puts the whole load on one ball."""
     w = float(np.hypot(*target))
-    if w < 1e-9:
-        return np.zeros(2)
-    direction = target / w
-    # 1-D search along the load direction, then a 2-D polish (the load zone need not be symmetric)
+    direction = target / w if w > 1e-9 else np.array([0.0, -1.0])
+
     def along(a):
-        return bearing_force(a * direction, phis, k_eff, pd)[0] @ direction - w
-    hi = pd / 2 + (4.37 * w / (z * k_eff)) ** (2 / 3) * 4 + 1e-9
-    lo = min(pd / 2, 0.0) - 1e-6
+        return force_of(a * direction) @ direction - w
+    lo, hi = -abs(scale) - 1e-6, abs(scale) + 1e-9
+    while along(lo) > 0:
+        lo *= 2
+        if lo < -1e-2:
+            raise SceneError(f"{where}: no static equilibrium (the balls' own forces cannot be balanced)")
     while along(hi) < 0:
         hi *= 2
         if hi > 1e-2:
             raise SceneError(f"{where}: no static equilibrium (load {w:.3g} N too large for the bearing)")
     a = brentq(along, lo, hi, xtol=1e-16, rtol=1e-14)
-    sol = root(lambda e: (bearing_force(e, phis, k_eff, pd)[0] - target) / w, a * direction,
-               method="hybr", options={"xtol": 1e-14})
-    e = sol.x if sol.success else a * direction
-    return e
+    norm = max(w, 1.0)
+    sol = root(lambda e: (force_of(e) - target) / norm, a * direction, method="hybr",
+               options={"xtol": 1e-14})
+    return sol.x if sol.success else a * direction
 
 
-def static_equilibrium(scene: Scene, phi_c0: float, k_eff: float, *, exponent=1.5) -> dict:
-    """Static equilibrium of the rings (quasi-static balls, no defects).
+def _loaded_ring_positions(on, phases, z, phi_c0, forces_at, f_in, f_out, ks, km, scale):
+    """Ring positions (xi, xo stacked) with the loaded ring's spring unstressed, at
+    ``phases`` cage positions across one ball spacing."""
+    pos = []
+    for k in range(phases):
+        _, _, forces = forces_at(phi_c0 + 2 * math.pi * k / (phases * z))
+        if on == "outer":
+            # the mount unstressed: the balls hold the outer ring's load and weight
+            e = _solve_relative(-f_out, lambda e: forces(e)[1], scale, "load")
+            xi = (forces(e)[0] + f_in) / ks
+            pos.append(np.concatenate([xi, xi - e]))
+        else:
+            # the shaft spring unstressed: the balls hold the inner ring's load and weight
+            e = _solve_relative(f_in, lambda e: -forces(e)[0], scale, "load")
+            xo = (forces(e)[1] + f_out) / km
+            pos.append(np.concatenate([xo + e, xo]))
+    return pos
 
-    Returns ring positions, the support springs' rest positions and the
-    external forces on each ring (load + weight).
+
+def static_equilibrium(scene: Scene, phi_c0: float, k_in: float, k_out: float, *,
+                       ball_mass: float = 0.0, omega_cage: float = 0.0, exponent: float = 1.5,
+                       phases: int = 4) -> dict:
+    """Static equilibrium of the rings and balls at the start of a run (no defects).
+
+    Each ball is in radial equilibrium between its two contacts under its centrifugal
+    force ``m_b (d_m/2) omega_cage^2`` and weight (``ball_mass = 0``: massless balls, the
+    quasi-static fidelity), so the outer contact carries ``Q_o = Q_i + m_b (d_m/2)
+    omega_c^2 - m_b g sin(phi_j)``.
+
+    Load path "bearing": the loaded ring's support spring is preloaded so that it carries
+    no load on average over a ball spacing: its rest position is the mean of the ring's
+    equilibrium positions at ``phases`` cage positions (the ring moves with the number of
+    balls in the load zone), and the start (cage at ``phi_c0``) is the exact equilibrium
+    with that spring.  Load path "springs": both springs unstressed at the centre.
+
+    Returns ring positions, the springs' rest positions, the external forces on each ring
+    (load + weight), the ball loads at both contacts and their body forces.
     """
     d = scene.data
-    b = scene.bearing
-    z = b.n_balls
-    m_i, m_o, m_b = scene.masses()
-    phis = phi_c0 + 2 * math.pi * np.arange(z) / z
+    z = scene.bearing.n_balls
+    m_i, m_o, _ = scene.masses()
     g = d["gravity"]["g_m_s2"] if d["gravity"]["enabled"] else 0.0
     gvec = np.array([0.0, -g])
     load = d["load"]["radial_n"] * _unit(math.radians(d["load"]["direction_deg"]))
@@ -99,36 +184,47 @@ def static_equilibrium(scene: Scene, phi_c0: float, k_eff: float, *, exponent=1.
     ks = np.array([d["shaft"]["stiffness_x_n_m"], d["shaft"]["stiffness_y_n_m"]])
     km = np.array([d["mount"]["stiffness_x_n_m"], d["mount"]["stiffness_y_n_m"]])
     pd = scene.clearance
-    if d["load"]["path"] == "bearing":
-        if d["load"]["on"] == "outer":
-            e = _solve_relative(-f_out, phis, k_eff, pd, z, "load")
-            fb, q = bearing_force(e, phis, k_eff, pd)
-            xi = (-fb + f_in) / ks
-            xo = xi - e
-            rest_i, rest_o = np.zeros(2), xo.copy()
-        else:
-            e = _solve_relative(f_in, phis, k_eff, pd, z, "load")
-            fb, q = bearing_force(e, phis, k_eff, pd)
-            xo = (fb + f_out) / km
-            xi = xo + e
-            rest_i, rest_o = xi.copy(), np.zeros(2)
-    else:
-        rest_i, rest_o = np.zeros(2), np.zeros(2)
+    k_eff = series_stiffness(k_in, k_out)
+    scale = pd / 2 + (max(float(np.hypot(*load)), 1.0) / k_eff) ** (1 / exponent) * 4
 
-        def resid(x):
-            xi, xo = x[:2], x[2:]
-            fb, _ = bearing_force(xi - xo, phis, k_eff, pd)
-            r_i = -fb + f_in - ks * xi
-            r_o = fb + f_out - km * xo
-            return np.concatenate([r_i, r_o]) / max(1.0, d["load"]["radial_n"])
-        x0 = np.concatenate([f_in / ks, f_out / km])
-        sol = root(resid, x0, method="hybr", options={"xtol": 1e-14})
-        if not sol.success or np.max(np.abs(resid(sol.x))) > 1e-6:
-            raise SolverError(f"scene {scene.name!r}: static equilibrium not found ({sol.message})")
-        xi, xo = sol.x[:2], sol.x[2:]
-        fb, q = bearing_force(xi - xo, phis, k_eff, pd)
+    def forces_at(phi0):
+        phis = phi0 + 2 * math.pi * np.arange(z) / z
+        body = ball_mass * (scene.bearing.pitch_diameter / 2 * omega_cage ** 2 - g * np.sin(phis))
+        return phis, body, lambda e: _ring_forces(e, phis, k_in, k_out, pd, body, exponent)
+
+    rest_i, rest_o = np.zeros(2), np.zeros(2)
+    x0 = np.concatenate([f_in / ks, f_out / km])
+    if d["load"]["path"] == "bearing":
+        pos = _loaded_ring_positions(d["load"]["on"], phases, z, phi_c0, forces_at, f_in, f_out,
+                                     ks, km, scale)
+        x0 = pos[0]
+        if d["load"]["on"] == "outer":
+            rest_o = np.mean(pos, axis=0)[2:]
+        else:
+            rest_i = np.mean(pos, axis=0)[:2]
+    phis, body, forces = forces_at(phi_c0)
+
+    def rings(e):
+        # each ring where its spring balances the balls' force and its external force
+        fi, fo, _, _ = forces(e)
+        return rest_i + (fi + f_in) / ks, rest_o + (fo + f_out) / km
+
+    def resid(e):
+        xi, xo = rings(e)
+        return (xi - xo - e) / scale
+    e0 = x0[:2] - x0[2:]
+    sol = root(resid, e0, method="hybr", options={"xtol": 1e-15})
+    xi, xo = rings(sol.x)
+    fi, fo, _, _ = forces(xi - xo)
+    unbalanced = max(np.max(np.abs(fi + f_in - ks * (xi - rest_i))),
+                     np.max(np.abs(fo + f_out - km * (xo - rest_o))))
+    if not np.all(np.isfinite(sol.x)) or np.max(np.abs(resid(sol.x))) > 1e-9:
+        raise SolverError(f"scene {scene.name!r}: static equilibrium not found ({sol.message}; "
+                          f"unbalanced force {unbalanced:.3g} N)")
+    _, _, q_in, q_out = forces(xi - xo)
     return {"xi": xi, "xo": xo, "rest_i": rest_i, "rest_o": rest_o, "f_in": f_in, "f_out": f_out,
-            "ball_loads": q, "phis": phis, "load_vec": load, "gvec": gvec}
+            "ball_loads": q_out, "ball_loads_inner": q_in, "ball_loads_outer": q_out,
+            "ball_body_force": body, "phis": phis, "load_vec": load, "gvec": gvec}
 
 
 def load_zone_angle(scene: Scene) -> float:
@@ -142,21 +238,20 @@ def load_zone_angle(scene: Scene) -> float:
 def choose_contact_model(defect, requested: str, bearing) -> str:
     """The defect-contact model for this defect.
 
-    "auto" takes "area" (2-D, with loss of contact area) for every defect: measured on the
-    paper's scenes (benchmarks/defect_models.py, README), the cheaper models are not exact
-    even where one might expect it.  For the full-width slot the along-track "profile" model
-    (a rigid ball meeting the slot's edge lines) overstates the peak acceleration by ~70 %,
-    because the contact patch is 0.3 mm long along the track against a 1 mm slot; for narrow,
-    offset or skewed defects "profile" and "drop" are off by factors.  All three cost the same
-    in the time loop (one table lookup); only the table build differs (0.05-1 s).  The cheaper
-    models stay selectable with ``contact_model = "profile"`` or ``"drop"``.
+    "auto" takes "halfspace" (the elastic half-space, the reference) for every defect.
+    The cheaper models were measured against it on the paper's scenes
+    (``benchmarks/defect_models.py``; ``benchmarks/README.md``) and none stays within 1 %
+    of its peak acceleration there; they cost the same in the time loop (one table lookup),
+    and the half-space table costs a few tenths of a second once, then comes from the
+    cache.  They stay selectable with ``contact_model = "area"``, ``"drop"`` or
+    ``"profile"``.
     """
     if requested and requested != "auto":
         if requested not in ("profile", "drop", "area", "halfspace"):
             raise SceneError(f"defect.contact_model={requested!r}; allowed values are "
                              "'auto', 'profile', 'drop', 'area' and 'halfspace'")
         return requested
-    return "area"
+    return "halfspace"
 
 
 def assemble(scene: Scene, *, fidelity: str | None = None) -> Assembly:
@@ -179,7 +274,11 @@ def assemble(scene: Scene, *, fidelity: str | None = None) -> Assembly:
     lz = load_zone_angle(scene)
     # cage angle at t = 0: a ball centred in the load zone (the symmetric start)
     phi_c0 = lz
-    st = static_equilibrium(scene, phi_c0, k_eff, exponent=d["contact"]["exponent"])
+    _, rpm0 = scene.speed_profile()
+    omega_c0 = ftf * rpm0[0] * 2 * math.pi / 60
+    st = static_equilibrium(scene, phi_c0, hi.stiffness, ho.stiffness,
+                            ball_mass=0.0 if fid == "quasi-static" else m_b, omega_cage=omega_c0,
+                            exponent=d["contact"]["exponent"])
 
     # speed profile (rad/s), shaft angle at the nodes
     sp_t, rpm = scene.speed_profile()
@@ -228,8 +327,11 @@ def assemble(scene: Scene, *, fidelity: str | None = None) -> Assembly:
     dflt = np.zeros((n_e, 7))
     hparts, gparts = [], []
     hoff = goff = 0
+    t_tables = time.perf_counter()
+    material = (E, nu)
     for kk, (code, dfc, psi0, ball, model) in enumerate(entries):
-        tab = contact_table(dfc, b, model=model, clearance=scene.clearance, delta_max=delta_max)
+        tab = contact_table(dfc, b, model=model, clearance=scene.clearance, delta_max=delta_max,
+                            material=material)
         tables.append(tab)
         psi = np.asarray(tab.psi, dtype=float)
         kind = 1 if model in ("area", "halfspace") else 0
@@ -243,6 +345,7 @@ def assemble(scene: Scene, *, fidelity: str | None = None) -> Assembly:
         gparts.append(G.ravel() if kind == 1 else np.zeros(0))
         hoff += len(h)
         goff += gparts[-1].size
+    table_time = time.perf_counter() - t_tables
     hbuf = np.concatenate(hparts) if hparts else np.zeros(1)
     gbuf = np.concatenate(gparts) if gparts and goff else np.zeros(1)
 
@@ -254,6 +357,7 @@ def assemble(scene: Scene, *, fidelity: str | None = None) -> Assembly:
     p[K.P_CMAX] = d["contact"]["damping_n_s_m"]
     p[K.P_DPEN] = d["contact"]["penetration_um"] * 1e-6
     p[K.P_EXP] = d["contact"]["exponent"]
+    p[K.P_DRATE] = 1.0 if d["contact"]["defect_damping"] == "penetration_rate" else 0.0
     p[K.P_MI], p[K.P_MO], p[K.P_MB] = m_i, m_o, m_b
     p[K.P_KSX], p[K.P_KSY] = d["shaft"]["stiffness_x_n_m"], d["shaft"]["stiffness_y_n_m"]
     p[K.P_CSX], p[K.P_CSY] = d["shaft"]["damping_x_n_s_m"], d["shaft"]["damping_y_n_s_m"]
@@ -346,4 +450,4 @@ def assemble(scene: Scene, *, fidelity: str | None = None) -> Assembly:
         atol[sb + 2:sb + 4] = v_scale
     return Assembly(scene, p, np.ascontiguousarray(sp_t, dtype=float), np.ascontiguousarray(sp_w),
                     np.ascontiguousarray(sp_th), dint, dflt, hbuf, gbuf, y0, atol, z, fid,
-                    tuple(models), tuple(tables), st, lz, hi, ho)
+                    tuple(models), tuple(tables), st, lz, hi, ho, table_time)

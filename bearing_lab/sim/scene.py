@@ -182,6 +182,11 @@ SCHEMA: dict[str, dict[str, tuple]] = {
         "damping_n_s_m": (350.0, _NUM, "nonneg", "IMPACT c_max (paper: 350 N s/m)"),
         "penetration_um": (1.0, _NUM, "pos", "IMPACT d: penetration at which full damping applies"),
         "exponent": (1.5, _NUM, "pos", "IMPACT exponent e (Hertz point contact: 1.5)"),
+        "defect_damping": ("approach", str, ("approach", "penetration_rate"),
+                           "rate the IMPACT damping multiplies over a defect: approach = the bodies' "
+                           "approach rate (as Adams' IMPACT); penetration_rate = the rate of the defect "
+                           "law's equivalent penetration, which adds its change as the ball rolls over "
+                           "the outline (docs/contact-model.md)"),
     },
     "cage": {
         "model": ("kinematic", str, ("kinematic", "dynamic"),

@@ -49,7 +49,11 @@ def test_paper_case_writes_the_contract_files(paper_reports):
     assert rows["healthy: shaft_hz"]["experiment"] == 29.69 and rows["healthy: bpfo"]["experiment"] == 95.31
     # these rows can fail, and do: the paper's healthy BPFO is 3.4 % above kinematics; the model has no BPFI source
     assert not rows["healthy: bpfo"]["pass"] and rows["healthy: bpfo"]["status"] == "known limitation"
-    assert not rows["healthy: bpfi"]["pass"] and "missing value" in rows["healthy: bpfi"]["note"]
+    # no BPFI source: either no line at all, or (a noise-free record's floor is so low that a
+    # few-dB ripple near 145 Hz can pass the family search) a line far outside the tolerance
+    bpfi = rows["healthy: bpfi"]
+    assert not bpfi["pass"] and bpfi["status"] == "known limitation"
+    assert "missing value" in bpfi["note"] or abs(bpfi["difference_pct"]) > 2 * bpfi["tolerance_pct"]
     assert "slot: peak_model" in rows and rows["slot: peak_model"]["experiment"] == 60.0 * 9.80665
     assert status == (0 if all(r["pass"] for r in s["rows"]) else 1)
     assert "error" not in {o.status for o in outcomes}

@@ -2,7 +2,7 @@
 inner-race and ball defects at their kinematic frequencies, a defect off the track.
 
 Trends that depend on how the defect's edges meet the contact (amplitude against size and
-against skew) are reported by the study, not asserted (issue 7).
+against skew) are reported by the study, not asserted.
 """
 import math
 
@@ -35,11 +35,22 @@ def studies(tmp_path_factory):
 
 def test_study_outputs_written(studies):
     out, _ = studies
-    for name in ("size", "offset", "skew", "speed", "mechanism"):
+    for name in ("size", "offset", "skew", "speed", "slot", "mechanism"):
         assert (out / f"{name}.png").stat().st_size > 10_000
     assert (out / "studies.nc").is_file()
     html = (out / "index.html").read_text()
     assert "data:image/png;base64" in html and "paper: 1.00, 0.78, 0.54" in html
+    assert "exit edge" in html and "No value is picked" in html
+
+
+def test_slot_amplitude_depends_on_how_the_edge_impact_is_damped(studies):
+    """Reported, not tuned: the slot's peak acceleration moves by a large factor with the
+    damping of the exit-edge impact (undamped far above the damped cases)."""
+    _, r = studies
+    peaks = {k[1]: x.peak_acceleration for k, x in r.items() if k[0] == "slot"}
+    assert len(peaks) == 5
+    assert peaks["approach, 0"] > 2 * peaks["approach, 350 N s/m"]
+    assert peaks["approach, 350 N s/m"] > peaks["approach, 700 N s/m"]
 
 
 def test_duration_grows_with_size(studies):
@@ -127,5 +138,12 @@ def test_two_defects_in_one_scene_double_the_impacts():
     peak, _, _ = _ses_peak(ds.outer_ring_acc_y.values, ds.attrs["sampling_rate_hz"], 50, 120)
     assert peak == pytest.approx(92.158, rel=5e-3)  # the family still sits at BPFO
     from tests.naive import impulse_times
-    t = impulse_times(ds.outer_ring_acc_y.values, ds.attrs["sampling_rate_hz"], 0.4, dead_time=0.0015)
+    # a ball meets the second defect (45 - 40) deg of cage travel after its neighbour met the
+    # first, 1.2 ms, while the rings still ring from that passage: its peak depends on the
+    # ringing's phase (1.8 g against 6.5 g with the half-space contact), so count impacts
+    # above 20 % of the largest
+    lag = math.radians(45.0 - 40.0) / (2 * math.pi * 92.158 / 8)
+    t = impulse_times(ds.outer_ring_acc_y.values, ds.attrs["sampling_rate_hz"], 0.2, dead_time=0.9 * lag)
     assert abs(len(t) - 2 * 92.158 * 0.2) <= 3
+    short = np.diff(t)[np.diff(t) < 0.5 / 92.158]
+    assert short.size >= 15 and np.median(short) == pytest.approx(lag, rel=0.1)

@@ -28,7 +28,7 @@ def test_contract_and_attributes(slot_half_second):
     ds = slot_half_second
     check_dataset(ds, kind="simulation")
     assert ds.attrs["fidelity"] == "multibody"
-    assert ds.attrs["defect_contact_models"] == "area"
+    assert ds.attrs["defect_contact_models"] == "halfspace"
     assert ds.attrs["wall_time_s"] > 0 and ds.attrs["compile_time_s"] >= 0
 
 

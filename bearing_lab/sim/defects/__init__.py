@@ -9,9 +9,10 @@ ContactTable      -- the table: psi, delta, G, drop, intact_fraction, model, rac
 RaceGeometry      -- exact torus groove of one race and the ball-race gap function.
 CONTACT_MODELS    -- ("profile", "drop", "area", "halfspace").
 
-Modules: model (Defect), geometry (exact sphere-torus gap, rigid drop), contact (tables),
-halfspace (elastic half-space contact solver: the check of the local law, and the
-"halfspace" model).
+Modules: model (Defect), geometry (exact sphere-torus gap, rigid drop), contact (tables
+and the models), halfspace (elastic half-space contact solver behind the default
+"halfspace" model), _table_cache (the on-disk table cache), _halfspace_kernels (numba
+steps of the solver).
 """
 from .model import Defect
 from .geometry import RaceGeometry, rigid_drop

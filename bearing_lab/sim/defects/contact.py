@@ -1,9 +1,11 @@
 """Ball-race contact over a defect, tabulated once per defect: ``F = K_hertz * G(psi, delta)``.
 
 Why a table: the contact geometry (sphere against a torus with an outline removed) is
-exact but costs a 2-D integral; the time loop needs the force millions of times.  So the
-geometry is reduced, once per defect and outside the loop, to a function of two numbers,
-the ball's angular position over the defect and its approach, and the loop interpolates.
+exact but costs a 2-D contact solution; the time loop needs the force millions of times.
+So the contact is reduced, once per defect and outside the loop, to a function of two
+numbers, the ball's angular position over the defect and its approach, and the loop
+interpolates.  Tables are kept in memory and on disk (:mod:`._table_cache`), so a sweep,
+a validation run or a second session pays for a table once.
 
 Conventions (SI)
 ----------------
@@ -23,75 +25,53 @@ Conventions (SI)
 
 Models
 ------
-``"profile"``  along-track 1-D: the defect reduced to its intervals on the track centre
-    line, each made a full-width slot; ``G = max(delta - h1(psi), 0)^1.5`` with ``h1`` the
-    exact drop over the slot's edge lines (:func:`.geometry.drop_profile_1d`).  Exact for a
-    full-width slot; blind to offset (a defect off the centre line vanishes) and to skew.
+``"halfspace"`` (the default)  the load the defected raceway carries at a given approach
+    and ball position, from the elastic half-space (Boussinesq/Love influence,
+    Polonsky-Keer conjugate gradient on a DC-FFT grid, :mod:`.halfspace`) with the exact
+    sphere-in-torus gap and the outline removed, as a share of the intact half-space load
+    at the same approach: ``G = share * delta^1.5``.  Solved at ``HALFSPACE_NODES``
+    approaches (fractions of ``delta_max``) for ball positions a whole number of cells
+    apart (refined where the share curves), interpolated linearly onto the table's psi;
+    between approaches ``G^(2/3)`` is interpolated by a monotone cubic through (0, 0) and
+    (drop, 0).
+    For rectangles with sides along and across the track the cell sizes put the sides on
+    cell boundaries, and two grids (``TABLE_CELLS`` and half as many cells) are
+    extrapolated to zero cell size (Richardson; the error is first order in the cell
+    size).  Accuracy and build time: ``docs/contact-model.md``.
+``"area"``     2-D loss of contact area by a local (Winkler-type) law over the raceway
+    surface, ``dF = K c sqrt(max(delta - h(s, z), 0)) dA`` with ``h`` the exact gap of
+    :mod:`.geometry` to the remaining surface, ``c = 3 / (4 pi sqrt(R_x R_y))`` so that the
+    paraboloid gives ``K delta^1.5``; the table divides the defected integral by the intact
+    one on the same lattice (``G = delta^1.5`` exactly on intact surface).  Its footprint is
+    the rigid interpenetration region ``{h < delta}``, about 1.4 times longer and wider than
+    the elastic contact, and no load moves to the intact flanks: it removes too much load
+    over too long a stretch of track.
 ``"drop"``     rigid 2-D drop: ``G = max(delta - h2(psi), 0)^1.5`` with ``h2`` the exact 3-D
     drop (:func:`.geometry.drop_profile_2d`); the contact keeps its intact stiffness.
-``"area"``     2-D loss of contact area.  A local (Winkler-type) law over the raceway
-    surface, ``dF = K c sqrt(max(delta - h(s, z), 0)) dA`` with ``h`` the exact gap of
-    :mod:`.geometry` to the remaining surface (intact groove outside the outline, the floor
-    inside it).  On the intact paraboloid gap ``s^2/2R_x + z^2/2R_y`` the integral is
-    ``(4 pi / 3) sqrt(R_x R_y) delta^1.5``, so ``c = 3 / (4 pi sqrt(R_x R_y))`` gives exactly
-    ``K delta^1.5``.  With the exact torus gap the raw law falls below that by 0.12 %/µm
-    (outer race; 0.18 %/µm inner): -1.0 % at 8 µm, -2.4 % at 20 µm, because the exact gap
-    grows faster than Hertz's paraboloid (``+z^4/8 (1/r_b^3 - 1/r_g^3)`` across the track;
-    the half-space solver sees the same effect at a third of the size); the lattice itself
-    is exact to 0.5 % on the paraboloid (``info["intact_law_ratio"]``, tests).  The table
-    divides the defected integral by the intact one computed on the same lattice, so
-    ``G = delta^1.5`` exactly on intact surface (consistent with the simulator's K delta^1.5)
-    and discretisation errors cancel to first order.  Edge contact (the ball riding on
-    the length edges of a long defect: a flat section of G), the offset effect (part of the
-    ellipse left on intact surface) and the gradual entry of a skewed edge all come out of
-    ``h``; nothing is special-cased.
+``"profile"``  along-track 1-D: the defect reduced to its intervals on the track centre
+    line, each made a full-width slot; ``G = max(delta - h1(psi), 0)^1.5`` with ``h1`` the
+    exact drop over the slot's edge lines (:func:`.geometry.drop_profile_1d`).  Blind to
+    offset (a defect off the centre line vanishes) and to skew.
 
-``"halfspace"`` the same exact gap, but the load from an elastic half-space solution
-    (Boussinesq/Love influence, Polonsky-Keer conjugate gradient, :mod:`.halfspace`)
-    computed on coarse nodes: approaches ``HALFSPACE_NODES * delta_max`` and ball positions
-    every 2 cells (ball-centred grid of 64 x 48 cells over {h < delta}); the share of the
-    intact force is interpolated linearly in psi, and ``G^(2/3)`` linearly in delta through
-    (0, 0) and (drop, 0).  The elastic body carries on the intact flanks much of the load a
-    local law removes: it is the reference for the other models, at 1-6 s per table
-    (the area model: 0.02-0.3 s).  Grid accuracy: about 2-3 % on the carried share.
-
-How far the local law is from the half-space (6308 outer race, centred 1 x 1 mm defect,
-share of the intact force still carried; fine half-space grid 0.0125 x 0.004 mm):
-
-=====================  =========  ==========  =========  ==========
-ball at s (mm)         4.38 µm (300 N intact)  8 µm (738 N intact)
----------------------  ---------------------  ---------------------
-                       local law  half-space  local law  half-space
-=====================  =========  ==========  =========  ==========
-0 (centred)            0.350      0.553       0.499      0.708
-0.3                    0.404      0.618       0.589      0.794
-0.5 (edge)             0.676      0.903       0.749      0.930
-0.6                    0.823      0.986       0.833      0.977
-0.7                    0.947      1.000       0.910      1.000
-=====================  =========  ==========  =========  ==========
-
-So the local law removes 1.45 x (300 N) and 1.7 x (8 µm) the load the half-space removes
-with the ball centred, and feels the defect over a longer stretch of track (its footprint
-is the interpenetration region, sqrt(2) wider than the Hertz ellipse).  At 8 µm and psi =
-0 the carried share for O1 at H = 0, B/3, B/2 is 0.499, 0.530, 0.565 (area) and 0.705,
-0.724, 0.747 (halfspace); the rigid drop model gives 0.829, 0.980, 1.000.
+How far the cheaper models are from the half-space on the paper's defects, as tables and
+in the dynamics, is measured by ``benchmarks/defect_tables.py`` and
+``benchmarks/defect_models.py`` (figures in ``benchmarks/README.md``).
 
 Discretisation of "area"
 ------------------------
 A lattice on the track, cells ``ds x dz``; ``ds = psi step * R / m`` with integer ``m`` so
 the ball-centred window slides by whole cells; each cell carries the fraction of it inside
 the outline (4 x 4 sub-samples), so G is smooth in psi.  The sum over the window is a
-correlation evaluated as ``2 n_b + 1`` small matrix products.
+correlation evaluated by FFT along the track.
 
 The ``intact_fraction`` is geometric and the same for every model: the share of the intact
 Hertz contact ellipse at that approach (semi-axes from :func:`.geometry.hertz_semi_axes`,
 0.90 x 0.16 mm at 300 N on the 6308 outer race) that lies outside the outline (1 at
-delta = 0).  ``info["interpenetration_fraction"]`` is the same for the local law's
-footprint ``{h_intact < delta}``.
+delta = 0).
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 import math
 import time
 
@@ -104,10 +84,13 @@ from .model import Defect
 
 CONTACT_MODELS = ("profile", "drop", "area", "halfspace")
 #: approach nodes of the "halfspace" model, as fractions of delta_max
-HALFSPACE_NODES = (0.1, 0.2, 0.35, 0.5, 0.7, 1.0)
+HALFSPACE_NODES = (0.05, 0.1, 0.16, 0.25, 0.35, 0.5, 0.7, 1.0)
+#: Young's modulus and Poisson ratio the tables assume unless told (52100 steel)
+DEFAULT_MATERIAL = (208e9, 0.3)
 _SUB = 4            # sub-samples per cell side for the outline coverage
-_CELLS_ALONG = 60   # lattice cells per along-track reach at delta_max
-_CELLS_ACROSS = 60  # lattice cells per across-track reach at delta_max
+_CELLS_ALONG = 60   # lattice cells per along-track reach at delta_max ("area")
+_CELLS_ACROSS = 60  # lattice cells per across-track reach at delta_max ("area")
+_FRACTION_CELLS = 24  # lattice cells per reach for the intact fraction of the other models
 _PSI_PER_REACH = 40  # psi grid points per along-track reach at delta_max (auto n_psi)
 
 
@@ -261,10 +244,6 @@ def _coverage(defect: Defect, s_cells: np.ndarray, z_cells: np.ndarray, ds: floa
     return f
 
 
-_CACHE: dict = {}
-_CACHE_SIZE = 64
-
-
 def _correlate(f: np.ndarray, kern: np.ndarray, m: int, n_psi: int) -> np.ndarray:
     """out[j, d] = sum_{k, l} f[j m + k, l] kern[k, l, d], by FFT along the track.
 
@@ -294,21 +273,25 @@ def _correlate(f: np.ndarray, kern: np.ndarray, m: int, n_psi: int) -> np.ndarra
 
 def contact_table(defect: Defect, bearing, *, model: str, clearance: float = 0.0,
                   delta_max: float, n_psi: int | None = None, n_delta: int = 41,
-                  against: str | None = None) -> ContactTable:
+                  against: str | None = None, material: tuple[float, float] | None = None,
+                  cache: bool = True) -> ContactTable:
     """Tabulate the contact of a ball with the defected race (see the module docstring).
 
-    Tables are cached in-process by their arguments (a defect's ``angle`` does not enter
-    the table, so the same outline at several positions or speeds is built once); the
-    returned arrays are read-only.
+    Tables are kept in memory (a defect's ``angle`` does not enter the table, so the same
+    outline at several positions or speeds is built once) and, with ``cache=True``, on
+    disk under :func:`bearing_lab._files.cache_dir` ``("tables")``, keyed by everything
+    the table depends on; a damaged disk entry is reported and rebuilt.  The returned
+    arrays are read-only; ``info["source"]`` says where the table came from ("built",
+    "memory", "disk").
 
     Parameters
     ----------
-    defect : Defect on the "outer" or "inner" race.
+    defect : Defect on the "outer" or "inner" race, or on a ball (see ``against``).
     bearing : BearingGeometry.
-    model : "profile", "drop", "area" or "halfspace".
+    model : "halfspace", "area", "drop" or "profile".
     clearance : diametral clearance, m (moves the groove bottoms by clearance/4).
     delta_max : largest approach to tabulate, m (e.g. 2-3 x the static deflection of the
-        most loaded ball; 20e-6 for the 6308 at 480 N).
+        most loaded ball; 12e-6 for the 6308 at 480 N).
     n_psi : psi grid size; default: about 40 points per along-track contact reach.
     n_delta : delta grid size (default 41).
     against : for a ball defect only, the race it strikes, "outer" or "inner" (build one
@@ -316,35 +299,43 @@ def contact_table(defect: Defect, bearing, *, model: str, clearance: float = 0.0
         ball relative to the defect centre (arc ``ball_radius * psi``), and the outline is
         laid on the contact plane to first order (ball arc = race arc); the floor gap is the
         race's (intact gap + depth to first order).
+    material : (Young's modulus Pa, Poisson ratio) of ball and race; default 208 GPa, 0.3.
+        G does not depend on it (the half-space share is a ratio); the intact half-space
+        force reported in ``info`` does.
+    cache : use the on-disk table cache (default True).
+
+    Returns
+    -------
+    ContactTable
     """
-    key = (_defect_key(defect), bearing, model, float(clearance), float(delta_max), n_psi, n_delta,
-           against)
-    try:
-        hit = _CACHE.get(key)
-    except TypeError:       # unhashable bearing: no cache
-        key, hit = None, None
+    from . import _table_cache
+    material = DEFAULT_MATERIAL if material is None else (float(material[0]), float(material[1]))
+    args = dict(model=model, clearance=float(clearance), delta_max=float(delta_max), n_psi=n_psi,
+                n_delta=int(n_delta), against=against, material=material)
+    _check_arguments(defect, **args)
+    key = _table_cache.table_key(replace(defect, angle=0.0), bearing, **args)
+    hit = _MEMORY.get(key)
     if hit is not None:
         return hit
-    table = _build(defect, bearing, model=model, clearance=clearance, delta_max=delta_max,
-                   n_psi=n_psi, n_delta=n_delta, against=against)
+    table = _table_cache.load(key, model) if cache else None
+    if table is None:
+        table = _build(defect, bearing, **args)
+        table.info["source"] = "built"
+        if cache:
+            _table_cache.store(key, table)
     for name in ("psi", "delta", "G", "drop", "intact_fraction"):
         getattr(table, name).flags.writeable = False
-    if key is not None:
-        if len(_CACHE) >= _CACHE_SIZE:
-            _CACHE.pop(next(iter(_CACHE)))
-        _CACHE[key] = table
+    if len(_MEMORY) >= _MEMORY_SIZE:
+        _MEMORY.pop(next(iter(_MEMORY)))
+    _MEMORY[key] = table
     return table
 
 
-def _defect_key(defect: Defect):
-    from dataclasses import replace
-    return replace(defect, angle=0.0)
+_MEMORY: dict = {}
+_MEMORY_SIZE = 64
 
 
-def _build(defect, bearing, *, model, clearance, delta_max, n_psi, n_delta,
-           against=None) -> ContactTable:
-    t0 = time.perf_counter()
-    c0 = time.process_time()
+def _check_arguments(defect, *, model, clearance, delta_max, n_psi, n_delta, against, material):
     if model not in CONTACT_MODELS:
         raise SceneError(f"Invalid value for the 'model' parameter. Allowed values are "
                          f"{', '.join(map(repr, CONTACT_MODELS))}, but got {model!r} instead.")
@@ -354,132 +345,182 @@ def _build(defect, bearing, *, model, clearance, delta_max, n_psi, n_delta,
         raise SceneError(f"{n_delta=} must be at least 3")
     if n_psi is not None and n_psi < 8:
         raise SceneError(f"{n_psi=} must be at least 8")
+    E, nu = material
+    if not (math.isfinite(E) and E > 0 and 0 <= nu < 0.5):
+        raise SceneError(f"material={material!r}: give (Young's modulus in Pa > 0, "
+                         "Poisson ratio in [0, 0.5))")
     if defect.race == "ball":
         if against not in ("outer", "inner"):
             raise SceneError(f"a ball defect needs against='outer' or 'inner' (the race it "
                              f"strikes), got {against!r}")
-        geom = RaceGeometry.from_bearing(bearing, against, clearance=clearance)
-        R = geom.ball_radius          # psi is measured on the ball
-    else:
-        if against not in (None, defect.race):
-            raise SceneError(f"against={against!r} is only for ball defects "
-                             f"(this defect is on the {defect.race} race)")
-        geom = RaceGeometry.from_bearing(bearing, defect.race, clearance=clearance)
-        R = geom.track_radius
-    Rg = geom.track_radius
+    elif against not in (None, defect.race):
+        raise SceneError(f"against={against!r} is only for ball defects "
+                         f"(this defect is on the {defect.race} race)")
+
+
+def _build(defect, bearing, *, model, clearance, delta_max, n_psi, n_delta, against=None,
+           material=DEFAULT_MATERIAL, halfspace_settings=None) -> ContactTable:
+    t0 = time.perf_counter()
+    c0 = time.process_time()
+    _check_arguments(defect, model=model, clearance=clearance, delta_max=delta_max, n_psi=n_psi,
+                     n_delta=n_delta, against=against, material=material)
+    race = defect.race if defect.race != "ball" else against
+    geom = RaceGeometry.from_bearing(bearing, race, clearance=clearance)
+    # psi is measured on the defected body: the ball for a ball defect
+    R = geom.ball_radius if defect.race == "ball" else geom.track_radius
     b_reach, a_reach = geom.reach(delta_max)
     if a_reach >= 0.9 * geom.z_limit:
         raise SceneError(f"{delta_max=} m: the contact would reach the groove's edge; "
                          "give a smaller delta_max")
-    b_w, a_w = 1.05 * b_reach, 1.05 * a_reach
-    ext = _interacting_s_extent(defect, a_w)
+    ext = _interacting_s_extent(defect, 1.05 * a_reach)
     misses = ext is None
     if misses:
         s0, s1, _, _ = defect.track_extent()
         ext = (s0, s1)
-    margin = 0.1 * b_reach
-    s_lo, s_hi = ext[0] - b_w - margin, ext[1] + b_w + margin
+    s_lo = ext[0] - 1.15 * b_reach
+    s_hi = ext[1] + 1.15 * b_reach
     if n_psi is None:
         n_psi = int(min(max(math.ceil((s_hi - s_lo) / (b_reach / _PSI_PER_REACH)) + 1, 64), 8001))
     psi = np.linspace(s_lo / R, s_hi / R, n_psi)
-    dpsi = psi[1] - psi[0]
     delta = np.linspace(0.0, delta_max, n_delta)
-
-    # ---- geometric drops (exact, no lattice)
     drop2 = drop_profile_2d(defect, geom, psi, psi_radius=R)
-    if model == "profile":
-        drop = drop_profile_1d(defect, geom, psi, psi_radius=R)
+    drop = drop_profile_1d(defect, geom, psi, psi_radius=R) if model == "profile" else drop2
+    cells = (_CELLS_ALONG, _CELLS_ACROSS) if model == "area" else (_FRACTION_CELLS,) * 2
+    lat = _lattice(defect, geom, psi, R, delta, cells=cells, area_law=model == "area")
+    info = {"reach_along_m": b_reach, "reach_across_m": a_reach, "misses_track": misses,
+            "drop_2d": drop2, **lat["info"]}
+    if model == "halfspace":
+        E, nu = material
+        G, info_hs = _halfspace_G(defect, geom, psi * R, delta, drop2, e_star=E / (2 * (1 - nu * nu)),
+                                  misses=misses, settings=halfspace_settings)
+        info.update(info_hs)
+    elif model == "area":
+        G = lat["G"]
     else:
-        drop = drop2
+        G = np.maximum(delta[None, :] - drop[:, None], 0.0) ** 1.5
+    G[:, 0] = 0.0
+    info["build_time_s"] = time.perf_counter() - t0
+    info["build_cpu_s"] = time.process_time() - c0
+    label = defect.race if defect.race != "ball" else f"ball/{against}"
+    return ContactTable(psi=psi, delta=delta, G=G, drop=drop, intact_fraction=lat["intact_fraction"],
+                        model=model, race=label, psi_min=float(psi[0]), psi_max=float(psi[-1]),
+                        track_radius=R, info=info)
 
-    # ---- lattice: coverage and the intact/floor gap over the ball-centred window
-    m = max(1, math.ceil(dpsi * R / (b_reach / _CELLS_ALONG)))
+
+def _lattice(defect, geom, psi, R, delta, *, cells, area_law):
+    """Ball-centred lattice over the track: the intact share of the Hertz ellipse, the
+    interpenetration region's, and (``area_law``) the local law's G.  See the module
+    docstring."""
+    n_psi, n_delta = psi.size, delta.size
+    dpsi = psi[1] - psi[0]
+    Rg = geom.track_radius
+    b_reach, a_reach = geom.reach(delta[-1])
+    b_w, a_w = 1.05 * b_reach, 1.05 * a_reach
+    m = max(1, math.ceil(dpsi * R / (b_reach / cells[0])))
     ds = dpsi * R / m
     nb = math.ceil(b_w / ds)
-    dz = a_reach / _CELLS_ACROSS
+    dz = a_reach / cells[1]
     nzh = math.ceil(a_w / dz)
     z = (np.arange(2 * nzh) - nzh + 0.5) * dz
     srel = np.arange(-nb, nb + 1) * ds
     h0 = geom.approach(srel[:, None] / Rg, z[None, :])
-    hf = geom.approach(srel[:, None] / Rg, z[None, :], depth=defect.depth)
     n_glob = (n_psi - 1) * m + 2 * nb + 1
     s_glob = psi[0] * R + (np.arange(n_glob) - nb) * ds
     f = _coverage(defect, s_glob, z, ds, dz)
-
     d = delta[None, None, :]
-    ind0 = (h0[:, :, None] < d).astype(float)              # (2nb+1, nz, n_delta)
-    area0 = ind0.sum(axis=(0, 1))
     a_h, b_h = hertz_semi_axes(geom, delta)
     with np.errstate(invalid="ignore", divide="ignore"):
         indh = ((srel[:, None, None] / b_h[None, None, :]) ** 2
                 + (z[None, :, None] / a_h[None, None, :]) ** 2 < 1.0).astype(float)
     indh[:, :, delta <= 0] = 0.0
     areah = indh.sum(axis=(0, 1))
-    need_area = model == "area"
-    if need_area:
+    kernels = [indh]
+    if area_law:
+        ind0 = (h0[:, :, None] < d).astype(float)              # (2nb+1, nz, n_delta)
+        hf = geom.approach(srel[:, None] / Rg, z[None, :], depth=defect.depth)
         w0 = np.sqrt(np.maximum(d - h0[:, :, None], 0.0))
         wf = np.sqrt(np.maximum(d - hf[:, :, None], 0.0))
         I0 = w0.sum(axis=(0, 1))
-        D = w0 - wf
-    kernels = [ind0, indh] + ([D] if need_area else [])
+        kernels += [ind0, w0 - wf]
     out = _correlate(f, np.concatenate(kernels, axis=2), m, n_psi)
-    frac_loss, hertz_loss = out[:, :n_delta], out[:, n_delta:2 * n_delta]
-    if need_area:
-        loss = out[:, 2 * n_delta:]
     with np.errstate(invalid="ignore", divide="ignore"):
-        pen_fraction = np.where(area0 > 0, 1.0 - frac_loss / np.where(area0 > 0, area0, 1.0), 1.0)
-        intact_fraction = np.where(areah > 0, 1.0 - hertz_loss / np.where(areah > 0, areah, 1.0), 1.0)
-    pen_fraction = np.clip(pen_fraction, 0.0, 1.0)
-    intact_fraction = np.clip(intact_fraction, 0.0, 1.0)
-
-    d15 = delta ** 1.5
-    if model == "halfspace":
-        from .halfspace import halfspace_ratio_nodes
-        nodes_d = np.array(HALFSPACE_NODES) * delta_max
-        nodes = halfspace_ratio_nodes(defect, geom, nodes_d)
-        s_tab = psi * R
-        # ratio on the table's psi, then G^(2/3) linear in delta between the nodes, through
-        # (0, 0) and (drop, 0): exact for both delta^1.5 scaling and a rigid drop
-        r = np.column_stack([np.interp(s_tab, sn, rn, left=1.0, right=1.0) for sn, rn in nodes])
-        g23 = (np.clip(r, 0, None) ** (2 / 3)) * nodes_d[None, :]
-        G = np.empty((n_psi, n_delta))
-        for j in range(n_psi):
-            xd = np.concatenate([[0.0], nodes_d])
-            yd = np.concatenate([[0.0], g23[j]])
-            if 0 < drop2[j] < delta_max:
-                keep = xd > drop2[j]
-                xd = np.concatenate([[0.0, drop2[j]], xd[keep]])
-                yd = np.concatenate([[0.0, 0.0], yd[keep]])
-            elif drop2[j] >= delta_max:
-                xd, yd = np.array([0.0, delta_max]), np.array([0.0, 0.0])
-            G[j] = np.interp(delta, xd, yd) ** 1.5
-        far = np.all(r == 1.0, axis=1)
-        G[far] = d15[None, :]
-        law = None
-        info_hs = {"halfspace_delta_nodes": nodes_d, "halfspace_ratio": r}
-    elif model == "area":
+        intact = np.where(areah > 0, 1.0 - out[:, :n_delta] / np.where(areah > 0, areah, 1.0), 1.0)
+    res = {"intact_fraction": np.clip(intact, 0.0, 1.0), "G": None,
+           "info": {"lattice_ds_m": ds, "lattice_dz_m": dz, "lattice_window": (2 * nb + 1, 2 * nzh),
+                    "psi_substeps": m, "hertz_semi_axes_m": (a_h, b_h)}}
+    if area_law:
+        area0 = ind0.sum(axis=(0, 1))
+        loss = out[:, 2 * n_delta:]
         with np.errstate(invalid="ignore", divide="ignore"):
+            pen = np.where(area0 > 0, 1.0 - out[:, n_delta:2 * n_delta] / np.where(area0 > 0, area0, 1.0), 1.0)
             ratio = np.where(I0 > 0, (I0 - loss) / np.where(I0 > 0, I0, 1.0), 1.0)
-        G = np.clip(ratio, 0.0, None) * d15[None, :]
+        d15 = delta ** 1.5
+        res["G"] = np.clip(ratio, 0.0, None) * d15[None, :]
         c = 3.0 / (4.0 * math.pi * math.sqrt(geom.rx * geom.ry))
         with np.errstate(invalid="ignore", divide="ignore"):
             law = np.where(d15 > 0, c * I0 * ds * dz / np.where(d15 > 0, d15, 1.0), np.nan)
-    else:
-        G = np.maximum(delta[None, :] - drop[:, None], 0.0) ** 1.5
-        law = None
-    G[:, 0] = 0.0
-    info = {
-        "build_time_s": time.perf_counter() - t0, "build_cpu_s": time.process_time() - c0,
-        "lattice_ds_m": ds, "lattice_dz_m": dz, "lattice_window": (2 * nb + 1, 2 * nzh),
-        "psi_substeps": m, "reach_along_m": b_reach, "reach_across_m": a_reach,
-        "misses_track": misses, "drop_2d": drop2, "interpenetration_fraction": pen_fraction,
-        "hertz_semi_axes_m": (a_h, b_h),
-    }
-    if law is not None:
-        info["intact_law_ratio"] = law
-    if model == "halfspace":
-        info.update(info_hs)
-    race = defect.race if defect.race != "ball" else f"ball/{against}"
-    return ContactTable(psi=psi, delta=delta, G=G, drop=drop, intact_fraction=intact_fraction,
-                        model=model, race=race, psi_min=float(psi[0]),
-                        psi_max=float(psi[-1]), track_radius=R, info=info)
+        res["info"]["intact_law_ratio"] = law
+        res["info"]["interpenetration_fraction"] = np.clip(pen, 0.0, 1.0)
+    return res
+
+
+def _halfspace_G(defect, geom, s_tab, delta, drop, *, e_star, misses, settings=None):
+    """G of the "halfspace" model on the table's (s, delta) grid, and diagnostics.
+
+    ``settings`` (for convergence studies) overrides ``nodes`` (fractions of delta_max),
+    ``cells``, ``richardson`` and the keywords of :func:`.halfspace.ratio_curve`
+    (``tol``, ``refine_tol``, ``coarse_step``)."""
+    from .halfspace import TABLE_CELLS, aligned_sides, ratio_curve
+    settings = dict(settings or {})
+    n_psi, n_delta = s_tab.size, delta.size
+    nodes_d = np.array(settings.pop("nodes", HALFSPACE_NODES)) * delta[-1]
+    cells = tuple(settings.pop("cells", TABLE_CELLS))
+    richardson = settings.pop("richardson", True) and aligned_sides(defect) is not None
+    info = {"halfspace_delta_nodes": nodes_d, "halfspace_cells": cells}
+    if misses:
+        info["halfspace_ratio"] = np.ones((n_psi, nodes_d.size))
+        return np.broadcast_to(delta ** 1.5, (n_psi, n_delta)).copy(), info
+    coarse = (cells[0] // 2, cells[1] // 2)
+    ratios, forces, axes, solves = [], [], [], 0
+    for dn in nodes_d:
+        s_f, r_f, inf_f = ratio_curve(defect, geom, dn, cells=cells, e_star=e_star, **settings)
+        r = np.interp(s_tab, s_f, r_f, left=1.0, right=1.0)
+        solves += inf_f["solves"]
+        if richardson:
+            # first-order error in the cell size h: r = r_h + (r_h - r_2h) h / (h_2h - h)
+            s_c, r_c, inf_c = ratio_curve(defect, geom, dn, cells=coarse, e_star=e_star, **settings)
+            rc = np.interp(s_tab, s_c, r_c, left=1.0, right=1.0)
+            h_f, h_c = math.sqrt(math.prod(inf_f["cell_m"])), math.sqrt(math.prod(inf_c["cell_m"]))
+            r = r + (r - rc) * h_f / (h_c - h_f)
+            solves += inf_c["solves"]
+        ratios.append(np.clip(r, 0.0, 1.0))
+        forces.append(inf_f["intact_force_n"])
+        axes.append(inf_f["semi_axes_m"])
+    r = np.column_stack(ratios)
+    # G^(2/3) between the nodes by a monotone cubic (Fritsch-Carlson, scipy's PCHIP)
+    # through (0, 0) and (drop, 0): exact for delta^1.5 scaling and for a rigid drop, and
+    # the share curves' bends between nodes cost a quarter of what straight lines did
+    from scipy.interpolate import PchipInterpolator
+    g23 = (r ** (2 / 3)) * nodes_d[None, :]
+    xd = np.concatenate([[0.0], nodes_d])
+    # rows the ball's rigid drop does not touch share one set of nodes: one interpolant
+    plain = drop <= 0
+    G = np.empty((n_psi, n_delta))
+    if np.any(plain):
+        yd = np.column_stack([np.zeros(int(plain.sum())), g23[plain]])
+        G[plain] = np.maximum(PchipInterpolator(xd, yd, axis=1)(delta), 0.0) ** 1.5
+    for j in np.flatnonzero(~plain):
+        if drop[j] >= delta[-1]:
+            G[j] = 0.0
+            continue
+        keep = xd > drop[j]
+        xj = np.concatenate([[0.0, drop[j]], xd[keep]])
+        yj = np.concatenate([[0.0, 0.0], g23[j, keep[1:]]])
+        G[j] = (np.maximum(PchipInterpolator(xj, yj)(delta), 0.0) ** 1.5 if xj.size >= 3
+                else np.interp(delta, xj, yj) ** 1.5)
+    far = np.all(r == 1.0, axis=1)
+    G[far] = delta[None, :] ** 1.5
+    info.update({"halfspace_ratio": r, "halfspace_intact_force_n": np.array(forces),
+                 "halfspace_semi_axes_m": np.array(axes), "halfspace_richardson": richardson,
+                 "halfspace_solves": solves})
+    return G, info

@@ -1,43 +1,70 @@
-"""Elastic half-space contact solver: the independent check of the "area" local law.
+"""Elastic half-space contact of a ball with a defected raceway: the "halfspace" model.
 
-Why: the "area" contact model (:mod:`.contact`) spreads the load over the raceway by a
-local law, ``p ~ sqrt(delta - h)``, which ignores that an elastic body carries the load
-lost over a defect partly on the neighbouring intact surface.  This module solves the
-frictionless normal contact of two elastic half-spaces exactly (to the grid) for the same
-exact sphere-torus gap, so the local law can be measured against it.  It is far too slow
-for the time loop (one solve is 0.1-1 s) and is run once, in a test and a benchmark.
+Why: over a defect the raceway loses part of the surface that carried the Hertz
+pressure.  How much load the contact loses at a given approach is an elastic question:
+the material next to the pit is pressed further and carries part of the load the pit
+removed.  A local (Winkler) law, where each surface point carries ``~ sqrt(delta - h)``
+independently of its neighbours ("area" model), cannot show this; the elastic
+half-space can.  This module solves the frictionless normal contact of the ball and the
+race, both linear-elastic half-spaces (Boussinesq; Johnson, *Contact Mechanics*, 1985,
+sections 3.2 and 5.9), for the exact sphere-in-torus gap with the outline removed, at
+a fixed rigid approach.
 
-Method: piecewise-constant pressure on a rectangular grid; surface displacement from
-Love's (1929) closed form for a uniformly loaded rectangle; the convolution by FFT with
-zero padding (DC-FFT, Liu, Wang & Liu 2000); the complementarity problem by the
-conjugate-gradient method of Polonsky & Keer (Wear 231, 1999), displacement-controlled
-(the rigid approach is fixed, so the mean-gap/load-balance step is omitted).
+Method
+------
+Piecewise-constant pressure on a rectangular grid of cells; the surface displacement of
+a uniformly loaded rectangle from Love's (1929) closed form; the convolution over the
+grid by FFT with zero padding (DC-FFT: Liu, Wang & Liu, Wear 243, 2000), pruned so that
+only the non-zero quarter of the padded array is transformed; the complementarity
+problem (pressure >= 0, gap >= 0, one of them zero) by the conjugate-gradient method of
+Polonsky & Keer (Wear 231, 1999), displacement-controlled (the approach is fixed, so
+their load-balance step is omitted).  A cell whose centre lies inside the outline
+carries the floor's gap (the intact gap plus the depth), so a deep pit never touches.
 
-Figures (6308 outer race, E = 208 GPa, nu = 0.3, r_o = 0.53 D_b, exact sphere-torus
-gap; ``compare_local_law()``, grid 0.0125 x 0.004 mm):
+The grid is ball-centred and covers the rigid interpenetration region ``{h < delta}``
+(the elastic contact lies inside it, with or without a defect: surface displacements
+are >= 0) with ``TABLE_CELLS`` cells.  For a rectangle whose sides run along and across
+the track the cell sizes are adjusted so the sides fall on cell boundaries (no
+staircase); other outlines are resolved by their cells' centres.  Ball positions are
+whole numbers of cells along the track (so the outline moves by whole cells), first
+every ``COARSE_STEP`` cells, then halved where linear interpolation misses the solved
+midpoint by more than ``REFINE_TOL``; positions whose cells see the same part of the
+outline are solved once; each round is one batch warm-started from its neighbours.
 
-* intact, at the approach 4.382 µm that Hertz (K_o = 3.27e10 N/m^1.5) gives for 300 N:
-  force 299.69 N (-0.10 %), contact semi-axes 0.888 x 0.158 mm (reference.md: 0.90 x 0.16;
-  the extents are read to one cell, -1.4 % and -1.3 %); at 8 µm 737.8 N (K_o -0.3 %: the
-  exact torus gap grows faster than Hertz's paraboloid);
-* centred 1 x 1 mm, 0.5 mm deep defect, ball over its centre, same approach: share of the
-  intact load still carried 0.553 (half-space) vs 0.350 (local law, "area" table); at 8 µm
-  0.708 vs 0.499.  More positions in :mod:`.contact`.
+Accuracy and cost (6308 outer race; ``benchmarks/defect_tables.py``): on the tables'
+grids the intact force is within 0.4 % of Hertz (K_o delta^1.5) and the contact
+semi-axes from the pressure's second moments within 0.7 % up to 8.4 µm (800 N); the
+share of the intact force carried over a centred 1 x 1 mm defect converges to first
+order in the cell size (the pressure is singular at the pit's edge), which the
+two-grid extrapolation of :mod:`.contact` removes.  One approach costs about 30 ms of
+CPU; figures in ``docs/contact-model.md``.
 
-The pit is modelled as a pressure-free region of the half-space surface: the compliance
-added by the removed material is ignored.  A flank next to a pit is an edge of a
-quarter-space and softer than a half-space, so the true load lost lies between the
-half-space figure and the local law's, nearer the half-space for pits narrower than the
-ring section (the usual approximation in rough-surface and dent contact solvers).
+What is neglected: the pit is a pressure-free region of the half-space surface; the
+compliance the removed material would add (a flank next to a pit is the edge of a
+quarter-space, softer than a half-space) is ignored, as in dent and rough-surface
+contact solvers.  So the load lost lies between this figure and the local law's, nearer
+this one for pits narrower than the ring section.
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
 import math
 
 import numpy as np
+from scipy import fft as sfft
 
 from .geometry import RaceGeometry
 from .model import Defect
+
+#: cells (across, along the track) over the interpenetration region at each approach
+TABLE_CELLS = (32, 24)
+#: Polonsky-Keer stopping rule: sum |p - p_previous| / sum p
+SOLVE_TOL = 1e-4
+#: a position interval is halved while |ratio(mid) - linear interpolation| exceeds this
+REFINE_TOL = 1e-3
+#: first pass: one ball position every COARSE_STEP cells along the track
+COARSE_STEP = 4
+
 
 def _stable_sum(t, s):
     """t + sqrt(t^2 + s^2) without cancellation for t < 0."""
@@ -63,22 +90,40 @@ def love_influence(nx: int, ny: int, dx: float, dy: float, e_star: float) -> np.
 
 
 class HalfSpace:
-    """DC-FFT influence operator on an (nx, ny) grid of cells dx x dy."""
+    """DC-FFT influence operator on an (nx, ny) grid of cells dx x dy, and its solver."""
 
     def __init__(self, nx: int, ny: int, dx: float, dy: float, e_star: float):
         self.nx, self.ny, self.dx, self.dy = nx, ny, dx, dy
         k = love_influence(nx, ny, dx, dy, e_star)
-        full = np.zeros((2 * nx, 2 * ny))
+        # the kernel spans offsets -(n-1)..(n-1): a period of 2n - 1 avoids wrap-around
+        self.mx = sfft.next_fast_len(2 * nx - 1, real=True)
+        self.my = sfft.next_fast_len(2 * ny - 1, real=True)
+        full = np.zeros((self.mx, self.my))
         full[:nx, :ny] = k
-        full[nx + 1:, :ny] = k[:0:-1, :]
-        full[:nx, ny + 1:] = k[:, :0:-1]
-        full[nx + 1:, ny + 1:] = k[:0:-1, :0:-1]
-        self.kf = np.fft.rfft2(full)
+        full[self.mx - nx + 1:, :ny] = k[:0:-1, :]
+        full[:nx, self.my - ny + 1:] = k[:, :0:-1]
+        full[self.mx - nx + 1:, self.my - ny + 1:] = k[:0:-1, :0:-1]
+        self.k00 = float(k[0, 0])          # a cell's displacement under its own pressure
+        # single precision in the transforms (~1e-7 relative error in the displacement, far
+        # below the solver's tolerance) at a third of the cost; the kernel is scaled to
+        # order one so that no product falls into float32's subnormal range (~1e-38),
+        # where the arithmetic is a hundred times slower
+        self.kf = (sfft.rfft2(full, workers=1) / self.k00).astype(np.complex64)
 
     def displacement(self, p: np.ndarray) -> np.ndarray:
-        pp = np.zeros((2 * self.nx, 2 * self.ny))
-        pp[:self.nx, :self.ny] = p
-        return np.fft.irfft2(np.fft.rfft2(pp) * self.kf, s=pp.shape)[:self.nx, :self.ny]
+        """Surface displacement (m) at the cell centres for cell pressures ``p`` (Pa),
+        shape (..., nx, ny) (leading axes: independent problems).
+
+        Only the nx x ny corner of the padded array is non-zero and only that corner of
+        the result is needed, so the first and last 1-D passes run on nx rows only.
+        """
+        a = sfft.rfft(p.astype(np.float32), n=self.my, axis=-1, workers=1)
+        a = sfft.fft(a, n=self.mx, axis=-2, workers=1, overwrite_x=True)
+        a *= self.kf
+        a = sfft.ifft(a, axis=-2, workers=1, overwrite_x=True)[..., :self.nx, :]
+        u = sfft.irfft(a, n=self.my, axis=-1, workers=1)[..., :self.ny].astype(np.float64)
+        u *= self.k00
+        return u
 
     def solve(self, gap: np.ndarray, approach: float, *, tol: float = 1e-8,
               maxiter: int = 3000, p0: np.ndarray | None = None) -> tuple[np.ndarray, int]:
@@ -87,43 +132,52 @@ class HalfSpace:
         Polonsky-Keer conjugate gradient, displacement-controlled, started from ``p0``
         (default: uniform over the interpenetration).  Returns (p, iterations).
         """
-        h = np.asarray(gap, dtype=float)
+        p, its = self.solve_batch(np.asarray(gap, dtype=float)[None], approach, tol=tol,
+                                  maxiter=maxiter, p0=None if p0 is None else np.asarray(p0)[None])
+        return p[0], int(its[0])
+
+    def solve_batch(self, gaps: np.ndarray, approach: float, *, tol: float = 1e-8,
+                    maxiter: int = 3000, p0: np.ndarray | None = None):
+        """:meth:`solve` for K problems at once: ``gaps`` (K, nx, ny) -> (p, iterations).
+
+        One FFT call serves every problem still iterating (the calls' fixed cost, not the
+        arithmetic, dominates on these small grids); each problem keeps its own step
+        sizes and stops on its own.
+        """
+        from ._halfspace_kernels import cg_direction, cg_step
+        h = np.asarray(gaps, dtype=float)
+        allowed = h < approach
         if p0 is None:
-            p = np.where(h < approach, 1.0, 0.0) * 1e6
+            p = np.where(allowed, 1e6, 0.0)
         else:
-            p = np.where(h < approach, np.maximum(p0, 0.0), 0.0)
-            if not np.any(p > 0):
-                p = np.where(h < approach, 1.0, 0.0) * 1e6
+            p = np.where(allowed, np.maximum(p0, 0.0), 0.0)
+            empty = ~np.any(p > 0, axis=(1, 2))
+            p[empty] = np.where(allowed[empty], 1e6, 0.0)
+        hd = h - approach
+        floor = 1e-24 * np.einsum("kij,kij->k", hd, hd)
+        out = p.copy()
+        iters = np.full(h.shape[0], maxiter)
+        act = np.arange(h.shape[0])
         t = np.zeros_like(p)
-        g_old = 1.0
-        restart = True
+        g_old = np.ones(act.size)
+        restart = np.ones(act.size, dtype=bool)
+        stalled, exact, done = (np.zeros(act.size, dtype=bool) for _ in range(3))
         for it in range(1, maxiter + 1):
-            g = self.displacement(p) + h - approach
-            S = p > 0
-            G = float(np.sum(g[S] ** 2))
-            if restart:
-                t = np.where(S, g, 0.0)
-            else:
-                t = np.where(S, g + (G / g_old) * t, 0.0)
-            g_old = G
-            r = self.displacement(t)
-            den = float(np.sum(r[S] * t[S]))
-            if den == 0:
-                break
-            tau = float(np.sum(g[S] * t[S])) / den
-            p_old = p
-            p = p - tau * t
-            p[p < 0] = 0.0
-            ol = (p == 0) & (g < 0)
-            if np.any(ol):
-                restart = True
-                p[ol] -= tau * g[ol]
-            else:
-                restart = False
-            tot = float(np.sum(p))
-            if tot > 0 and float(np.sum(np.abs(p - p_old))) / tot < tol:
-                break
-        return p, it
+            g = np.ascontiguousarray(self.displacement(p))
+            cg_direction(p, g, hd, t, allowed, restart, g_old, floor, self.k00, stalled, exact)
+            r = np.ascontiguousarray(self.displacement(t))
+            cg_step(p, g, t, r, allowed, stalled, exact, restart, tol, done)
+            if np.any(done):
+                out[act[done]] = p[done]
+                iters[act[done]] = it
+                keep = ~done
+                act, p, t, hd, floor = act[keep], p[keep], t[keep], hd[keep], floor[keep]
+                allowed, g_old, restart = allowed[keep], g_old[keep], restart[keep]
+                stalled, exact, done = stalled[keep], exact[keep], done[keep]
+                if act.size == 0:
+                    break
+        out[act] = p
+        return out, iters
 
 
 def e_star_of(E: float = 208e9, nu: float = 0.3) -> float:
@@ -131,18 +185,236 @@ def e_star_of(E: float = 208e9, nu: float = 0.3) -> float:
     return E / (2 * (1 - nu * nu))
 
 
+# ----------------------------------------------------------------------------- grids
+
+@dataclass(frozen=True)
+class ContactGrid:
+    """Ball-centred cells in track coordinates: centres ``z`` (across), ``s`` (along), m."""
+
+    z: np.ndarray
+    s: np.ndarray
+    dx: float
+    dy: float
+    aligned: bool
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        return self.z.size, self.s.size
+
+
+def aligned_sides(defect: Defect):
+    """(along, across) side lengths if the outline is a rectangle with sides along and
+    across the track, else None."""
+    if defect.shape != "rectangle":
+        return None
+    c, s = abs(math.cos(defect.skew)), abs(math.sin(defect.skew))
+    if s < 1e-12:
+        return defect.length, defect.width
+    if c < 1e-12:
+        return defect.width, defect.length
+    return None
+
+
+def contact_grid(defect: Defect | None, geom: RaceGeometry, delta: float,
+                 cells: tuple[int, int] = TABLE_CELLS) -> ContactGrid:
+    """Cells covering the interpenetration region at approach ``delta`` (one cell margin).
+
+    For a rectangle with sides along and across the track the sides fall on cell
+    boundaries for every ball position that is a whole number of cells from the defect
+    centre (``s`` is symmetric about the ball, ``z`` shifted to the sides)."""
+    b_r, a_r = geom.reach(delta)
+    dx, dy = 2 * a_r / cells[0], 2 * b_r / cells[1]
+    sides = None if defect is None else aligned_sides(defect)
+    if sides is None:
+        nx, ny = cells[0] + 2, cells[1] + 2
+        z = (np.arange(nx) - nx / 2 + 0.5) * dx
+        s = (np.arange(ny) - ny / 2 + 0.5) * dy
+        return ContactGrid(z, s, dx, dy, False)
+    along, across = sides
+    n_along = max(1, round(along / dy))
+    dy = along / n_along
+    n_across = max(1, round(across / dx))
+    dx = across / n_across
+    ny = math.ceil(2 * b_r / dy) + 2
+    if ny % 2 != n_along % 2:
+        ny += 1            # sides at +-along/2 from a whole-cell position are boundaries
+    s = (np.arange(ny) - (ny - 1) / 2) * dy
+    z_side = defect.offset - across / 2
+    i_lo = math.floor((-a_r - dx - z_side) / dx)
+    i_hi = math.ceil((a_r + dx - z_side) / dx)
+    z = z_side + (np.arange(i_lo, i_hi) + 0.5) * dx
+    return ContactGrid(z, s, dx, dy, True)
+
+
+def _gaps(geom: RaceGeometry, grid: ContactGrid, depth: float):
+    Z, S = np.meshgrid(grid.z, grid.s, indexing="ij")
+    R = geom.track_radius
+    g0 = geom.approach(S / R, Z)
+    gf = geom.approach(S / R, Z, depth=depth)
+    return Z, S, np.where(np.isfinite(g0), g0, 1.0), np.where(np.isfinite(gf), gf, 1.0)
+
+
+def pressure_semi_axes(p: np.ndarray, Z: np.ndarray, S: np.ndarray, dx: float, dy: float):
+    """Contact semi-axes (a across, b along; m) from the pressure's second moments.
+
+    For Hertz's ellipsoidal pressure ``p0 sqrt(1 - z^2/a^2 - s^2/b^2)`` the mean of z^2
+    weighted by p is a^2/5 (and s^2: b^2/5); the cells add their own dx^2/12, dy^2/12.
+    """
+    w = p / p.sum()
+    zc = float((w * Z).sum())
+    sc = float((w * S).sum())
+    z2 = float((w * (Z - zc) ** 2).sum()) + dx * dx / 12
+    s2 = float((w * (S - sc) ** 2).sum()) + dy * dy / 12
+    return math.sqrt(5 * z2), math.sqrt(5 * s2)
+
+
+def intact_contact(geom: RaceGeometry, delta: float, *, cells=TABLE_CELLS,
+                   e_star: float | None = None, tol: float = 1e-8, defect: Defect | None = None):
+    """Intact half-space contact at approach ``delta`` on the grid the tables use.
+
+    Returns a dict: force (N), a and b (m, from the pressure's moments), p (Pa), grid,
+    gaps, solver, iterations.  ``defect`` only sets the grid's alignment.
+    """
+    e_star = e_star_of() if e_star is None else e_star
+    grid = contact_grid(defect, geom, delta, cells)
+    Z, S, g0, gf = _gaps(geom, grid, 0.0 if defect is None else defect.depth)
+    hs = HalfSpace(*grid.shape, grid.dx, grid.dy, e_star)
+    p, it = hs.solve(g0, delta, tol=tol)
+    a, b = pressure_semi_axes(p, Z, S, grid.dx, grid.dy)
+    return {"force": float(p.sum()) * grid.dx * grid.dy, "a": a, "b": b, "p": p, "grid": grid,
+            "Z": Z, "S": S, "gap": g0, "gap_floor": gf, "solver": hs, "iterations": it}
+
+
+# ----------------------------------------------------------------------------- ratio curves
+
+def _symmetry(defect: Defect) -> bool:
+    """True if the contact over the defect is even in the ball position."""
+    if defect.shape == "polygon":
+        return False
+    return defect.offset == 0.0 or defect.skew == 0.0
+
+
+def ratio_curve(defect: Defect, geom: RaceGeometry, delta: float, *, cells=TABLE_CELLS,
+                e_star: float | None = None, tol: float = SOLVE_TOL,
+                refine_tol: float = REFINE_TOL, coarse_step: int = COARSE_STEP):
+    """Share of the intact half-space force carried over the defect at approach ``delta``.
+
+    Ball positions are whole numbers of cells from the defect centre: every
+    ``coarse_step`` cells first, then intervals are halved while the solved midpoint is
+    more than ``refine_tol`` from the linear interpolation; each round is solved as one
+    batch, warm-started from the nearest solved position.
+
+    Returns ``(s, ratio, info)``: ball positions s (m from the defect centre, sorted)
+    with ratio = F(defect) / F(intact) at the same approach (1 where the grid does not
+    meet the outline), and info (intact force N, semi-axes m, cells, solves, iterations).
+    """
+    base = intact_contact(geom, delta, cells=cells, e_star=e_star, tol=min(tol, 1e-6),
+                          defect=defect)
+    grid, hs = base["grid"], base["solver"]
+    Z, S, g0, gf = base["Z"], base["S"], base["gap"], base["gap_floor"]
+    p_int = base["p"]
+    f_int = float(p_int.sum())
+    touch = g0 < delta
+    dy = grid.dy
+    s0, s1, _, _ = defect.track_extent()
+    k_lo = math.floor((s0 - grid.s[-1] - dy) / dy)
+    k_hi = math.ceil((s1 - grid.s[0] + dy) / dy)
+    if _symmetry(defect):
+        k_lo = max(k_lo, 0)
+    solved: dict[int, tuple[float, np.ndarray]] = {}
+    stats = {"solves": 0, "iterations": 0}
+
+    same: dict[bytes, list] = {}     # positions whose cells see the same outline: one solve
+
+    def solve_round(ks, starts):
+        todo, gaps, p0 = [], [], []
+        for k, start in zip(ks, starts):
+            ins = defect.contains(S + k * dy, Z) & touch
+            if not np.any(ins):
+                solved[k] = (1.0, p_int)
+                continue
+            gap = np.where(ins, gf, g0)
+            if np.all(gap >= delta):
+                solved[k] = (0.0, np.zeros_like(p_int))
+                continue
+            key = np.packbits(ins).tobytes()
+            if key in same:
+                same[key].append(k)
+                continue
+            same[key] = [k]
+            todo.append(k)
+            gaps.append(gap)
+            p0.append(start)
+        if todo:
+            p, its = hs.solve_batch(np.array(gaps), delta, tol=tol, p0=np.array(p0))
+            stats["solves"] += len(todo)
+            stats["iterations"] += int(its.sum())
+            for k, pk in zip(todo, p):
+                solved[k] = (float(pk.sum()) / f_int, pk)
+        for group in same.values():
+            for k in group[1:]:
+                solved[k] = solved[group[0]]
+
+    _refine(solve_round, solved, p_int, k_lo, k_hi, coarse_step, refine_tol)
+    ks = np.array(sorted(solved))
+    s_nodes = ks * dy
+    ratio = np.array([solved[k][0] for k in ks])
+    if _symmetry(defect) and ks[0] == 0:
+        s_nodes = np.concatenate([-s_nodes[:0:-1], s_nodes])
+        ratio = np.concatenate([ratio[:0:-1], ratio])
+    info = {"intact_force_n": base["force"], "semi_axes_m": (base["a"], base["b"]),
+            "cells": grid.shape, "cell_m": (grid.dx, grid.dy), "aligned": grid.aligned, **stats}
+    return s_nodes, ratio, info
+
+
+def _refine(solve_round, solved, p_int, k_lo, k_hi, coarse_step, refine_tol):
+    """Solve every ``coarse_step`` positions, then halve intervals while the solved
+    midpoint misses linear interpolation by more than ``refine_tol`` (``solved`` maps a
+    position to (ratio, pressure) and is filled by ``solve_round(ks, starts)``)."""
+    coarse = list(range(k_lo, k_hi + 1, coarse_step))
+    if coarse[-1] != k_hi:
+        coarse.append(k_hi)
+    solve_round(coarse, [p_int] * len(coarse))
+    # an interval whose neighbourhood is straight on the coarse scale (both second
+    # differences below refine_tol) is not checked: e.g. the flat stretch while the
+    # contact lies inside a long defect's length
+    rc = np.array([solved[k][0] for k in coarse])
+    d2 = np.full(rc.size, np.inf)
+    d2[1:-1] = np.abs(rc[:-2] - 2 * rc[1:-1] + rc[2:])
+    intervals = [(a, b) for i, (a, b) in enumerate(zip(coarse[:-1], coarse[1:]))
+                 if b - a >= 2 and max(d2[i], d2[i + 1]) > refine_tol]
+    while intervals:
+        mids = [(a + b) // 2 for a, b in intervals]
+        starts = [solved[a][1] if m - a <= b - m else solved[b][1]
+                  for (a, b), m in zip(intervals, mids)]
+        solve_round(mids, starts)
+        nxt = []
+        for (a, b), m in zip(intervals, mids):
+            lin = solved[a][0] + (solved[b][0] - solved[a][0]) * (m - a) / (b - a)
+            if abs(solved[m][0] - lin) > refine_tol:
+                nxt += [(a, m), (m, b)]
+        intervals = [(a, b) for a, b in nxt if b - a >= 2]
+
+
+def halfspace_ratio_nodes(defect: Defect, geom: RaceGeometry, delta_nodes, **kw):
+    """:func:`ratio_curve` at each approach in ``delta_nodes``: a list of (s, ratio, info)."""
+    return [ratio_curve(defect, geom, float(d), **kw) for d in delta_nodes]
+
+
+# ----------------------------------------------------------------------------- checks
+
 def race_contact(geom: RaceGeometry, defect: Defect | None, approach: float, *,
                  s_ball: float = 0.0, half_across: float | None = None,
                  half_along: float | None = None, dx: float = 0.0125e-3, dy: float = 0.004e-3,
                  e_star: float | None = None, solver: HalfSpace | None = None):
     """Half-space contact of the ball at track position ``s_ball`` (m from the defect
-    centre) and approach ``approach`` with the race, exact sphere-torus gap; cells whose
-    centre lies inside the outline carry the floor's gap.  Returns a dict with force (N),
-    semi-axes a (across) and b (along) of the contact (m), p (Pa), iterations."""
+    centre) and approach ``approach`` on a grid of given cell size (dx across, dy along).
+
+    A fine-grid check, independent of the tables' grids.  Returns a dict with force (N),
+    semi-axes a (across) and b (along) of the contact from the pressure's moments (m),
+    p (Pa), iterations and the solver (reusable for the same grid)."""
     e_star = e_star_of() if e_star is None else e_star
     if half_across is None or half_along is None:
-        # the elastic contact lies inside the rigid interpenetration region {h < approach}
-        # (surface displacements are >= 0), with or without a defect
         b_r, a_r = geom.reach(approach)
         half_across = a_r + dx if half_across is None else half_across
         half_along = b_r + dy if half_along is None else half_along
@@ -159,22 +431,21 @@ def race_contact(geom: RaceGeometry, defect: Defect | None, approach: float, *,
     hs = solver if solver is not None else HalfSpace(nx, ny, dx, dy, e_star)
     p, it = hs.solve(gap, approach)
     c = p > 0
-    force = float(p.sum() * dx * dy)
-    a = float(np.abs(Z[c]).max() + dx / 2) if c.any() else 0.0
-    b = float(np.abs(S[c]).max() + dy / 2) if c.any() else 0.0
     if c.any() and (np.abs(Z[c]).max() > half_across - 2 * dx or np.abs(S[c]).max() > half_along - 2 * dy):
         raise ValueError("the contact reaches the edge of the half-space grid; enlarge it")
-    return {"force": force, "a": a, "b": b, "p": p, "iterations": it, "solver": hs}
+    a, b = pressure_semi_axes(p, Z, S, dx, dy) if c.any() else (0.0, 0.0)
+    return {"force": float(p.sum() * dx * dy), "a": a, "b": b, "p": p, "iterations": it, "solver": hs}
 
 
 def compare_local_law(bearing=None, *, load: float = 300.0, k_hertz: float = 3.27e10,
                       s_positions=(0.0, 0.3e-3, 0.5e-3, 0.6e-3), dx: float = 0.0125e-3,
                       dy: float = 0.004e-3) -> dict:
-    """6308 outer race: half-space vs the "area" local law over a centred 1 x 1 mm defect.
+    """6308 outer race: fine-grid half-space against the "area" local law and the
+    "halfspace" table over a centred 1 x 1 mm defect.
 
     At the approach ``(load / k_hertz)^(2/3)`` returns the intact half-space force and
     semi-axes, and for each ball position ``s`` (m from the defect centre) the share of the
-    intact force still carried by the half-space and by the local-law table.
+    intact force still carried: fine half-space solve, local-law table, half-space table.
     """
     from bearing_lab.bearings import get_bearing
     from .contact import contact_table
@@ -183,76 +454,15 @@ def compare_local_law(bearing=None, *, load: float = 300.0, k_hertz: float = 3.2
     d = Defect(length=1e-3, width=1e-3, depth=0.5e-3)
     delta = (load / k_hertz) ** (2 / 3)
     intact = race_contact(geom, None, delta, dx=dx, dy=dy)
-    table = contact_table(d, bearing, model="area", delta_max=2 * delta, n_delta=81)
+    tables = {m: contact_table(d, bearing, model=m, delta_max=2 * delta, n_delta=81)
+              for m in ("area", "halfspace")}
     out = {"approach": delta, "intact_force": intact["force"], "a": intact["a"], "b": intact["b"],
            "iterations": intact["iterations"], "positions": []}
     for s in s_positions:
         r = race_contact(geom, d, delta, s_ball=s, dx=dx, dy=dy, solver=intact["solver"])
-        law = float(table.lookup(s / geom.track_radius, delta)) / delta ** 1.5
-        out["positions"].append({"s": s, "halfspace": r["force"] / intact["force"], "local_law": law})
-    return out
-
-
-def _symmetry(defect: Defect) -> bool:
-    """True if the contact over the defect is even in psi (G(-psi) = G(psi))."""
-    if defect.shape == "polygon":
-        return False
-    return defect.offset == 0.0 or defect.skew == 0.0
-
-
-def halfspace_ratio_nodes(defect: Defect, geom: RaceGeometry, delta_nodes, *,
-                          cells_across: int = 64, cells_along: int = 48, step_cells: int = 2,
-                          e_star: float | None = None, tol: float = 1e-6):
-    """Share of the intact half-space force carried over the defect, on coarse nodes.
-
-    For each approach in ``delta_nodes``: a ball-centred grid over the interpenetration
-    region {h < delta} (``cells_across x cells_along`` cells; a cell is removed when its
-    centre lies inside the outline), the intact force, then the force with the ball at
-    track positions s = k * step_cells * dy (only where the grid meets the defect; warm
-    started from the neighbouring position).  Returns a list of (s_nodes, ratio) per delta.
-    """
-    e_star = e_star_of() if e_star is None else e_star
-    R = geom.track_radius
-    sym = _symmetry(defect)
-    s0, s1, z0, z1 = defect.track_extent()
-    out = []
-    for delta in delta_nodes:
-        b_r, a_r = geom.reach(delta)
-        dx, dy = 2 * a_r / cells_across, 2 * b_r / cells_along
-        nx, ny = cells_across + 2, cells_along + 2
-        z = (np.arange(nx) - nx / 2 + 0.5) * dx
-        s = (np.arange(ny) - ny / 2 + 0.5) * dy
-        Z, S = np.meshgrid(z, s, indexing="ij")
-        gap0 = geom.approach(S / R, Z)
-        gapf = geom.approach(S / R, Z, depth=defect.depth)
-        gap0 = np.where(np.isfinite(gap0), gap0, 1.0)
-        gapf = np.where(np.isfinite(gapf), gapf, 1.0)
-        hs = HalfSpace(nx, ny, dx, dy, e_star)
-        p_int, _ = hs.solve(gap0, delta, tol=tol)
-        f_int = float(p_int.sum())
-        step = step_cells * dy
-        k_lo = math.floor((s0 - b_r - dy) / step)
-        k_hi = math.ceil((s1 + b_r + dy) / step)
-        if sym:
-            k_lo = max(k_lo, 0)
-        ks = np.arange(k_lo, k_hi + 1)
-        ratio = np.ones(ks.size)
-        p_prev = p_int
-        for i, k in enumerate(ks):
-            ins = defect.contains(S + k * step, Z)
-            if not np.any(ins & (gap0 < delta)):
-                p_prev = p_int
-                continue
-            gap = np.where(ins, gapf, gap0)
-            if np.all(gap >= delta):
-                ratio[i] = 0.0
-                continue
-            p, _ = hs.solve(gap, delta, tol=tol, p0=p_prev)
-            ratio[i] = float(p.sum()) / f_int
-            p_prev = p
-        s_nodes = ks * step
-        if sym:
-            s_nodes = np.concatenate([-s_nodes[:0:-1], s_nodes])
-            ratio = np.concatenate([ratio[:0:-1], ratio])
-        out.append((s_nodes, ratio))
+        row = {"s": s, "halfspace": r["force"] / intact["force"]}
+        for m, T in tables.items():
+            row["local_law" if m == "area" else "table"] = (
+                float(T.lookup(s / geom.track_radius, delta)) / delta ** 1.5)
+        out["positions"].append(row)
     return out

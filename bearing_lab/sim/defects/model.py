@@ -38,8 +38,7 @@ from bearing_lab.errors import SceneError
 
 RACES = ("outer", "inner", "ball")
 SHAPES = ("rectangle", "ellipse", "polygon")
-#: Default defect depth (m): the 0.5 mm of reference.md's rigid-drop figures.  The paper
-#: does not state one; any depth much larger than the ball's drop (micrometres) gives the
+#: Default defect depth (m): 0.5 mm.  The reference paper (Liu et al.) does not state one; any depth much larger than the ball's drop (micrometres) gives the
 #: same response.
 DEFAULT_DEPTH = 0.5e-3
 
