@@ -32,11 +32,25 @@ shaft:
      ``f_s`` is judged the same way;
    - if a fault family of the bearing is detected at the frequencies ``f0``
      implies (noise rule and decoys, :mod:`._families`) in the squared envelope
-     spectrum of the pre-whitened signal or of the kurtogram band the diagnosis
-     would use at ``f0``, the kinematics confirm ``f0``;
+     spectrum of the cepstrum-pre-whitened signal, the kinematics confirm ``f0``.
+     Only that spectrum counts: pre-whitening removes discrete lines (shaft
+     harmonics, a slip-free comb) and keeps the slipping impacts of a fault, and
+     the harmonics of ``f0`` are masked there, so a comb at ``f0`` cannot confirm
+     ``f0``;
+   - if no fault reading of the family is plausible, it is a **plain 1x family**
+     and names the speed: its comb ``k f0`` shows in no envelope spectrum
+     (pre-whitened or kurtogram band; a fault's impacts modulate the resonances,
+     unbalance and misalignment do not), it is not a comb of discrete lines
+     reaching the resonances (a slip-free impact train), no other speed's 1x
+     family makes it a fault comb, and at least half of the harmonics searched
+     are clear lines (a few weak lines, such as a healthy bearing's ball-pass
+     lines, are not enough);
    - otherwise the speed is **unresolved**: a shaft and a fault comb would look
-     the same.  A healthy machine without a speed thus stays unresolved; without
-     a fault family there is nothing to name anyway.
+     the same.
+
+4. **A stored or given speed is never overridden by its own fault comb**: a
+   blind family within the slip tolerance of the prior's BPFO, BPFI, 2 BSF or
+   FTF leaves the prior "unconfirmed", not "contradicted".
 """
 from __future__ import annotations
 
@@ -45,7 +59,7 @@ from scipy import fft as _fft
 from scipy.stats import binom
 
 from ..errors import AnalysisError
-from ._families import search_families
+from ._families import family_evidence, search_families
 from ._speed import LINE_SNR_DB, SNR_CAP_DB, interpolated_peak, line_floor_db
 
 __all__ = ["RawLines", "resolve_speed", "MIN_SHAFT_LINES", "PRIOR_TOLERANCE", "BLIND_RANGE_HZ"]
@@ -80,6 +94,7 @@ class RawLines:
     def __init__(self, x, fs, *, top_hz, mains_hz=(50.0, 60.0)):
         n = x.size
         self.fs, self.n, self.df = float(fs), n, fs / n
+        self.x = x
         top = min(int(np.ceil(top_hz / self.df)) + 64, n // 2)
         self.X = _fft.rfft(x - x.mean())[: top + 2]
         amp = np.abs(self.X)
@@ -296,12 +311,24 @@ def _alternatives(raw, fam, factors, lo, hi, tolerance):
     return out
 
 
+def _spectra(cs, f0):
+    """(pre-whitened SES, kurtogram-band SES or None) that ``cs`` gives for f0."""
+    if cs is None:
+        return None, None
+    specs = list(cs(f0)) if callable(cs) else [cs]
+    return specs[0], (specs[1] if len(specs) > 1 else None)
+
+
 def _corroborated(cs, geometry, f0, tolerance):
     """The strongest fault family detected (noise rule and decoys) at the frequencies f0
-    implies, in any of the spectra ``cs`` gives for f0 (the pre-whitened squared envelope
-    spectrum, and that of the kurtogram band the diagnosis at f0 would use); None if none."""
+    implies in the squared envelope spectrum of the cepstrum-pre-whitened signal; None if
+    none.  Only that spectrum confirms a speed: pre-whitening removes the discrete lines
+    (shaft harmonics, a slip-free comb) and keeps the slipping impacts of a bearing fault,
+    and the search masks the harmonics of f0 itself, so a comb at f0 cannot confirm f0.
+    The kurtogram band's spectrum is not used: a band chosen for its impulsiveness may
+    hold a comb of discrete lines."""
     hits = {}
-    for spec in (cs(f0) if callable(cs) else [cs]):
+    for spec in _spectra(cs, f0)[:1]:
         if spec is None:
             continue
         try:
@@ -332,12 +359,49 @@ def _judge(raw, cs, geometry, fam, lo, hi, tolerance, depth=0):
     if fault is not None:
         return {"resolved": True, "family": fam, "candidates": cands,
                 "note": f"{len(fam['harmonics'])} shaft harmonics; the {fault.upper()} family at this speed "
-                        "is detected in the envelope spectrum"}
+                        "is detected in the envelope spectrum of the pre-whitened signal"}
+    comb = _fault_comb(raw, cs, f0)
+    rich = len(fam["harmonics"]) >= DISCRETE_FRACTION * raw.n_harmonics(hi)
+    if comb is None and not alts and rich:
+        return {"resolved": True, "family": fam, "candidates": cands,
+                "note": f"a plain 1x family: {len(fam['harmonics'])} shaft harmonics that are neither an "
+                        "envelope comb nor a comb of discrete lines reaching the resonances, so no fault "
+                        "reading of them is plausible"}
     readings = ", ".join(f"{n} of a {f0 / (factors[k] * m):.2f} Hz shaft" for n, k, m in FAULT_RATIOS
                          if lo <= f0 / (factors[k] * m) <= hi)
+    why = comb or ("another speed's 1x family makes it a fault comb" if alts else
+                   f"{len(fam['harmonics'])} clear harmonics of {raw.n_harmonics(hi)}: too few for a plain 1x "
+                   "family without a fault family to confirm it")
     return {"resolved": False, "family": fam, "candidates": [_summary(fam, "1x line family")] + cands,
             "note": f"no fault family at the frequencies {f0:.3f} Hz implies confirms it as the shaft, and "
-                    f"its line family could be a fault comb: {readings or 'of another speed'}"}
+                    f"its line family could be a fault comb ({why}): {readings or 'of another speed'}"}
+
+
+def _fault_comb(raw, cs, f0):
+    """Why the line family at f0 could be the comb of a fault's impacts, or None.
+
+    A fault's impacts modulate the structural resonances, so their comb shows in an
+    envelope spectrum; a slip-free impact train (a simulation) is also a comb of discrete
+    lines reaching the resonances.  Shaft harmonics of unbalance or misalignment are
+    neither.  The test: the comb k f0 passes the noise rule (fundamental, harmonics) in the
+    pre-whitened or the kurtogram band's envelope spectrum, or is a discrete comb up to
+    0.45 fs (:func:`discrete_comb`)."""
+    for name, spec in zip(("pre-whitened", "kurtogram band's"), _spectra(cs, f0)):
+        if spec is None:
+            continue
+        try:
+            ev = family_evidence(spec, f0, tolerance=max(2e-3, 1.5 * spec.df / f0), n_harmonics=5)
+        except AnalysisError:
+            continue
+        if ev["passes_noise_rule"]:
+            return f"a comb of {ev['harmonics']} lines in the {name} envelope spectrum"
+    if raw.x is not None:
+        discrete, frac, count = discrete_comb(raw.x, raw.fs, f0)
+        if discrete:
+            return f"a comb of discrete lines up to 0.45 fs ({100 * frac:.0f} % of {count} harmonics)"
+    if cs is None:
+        return "no envelope spectrum to tell"
+    return None
 
 
 def _blind(raw, cs, geometry, tolerance, lo, hi):
@@ -354,6 +418,16 @@ def _blind(raw, cs, geometry, tolerance, lo, hi):
     return {"resolved": False, "family": None, "candidates": tried,
             "note": f"no 1x line family with at least {MIN_SHAFT_LINES} clear harmonics that chance cannot "
                     f"explain in {lo:g}-{hi:g} Hz"}
+
+
+def _own_comb(geometry, prior_hz, f_hz, tolerance):
+    """Name of the fault family of ``prior_hz`` whose carrier lies at ``f_hz`` within the
+    slip tolerance, or None: a stored speed is never overridden by its own fault comb."""
+    factors = geometry.frequency_factors()
+    for name, key, mult in FAULT_RATIOS:
+        if abs(f_hz / (prior_hz * mult * factors[key]) - 1) <= tolerance:
+            return name
+    return None
 
 
 def resolve_speed(x, fs, geometry, *, rpm=None, rpm_source="given", cs=None, tolerance=0.02,
@@ -425,7 +499,14 @@ def resolve_speed(x, fs, geometry, *, rpm=None, rpm_source="given", cs=None, tol
         out["candidates"].append(_summary(fam, why or "outside the window"))
     blind = _blind(raw, cs, geometry, tolerance, lo_b, hi_b)
     f_b = blind["family"]["shaft_hz"] if blind["family"] else None
-    if blind["resolved"] and not lo <= f_b <= hi:
+    own = _own_comb(geometry, prior, f_b, tolerance) if blind["resolved"] else None
+    if own is not None:
+        out.update(status="unconfirmed",
+                   note=f"no 1x line family within +-{100 * PRIOR_TOLERANCE:g} % of the {rpm_source} speed; the "
+                        f"signal's line family at {f_b:.3f} Hz is the {own} comb of the {rpm_source} speed, which "
+                        "is used as it is")
+        out["candidates"].append(_summary(blind["family"], f"{own} comb of the {rpm_source} speed"))
+    elif blind["resolved"] and not lo <= f_b <= hi:
         out.update(status="contradicted", deviation_pct=100 * (f_b / prior - 1),
                    note=f"no 1x family near the {rpm_source} speed, but the signal's own 1x family is at "
                         f"{f_b:.3f} Hz ({60 * f_b:.1f} r/min): the {rpm_source} speed may be wrong")
