@@ -59,7 +59,8 @@ from scipy import fft as _fft
 from scipy.stats import binom
 
 from ..errors import AnalysisError
-from ._families import family_evidence, search_families
+from ._families import SK_MIN, search_families
+from ._faults import FUNDAMENTAL_SNR_DB, MIN_HARMONICS
 from ._speed import LINE_SNR_DB, SNR_CAP_DB, interpolated_peak, line_floor_db
 
 __all__ = ["RawLines", "resolve_speed", "MIN_SHAFT_LINES", "PRIOR_TOLERANCE", "BLIND_RANGE_HZ"]
@@ -74,6 +75,11 @@ BLIND_RANGE_HZ = (5.0, 100.0)
 N_SHAFT_HARMONICS = 20
 #: A 1x family must be less likely than this to arise by chance in its search range.
 CHANCE_MAX = 1e-3
+#: A plain 1x family (no fault family to confirm it) has half of its harmonics searched, or all of
+#: the first PLAIN_FIRST, as clear lines.
+PLAIN_FIRST = 5
+#: Harmonics of a candidate examined in the envelope spectra for a fault comb.
+COMB_HARMONICS = 5
 #: A comb is "discrete" when this fraction of its harmonics up the spectrum are clear lines.
 DISCRETE_FRACTION = 0.5
 
@@ -110,6 +116,17 @@ class RawLines:
         local[1:-1] = (amp[1:-1] >= amp[:-2]) & (amp[1:-1] >= amp[2:])
         self.clear = np.where(masked | (self.snr < LINE_SNR_DB) | ~local, 0.0, self.snr)
         self.top_hz = (amp.size - 3) * self.df
+
+    min_rms = None  # measurability floor of a plain 1x family, in signal units (None: no floor)
+
+    def family_rms(self, fam):
+        """rms of a family's clear lines (rectangular-window peak amplitudes 2|X|/N)."""
+        amps = []
+        for h in fam["harmonics"]:
+            k = int(round(h * fam["shaft_hz"] / self.df))
+            if 1 <= k < self.amp.size - 1:
+                amps.append(2.0 * self.amp[k - 1:k + 2].max() / self.n)
+        return float(np.sqrt(0.5 * np.sum(np.square(amps))))
 
     def n_harmonics(self, hi):
         return int(max(1, min(N_SHAFT_HARMONICS, np.floor(min(self.top_hz, 0.45 * self.fs) / hi))))
@@ -360,41 +377,56 @@ def _judge(raw, cs, geometry, fam, lo, hi, tolerance, depth=0):
         return {"resolved": True, "family": fam, "candidates": cands,
                 "note": f"{len(fam['harmonics'])} shaft harmonics; the {fault.upper()} family at this speed "
                         "is detected in the envelope spectrum of the pre-whitened signal"}
-    comb = _fault_comb(raw, cs, f0)
-    rich = len(fam["harmonics"]) >= DISCRETE_FRACTION * raw.n_harmonics(hi)
-    if comb is None and not alts and rich:
+    comb = _fault_comb(raw, cs, f0, fam["harmonics"])
+    hs = set(fam["harmonics"])
+    rich = len(hs) >= DISCRETE_FRACTION * raw.n_harmonics(hi) or hs >= set(range(1, PLAIN_FIRST + 1))
+    fam_rms = raw.family_rms(fam)
+    loud = raw.min_rms is None or fam_rms >= raw.min_rms
+    if comb is None and not alts and rich and loud:
         return {"resolved": True, "family": fam, "candidates": cands,
                 "note": f"a plain 1x family: {len(fam['harmonics'])} shaft harmonics that are neither an "
                         "envelope comb nor a comb of discrete lines reaching the resonances, so no fault "
                         "reading of them is plausible"}
     readings = ", ".join(f"{n} of a {f0 / (factors[k] * m):.2f} Hz shaft" for n, k, m in FAULT_RATIOS
                          if lo <= f0 / (factors[k] * m) <= hi)
+    readings_c = [{"shaft_hz": float(f0 / (factors[k] * m)), "harmonics": 0, "snr_db": 0.0,
+                   "note": f"if the {f0:.3f} Hz family is its {n} comb"} for n, k, m in FAULT_RATIOS
+                  if lo <= f0 / (factors[k] * m) <= hi]
+    cands = cands + readings_c
     why = comb or ("another speed's 1x family makes it a fault comb" if alts else
                    f"{len(fam['harmonics'])} clear harmonics of {raw.n_harmonics(hi)}: too few for a plain 1x "
-                   "family without a fault family to confirm it")
+                   "family without a fault family to confirm it" if not rich else
+                   f"its lines carry {fam_rms:.3g} rms, below the measurability floor {raw.min_rms:.3g}: a shaft "
+                   "in service vibrates more, a healthy bearing's ball-pass lines can be this small")
     return {"resolved": False, "family": fam, "candidates": [_summary(fam, "1x line family")] + cands,
             "note": f"no fault family at the frequencies {f0:.3f} Hz implies confirms it as the shaft, and "
                     f"its line family could be a fault comb ({why}): {readings or 'of another speed'}"}
 
 
-def _fault_comb(raw, cs, f0):
+def _fault_comb(raw, cs, f0, lines_h=()):
     """Why the line family at f0 could be the comb of a fault's impacts, or None.
 
     A fault's impacts modulate the structural resonances, so their comb shows in an
     envelope spectrum; a slip-free impact train (a simulation) is also a comb of discrete
     lines reaching the resonances.  Shaft harmonics of unbalance or misalignment are
-    neither.  The test: the comb k f0 passes the noise rule (fundamental, harmonics) in the
-    pre-whitened or the kurtogram band's envelope spectrum, or is a discrete comb up to
-    0.45 fs (:func:`discrete_comb`)."""
+    neither.  The test: the comb k f0 (k = 1..COMB_HARMONICS, each within one bin) passes the
+    noise rule (a fundamental line, MIN_HARMONICS lines) in the pre-whitened envelope spectrum or in that of the kurtogram band when the band is
+    impulsive (spectral kurtosis at least ``SK_MIN``: a band of a few steady lines has an
+    envelope beating at their spacing) and lies above the family's clear lines
+    ``lines_h``, or is a discrete comb up to 0.45 fs
+    (:func:`discrete_comb`)."""
     for name, spec in zip(("pre-whitened", "kurtogram band's"), _spectra(cs, f0)):
-        if spec is None:
+        if spec is None or getattr(spec, "kurtosis", SK_MIN) < SK_MIN:
+            continue  # a band without impulsiveness holds no impact comb (its lines beat)
+        band = getattr(spec, "band", None)
+        if band is not None and band[0] < (max(lines_h, default=0) + 1) * f0:
+            continue  # the band holds the family's own lines: its envelope beats at f0 anyway
+        k = np.arange(1, COMB_HARMONICS + 1)
+        if k[-1] * f0 + 2 * spec.df >= spec.f[-1]:
             continue
-        try:
-            ev = family_evidence(spec, f0, tolerance=max(2e-3, 1.5 * spec.df / f0), n_harmonics=5)
-        except AnalysisError:
-            continue
-        if ev["passes_noise_rule"]:
-            return f"a comb of {ev['harmonics']} lines in the {name} envelope spectrum"
+        _, snr = spec.best(k * f0, 1)  # lines within one bin: f0 is known to a fraction of a bin
+        if snr[0] >= FUNDAMENTAL_SNR_DB and np.count_nonzero(snr > 0) >= MIN_HARMONICS:
+            return f"a comb of {np.count_nonzero(snr > 0)} lines in the {name} envelope spectrum"
     if raw.x is not None:
         discrete, frac, count = discrete_comb(raw.x, raw.fs, f0)
         if discrete:
@@ -431,7 +463,7 @@ def _own_comb(geometry, prior_hz, f_hz, tolerance):
 
 
 def resolve_speed(x, fs, geometry, *, rpm=None, rpm_source="given", cs=None, tolerance=0.02,
-                  blind_range_hz=BLIND_RANGE_HZ):
+                  blind_range_hz=BLIND_RANGE_HZ, min_family_rms=None):
     """Shaft frequency from a prior speed or the signal alone (module docstring).
 
     Parameters
@@ -452,6 +484,9 @@ def resolve_speed(x, fs, geometry, *, rpm=None, rpm_source="given", cs=None, tol
         Slip tolerance of fault frequencies.
     blind_range_hz : (float, float)
         Search range without a prior.
+    min_family_rms : float, optional
+        Measurability floor (signal units, rms) a plain 1x family must reach to name a
+        blind speed without a fault family to confirm it.
 
     Returns
     -------
@@ -467,6 +502,7 @@ def resolve_speed(x, fs, geometry, *, rpm=None, rpm_source="given", cs=None, tol
     prior = None if rpm is None else float(rpm) / 60.0
     hi_all = max(hi_b, prior * (1 + PRIOR_TOLERANCE) if prior else 0.0)
     raw = RawLines(x, fs, top_hz=min(0.45 * fs, N_SHAFT_HARMONICS * hi_all * 1.03))
+    raw.min_rms = min_family_rms
     lowest = prior * (1 - PRIOR_TOLERANCE) if prior else lo_b
     if 4 * raw.df > lowest:
         msg = (f"the record lasts {x.size / fs:.3g} s: its 1/T = {raw.df:.3g} Hz bins cannot resolve shaft "
