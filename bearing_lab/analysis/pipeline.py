@@ -42,6 +42,7 @@ from ._diagnosis import (coincidences, combine, deciding_route, interpretations,
                          runner_up, spectrum_top)
 from ._families import LABELS, CyclicSpectrum
 from ._floor import band_rms, floor_in_units
+from ._hump import apply as apply_humps
 from ._impulse import excitation_period
 from ._metrics import METRIC_NAMES, metrics
 from ._shaft import BLIND_RANGE_HZ, resolve_speed
@@ -188,13 +189,17 @@ def _run(x, fs, *, bearing, rpm=None, shaft_hz=None, tolerance=0.02, n_harmonics
     res = run_routes(xa, fs, geom, fr, tolerance=tolerance, n_harmonics=n_harmonics, prewhiten=prewhiten,
                      xw=xw if xa is x else None)
     routes = res["routes"]
-    verdict = _floor_verdict(combine(routes, speed), band_rms(xa, fs, res["band"]), floor, units)
+    verdict, humps = apply_humps(combine(routes, speed), routes, res["fault_hz"], shaft_hz=fr,
+                                 factors=geom.frequency_factors(), speed_status=speed["status"], tolerance=tolerance)
+    verdict = _floor_verdict(verdict, band_rms(xa, fs, res["band"]), floor, units)
     decided = deciding_route(routes)
     key = {v: k for k, v in LABELS.items()}.get(verdict["diagnosis"]) if verdict["verdict"] == "diagnosed" else None
     period = None
     if key is not None:
         by = verdict["decided_by"]
-        if by == ["ees"]:
+        if verdict.get("hump"):  # a smeared family has no line to refine: the kinematic rate
+            period = 1.0 / (2.0 * res["fault_hz"]["bsf"])
+        elif by == ["ees"]:
             period = 1.0 / routes["ees"]["families"][key]["measured_hz"]
         else:
             period = _period(routes, by[0], key, xa, res["xw"], fs, res["band"])
@@ -212,6 +217,7 @@ def _run(x, fs, *, bearing, rpm=None, shaft_hz=None, tolerance=0.02, n_harmonics
     result["evidence"] = _evidence(res, verdict, speed, fs, xa.size, tolerance, n_harmonics, decided)
     result["evidence"]["reported_route"] = decided
     result["evidence"]["band"].update(rms=verdict["band_rms"], floor_rms=floor)
+    result["evidence"]["ball_humps"] = humps
     extras = {"f": routes[decided]["f"], "ses": routes[decided]["spectrum"], "band": res["band"],
               "lines": fams, "bearing": geom, "routes": routes, "route": decided}
     return result, extras
