@@ -521,6 +521,11 @@ def resolve_speed(x, fs, geometry, *, rpm=None, rpm_source="given", cs=None, tol
         out.update(source="estimated" if res["resolved"] else "unresolved",
                    status="resolved" if res["resolved"] else "unresolved")
         return out
+    return _with_prior(raw, cs, geometry, out, prior, rpm_source, tolerance, lo_b, hi_b)
+
+
+def _with_prior(raw, cs, geometry, out, prior, rpm_source, tolerance, lo_b, hi_b):
+    """Rules 2 and 4: refine a given or stored speed, or keep it, or mark it contradicted."""
     lo, hi = prior * (1 - PRIOR_TOLERANCE), prior * (1 + PRIOR_TOLERANCE)
     for f0 in raw.candidates(lo, hi, count=3):
         fam = raw.family(f0, hi)
