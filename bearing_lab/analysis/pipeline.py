@@ -182,15 +182,16 @@ def _run(x, fs, *, bearing, rpm=None, shaft_hz=None, tolerance=0.02, n_harmonics
                            pulses_per_rev=pulses_per_rev, tolerance=tolerance, n_harmonics=n_harmonics,
                            units=units)
     fr = float(speed["shaft_hz"])
-    floor = floor_in_units(units)
     if speed["status"] == "unresolved":
         out = _unresolved(speed, geom, fs, xa.size, m, tolerance, n_harmonics)
-        return _below_floor_unresolved(out, band_rms(xa, fs, None), floor, units)
+        return _below_floor_unresolved(out, band_rms(xa, fs, None), floor_in_units(units, fs / 2), units)
     res = run_routes(xa, fs, geom, fr, tolerance=tolerance, n_harmonics=n_harmonics, prewhiten=prewhiten,
                      xw=xw if xa is x else None)
     routes = res["routes"]
     verdict, humps = apply_humps(combine(routes, speed), routes, res["fault_hz"], shaft_hz=fr,
                                  factors=geom.frequency_factors(), speed_status=speed["status"], tolerance=tolerance)
+    width = fs / 2 if res["band"] is None else res["band"][1] - res["band"][0]
+    floor = floor_in_units(units, width)
     verdict = _floor_verdict(verdict, band_rms(xa, fs, res["band"]), floor, units)
     decided = deciding_route(routes)
     key = {v: k for k, v in LABELS.items()}.get(verdict["diagnosis"]) if verdict["verdict"] == "diagnosed" else None
@@ -230,9 +231,10 @@ def _floor_verdict(verdict, rms, floor, units):
         return verdict
     said = verdict["diagnosis"] if verdict["verdict"] == "diagnosed" else "uncertain"
     return dict(verdict, diagnosis="none", verdict="no fault evidence", decided_by=[],
-                reason=f"the demodulation band carries {rms:.3g} {units} rms ({rms / floor:.2g} mg), below the "
-                       f"1 mg measurability floor of an accelerometer chain: the routes' reading ({said}: "
-                       f"{verdict['reason']}) is not evidence of a fault")
+                reason=f"the demodulation band carries {rms:.3g} {units} rms, {rms / floor:.2g} times the "
+                       f"measurability floor of an accelerometer chain ({floor:.3g} {units} in this band: 1 mg "
+                       f"over 10 kHz): the routes' reading ({said}: {verdict['reason']}) is not evidence of a "
+                       "fault")
 
 
 def _below_floor_unresolved(out, rms, floor, units):
@@ -241,8 +243,9 @@ def _below_floor_unresolved(out, rms, floor, units):
     if floor is not None and rms < floor:
         ev = result["evidence"]
         result.update(diagnosis="none", verdict="no fault evidence")
-        ev["reason"] = (f"the signal carries {rms:.3g} {units} rms ({rms / floor:.2g} mg), below the 1 mg "
-                        f"measurability floor of an accelerometer chain; the speed is unresolved too ({ev['reason']})")
+        ev["reason"] = (f"the signal carries {rms:.3g} {units} rms, {rms / floor:.2g} times the measurability "
+                        f"floor of an accelerometer chain ({floor:.3g} {units} over 0-fs/2: 1 mg over 10 kHz); the "
+                        f"speed is unresolved too ({ev['reason']})")
         ev["candidates"] = []
     return result, extras
 

@@ -1,4 +1,4 @@
-"""The 1 mg measurability floor: a noise-free healthy model is no fault evidence."""
+"""The measurability floor (1 mg over 10 kHz): a noise-free healthy model is no fault evidence."""
 import numpy as np
 import pytest
 
@@ -14,8 +14,10 @@ def healthy():
 
 
 def test_floor_in_units():
+    """1 mg over 10 kHz (10 ug per root hertz), white: 0.316 mg in a 1 kHz band."""
     assert floor_in_units("m s-2") == pytest.approx(0.00980665)
     assert floor_in_units("g") == pytest.approx(0.001)
+    assert floor_in_units("g", 1000.0) == pytest.approx(0.001 / np.sqrt(10))
     assert floor_in_units("m") is None and floor_in_units("no such unit") is None
 
 
@@ -37,7 +39,7 @@ def test_noise_free_healthy_simulation_is_no_fault_evidence(healthy):
     for rpm in (float(ds.attrs["shaft_speed_rpm"]), None):
         r = analyze(x, fs, rpm=rpm, rpm_source="file", **kw)
         assert r["verdict"] == "no fault evidence" and r["diagnosis"] == "none", r["evidence"]["reason"]
-        assert "1 mg" in r["evidence"]["reason"]
+        assert "measurability floor" in r["evidence"]["reason"]
     unfloored = analyze(x, fs, rpm=float(ds.attrs["shaft_speed_rpm"]), rpm_source="file", units="V", **kw)
     assert unfloored["diagnosis"] in ("outer_race", "uncertain")  # what the floor protects against
 
@@ -48,8 +50,9 @@ def test_the_floor_is_an_amplitude_gate_in_the_signals_unit(healthy):
     x, fs, ds = healthy
     kw = dict(bearing=ds.attrs["bearing"], rpm=float(ds.attrs["shaft_speed_rpm"]), rpm_source="file")
     r = analyze(x / 9.80665, fs, units="g", **kw)
-    assert r["evidence"]["band"]["floor_rms"] == pytest.approx(0.001)
+    b = r["evidence"]["band"]
+    assert b["floor_rms"] == pytest.approx(0.001 * np.sqrt((b["high_hz"] - b["low_hz"]) / 10000.0))
     assert r["verdict"] == "no fault evidence"
     loud = analyze(100 * x, fs, **kw)
     assert loud["evidence"]["band"]["rms"] > FLOOR_MS2
-    assert "1 mg" not in loud["evidence"]["reason"]
+    assert "measurability floor" not in loud["evidence"]["reason"]
