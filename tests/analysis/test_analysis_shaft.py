@@ -144,3 +144,26 @@ def test_stored_speed_is_not_contradicted_by_its_own_fault_comb(monkeypatch):
     assert sp["status"] == "unconfirmed" and sp["shaft_hz"] == 30.0
     assert "BPFO comb of the file speed" in sp["note"]
     assert _shaft._own_comb(get_bearing("6205"), 25.0, 29.37, 0.02) is None
+
+
+def _ses_with_family(f0, key="bpfo", seed=0, with_family=True):
+    """A synthetic envelope spectrum (0.1 Hz bins, exponential noise) with lines at k F (k = 1..5)
+    of the 6205's ``key`` family at shaft f0, 30 dB over the floor."""
+    from bearing_lab.analysis._families import CyclicSpectrum
+    f = np.arange(0, 3000, 0.1)
+    s = np.random.default_rng(seed).exponential(1.0, f.size)
+    if with_family:
+        F = get_bearing("6205").fault_frequencies(f0)[key]
+        for k in range(1, 6):
+            s[int(round(k * F / 0.1))] = 1000.0
+    return CyclicSpectrum(f, s)
+
+
+def test_only_the_pre_whitened_spectrum_confirms_a_blind_speed():
+    """A BPFO family in the kurtogram band's spectrum alone does not confirm f0 (the band may
+    hold discrete lines); in the pre-whitened spectrum it does.  Breaking it: letting the
+    kurtogram band count confirms the speed from the first pair too."""
+    g = get_bearing("6205")
+    with_f, without = _ses_with_family(29.9), _ses_with_family(29.9, with_family=False)
+    assert _shaft._corroborated(lambda f0: [without, with_f], g, 29.9, 0.02) is None
+    assert _shaft._corroborated(lambda f0: [with_f, without], g, 29.9, 0.02) == "bpfo"
