@@ -14,8 +14,9 @@ demodulation band, 1.55 mg over the 24 kHz of a 48 kHz record.  Below it, a
 fault family is not evidence of a fault: the verdict is "no fault evidence".
 
 A blind speed's plain 1x family (:mod:`._shaft`) must carry ``FLOOR_MS2`` in its
-lines: a shaft in service vibrates more (the quietest severity zone of ISO
-10816-3, 0.7 mm/s rms, is about 14 mg at 30 Hz).
+lines, a chosen threshold: machines in service vibrate more at their shaft
+harmonics (ISO 10816-1 calls class I machines good up to 0.71 mm/s rms; even
+0.1 mm/s at 30 Hz is 1.9 mg).
 
 The floor is converted to the signal's unit; for a unit that is not an
 acceleration (or not known) no floor applies, and the result says so.
