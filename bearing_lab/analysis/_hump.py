@@ -84,7 +84,10 @@ def route_humps(f, s, fault_hz, *, shaft_hz, factors, tolerance=0.02):
     race = {k: hump_score(f, s, fault_hz[k], **kw) for k in ("bpfo", "bpfi")}
     dec = np.array([hump_score(f, s, r * shaft_hz, **kw) for r in decoy_ratios(factors, tolerance=tolerance)])
     dec = dec[np.isfinite(dec)]
-    out = {"score_db": score, "bpfo_db": race["bpfo"], "bpfi_db": race["bpfi"], "decoys": int(dec.size),
+    def num(v):
+        return float(v) if np.isfinite(v) else None  # NaN: the spectrum does not reach the humps
+    out = {"score_db": num(score), "bpfo_db": num(race["bpfo"]), "bpfi_db": num(race["bpfi"]),
+           "decoys": int(dec.size),
            "decoy_max_db": float(dec.max()) if dec.size else None, "decoy_threshold_db": None, "clear": False}
     if dec.size < MIN_DECOYS or not np.isfinite(score):
         return out
