@@ -80,9 +80,12 @@ def recordings(mirror):
 
 def _row(label, truth, group, res_stored, res_blind):
     def cell(r):
+        band = r["evidence"].get("band") or {}
         return {"diagnosis": r["diagnosis"], "verdict": r["verdict"], "source": r["speed_source"],
                 "status": r["speed"]["status"], "shaft_hz": r["shaft_hz"],
-                "candidates": r["evidence"]["candidates"]}
+                "candidates": r["evidence"]["candidates"], "band_rms": band.get("rms"),
+                "band_floor": band.get("floor_rms"),
+                "hump": "hump" in r["evidence"]["reason"]}
     return {"label": label, "truth": truth, "group": group, "stored": cell(res_stored), "blind": cell(res_blind)}
 
 
@@ -218,8 +221,8 @@ def _detail_table(rows):
         if b["source"] == "estimated" and s["status"] == "confirmed":
             err = f" ({100 * (b['shaft_hz'] / s['shaft_hz'] - 1):+.3f} %)"
         bf = f"{b['shaft_hz']:.3f}{err}" if b["source"] == "estimated" else "-"
-        flag = " **WRONG**" if _wrong(s, r["truth"]) else ""
-        flagb = " **WRONG**" if _wrong(b, r["truth"]) else ""
+        flag = (" **WRONG**" if _wrong(s, r["truth"]) else "") + (" (humps)" if s.get("hump") else "")
+        flagb = (" **WRONG**" if _wrong(b, r["truth"]) else "") + (" (humps)" if b.get("hump") else "")
         lines.append(f"| {r['label']} | {r['truth']} | {_fmt(s)}{flag} | {s['status']} | {_fmt(b)}{flagb} | "
                      f"{b['source']} | {bf} |")
     return "\n".join(lines)
@@ -236,13 +239,29 @@ def _speed_summary(rows):
             f"{unres} of {len(rows)} records unresolved (diagnosis `uncertain`).")
 
 
+def _floor_table(rows):
+    """Demodulation band rms per data set (stored speed): in mg, and over the band's floor."""
+    lines = ["| data set | n | lowest band rms (mg) | median band rms (mg) | lowest band rms / floor |",
+             "|---|---|---|---|---|"]
+    for group in sorted({r["group"] for r in rows}):
+        sel = [r["stored"] for r in rows if r["group"] == group and r["stored"]["band_rms"] is not None]
+        if sel:
+            v = [c["band_rms"] / 0.00980665 for c in sel]
+            q = min(c["band_rms"] / c["band_floor"] for c in sel)
+            lines.append(f"| {group} | {len(v)} | {min(v):.3g} | {float(np.median(v)):.3g} | {q:.3g} |")
+    return "\n".join(lines)
+
+
 def report(rec_rows, sim_rows, times):
     out = [f"Machine: {platform.machine()}, Python {platform.python_version()}, numpy {np.__version__}."]
     if rec_rows:
         out += ["", "## Recordings, per class and mode", "", _class_table(rec_rows, "data set"),
-                "", _speed_summary(rec_rows), "", "## Every recording", "", _detail_table(rec_rows)]
+                "", _speed_summary(rec_rows), "", "## Demodulation band level against the floor (1 mg over 10 kHz)", "",
+                _floor_table(rec_rows), "", "## Every recording", "", _detail_table(rec_rows)]
     if sim_rows:
+        healthy = [r for r in sim_rows if r["truth"] == "none"]
         out += ["", "## Simulations (2 s), per variant", "", _class_table(sim_rows, "variant"),
+                "", "Healthy scenes, demodulation band level:", "", _floor_table(healthy).replace("data set", "variant"),
                 "", "## Every simulation", "", _detail_table(sim_rows)]
     if times:
         out += ["", "## CPU time of `analyze`, 10 s at 20 kHz (best of repeats, one thread)", "",

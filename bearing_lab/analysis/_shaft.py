@@ -32,11 +32,25 @@ shaft:
      ``f_s`` is judged the same way;
    - if a fault family of the bearing is detected at the frequencies ``f0``
      implies (noise rule and decoys, :mod:`._families`) in the squared envelope
-     spectrum of the pre-whitened signal or of the kurtogram band the diagnosis
-     would use at ``f0``, the kinematics confirm ``f0``;
+     spectrum of the cepstrum-pre-whitened signal, the kinematics confirm ``f0``.
+     Only that spectrum counts: pre-whitening removes discrete lines (shaft
+     harmonics, a slip-free comb) and keeps the slipping impacts of a fault, and
+     the harmonics of ``f0`` are masked there, so a comb at ``f0`` cannot confirm
+     ``f0``;
+   - if no fault reading of the family is plausible, it is a **plain 1x family**
+     and names the speed: its comb ``k f0`` shows in no envelope spectrum
+     (pre-whitened or kurtogram band; a fault's impacts modulate the resonances,
+     unbalance and misalignment do not), it is not a comb of discrete lines
+     reaching the resonances (a slip-free impact train), no other speed's 1x
+     family makes it a fault comb, and at least half of the harmonics searched
+     are clear lines (a few weak lines, such as a healthy bearing's ball-pass
+     lines, are not enough);
    - otherwise the speed is **unresolved**: a shaft and a fault comb would look
-     the same.  A healthy machine without a speed thus stays unresolved; without
-     a fault family there is nothing to name anyway.
+     the same.
+
+4. **A stored or given speed is never overridden by its own fault comb**: a
+   blind family within the slip tolerance of the prior's BPFO, BPFI, 2 BSF or
+   FTF leaves the prior "unconfirmed", not "contradicted".
 """
 from __future__ import annotations
 
@@ -45,7 +59,8 @@ from scipy import fft as _fft
 from scipy.stats import binom
 
 from ..errors import AnalysisError
-from ._families import search_families
+from ._families import SK_MIN, search_families
+from ._faults import FUNDAMENTAL_SNR_DB, MIN_HARMONICS
 from ._speed import LINE_SNR_DB, SNR_CAP_DB, interpolated_peak, line_floor_db
 
 __all__ = ["RawLines", "resolve_speed", "MIN_SHAFT_LINES", "PRIOR_TOLERANCE", "BLIND_RANGE_HZ"]
@@ -60,6 +75,11 @@ BLIND_RANGE_HZ = (5.0, 100.0)
 N_SHAFT_HARMONICS = 20
 #: A 1x family must be less likely than this to arise by chance in its search range.
 CHANCE_MAX = 1e-3
+#: A plain 1x family (no fault family to confirm it) has half of its harmonics searched, or all of
+#: the first PLAIN_FIRST, as clear lines.
+PLAIN_FIRST = 5
+#: Harmonics of a candidate examined in the envelope spectra for a fault comb.
+COMB_HARMONICS = 5
 #: A comb is "discrete" when this fraction of its harmonics up the spectrum are clear lines.
 DISCRETE_FRACTION = 0.5
 
@@ -80,6 +100,7 @@ class RawLines:
     def __init__(self, x, fs, *, top_hz, mains_hz=(50.0, 60.0)):
         n = x.size
         self.fs, self.n, self.df = float(fs), n, fs / n
+        self.x = x
         top = min(int(np.ceil(top_hz / self.df)) + 64, n // 2)
         self.X = _fft.rfft(x - x.mean())[: top + 2]
         amp = np.abs(self.X)
@@ -95,6 +116,17 @@ class RawLines:
         local[1:-1] = (amp[1:-1] >= amp[:-2]) & (amp[1:-1] >= amp[2:])
         self.clear = np.where(masked | (self.snr < LINE_SNR_DB) | ~local, 0.0, self.snr)
         self.top_hz = (amp.size - 3) * self.df
+
+    min_rms = None  # measurability floor of a plain 1x family, in signal units (None: no floor)
+
+    def family_rms(self, fam):
+        """rms of a family's clear lines (rectangular-window peak amplitudes 2|X|/N)."""
+        amps = []
+        for h in fam["harmonics"]:
+            k = int(round(h * fam["shaft_hz"] / self.df))
+            if 1 <= k < self.amp.size - 1:
+                amps.append(2.0 * self.amp[k - 1:k + 2].max() / self.n)
+        return float(np.sqrt(0.5 * np.sum(np.square(amps))))
 
     def n_harmonics(self, hi):
         return int(max(1, min(N_SHAFT_HARMONICS, np.floor(min(self.top_hz, 0.45 * self.fs) / hi))))
@@ -296,12 +328,24 @@ def _alternatives(raw, fam, factors, lo, hi, tolerance):
     return out
 
 
+def _spectra(cs, f0):
+    """(pre-whitened SES, kurtogram-band SES or None) that ``cs`` gives for f0."""
+    if cs is None:
+        return None, None
+    specs = list(cs(f0)) if callable(cs) else [cs]
+    return specs[0], (specs[1] if len(specs) > 1 else None)
+
+
 def _corroborated(cs, geometry, f0, tolerance):
     """The strongest fault family detected (noise rule and decoys) at the frequencies f0
-    implies, in any of the spectra ``cs`` gives for f0 (the pre-whitened squared envelope
-    spectrum, and that of the kurtogram band the diagnosis at f0 would use); None if none."""
+    implies in the squared envelope spectrum of the cepstrum-pre-whitened signal; None if
+    none.  Only that spectrum confirms a speed: pre-whitening removes the discrete lines
+    (shaft harmonics, a slip-free comb) and keeps the slipping impacts of a bearing fault,
+    and the search masks the harmonics of f0 itself, so a comb at f0 cannot confirm f0.
+    The kurtogram band's spectrum is not used: a band chosen for its impulsiveness may
+    hold a comb of discrete lines."""
     hits = {}
-    for spec in (cs(f0) if callable(cs) else [cs]):
+    for spec in _spectra(cs, f0)[:1]:
         if spec is None:
             continue
         try:
@@ -332,12 +376,64 @@ def _judge(raw, cs, geometry, fam, lo, hi, tolerance, depth=0):
     if fault is not None:
         return {"resolved": True, "family": fam, "candidates": cands,
                 "note": f"{len(fam['harmonics'])} shaft harmonics; the {fault.upper()} family at this speed "
-                        "is detected in the envelope spectrum"}
+                        "is detected in the envelope spectrum of the pre-whitened signal"}
+    comb = _fault_comb(raw, cs, f0, fam["harmonics"])
+    hs = set(fam["harmonics"])
+    rich = len(hs) >= DISCRETE_FRACTION * raw.n_harmonics(hi) or hs >= set(range(1, PLAIN_FIRST + 1))
+    fam_rms = raw.family_rms(fam)
+    loud = raw.min_rms is None or fam_rms >= raw.min_rms
+    if comb is None and not alts and rich and loud:
+        return {"resolved": True, "family": fam, "candidates": cands,
+                "note": f"a plain 1x family: {len(fam['harmonics'])} shaft harmonics that are neither an "
+                        "envelope comb nor a comb of discrete lines reaching the resonances, so no fault "
+                        "reading of them is plausible"}
     readings = ", ".join(f"{n} of a {f0 / (factors[k] * m):.2f} Hz shaft" for n, k, m in FAULT_RATIOS
                          if lo <= f0 / (factors[k] * m) <= hi)
+    readings_c = [{"shaft_hz": float(f0 / (factors[k] * m)), "harmonics": 0, "snr_db": 0.0,
+                   "note": f"if the {f0:.3f} Hz family is its {n} comb"} for n, k, m in FAULT_RATIOS
+                  if lo <= f0 / (factors[k] * m) <= hi]
+    cands = cands + readings_c
+    why = comb or ("another speed's 1x family makes it a fault comb" if alts else
+                   f"{len(fam['harmonics'])} clear harmonics of {raw.n_harmonics(hi)}: too few for a plain 1x "
+                   "family without a fault family to confirm it" if not rich else
+                   f"its lines carry {fam_rms:.3g} rms, below the measurability floor {raw.min_rms:.3g}: a shaft "
+                   "in service vibrates more, a healthy bearing's ball-pass lines can be this small")
     return {"resolved": False, "family": fam, "candidates": [_summary(fam, "1x line family")] + cands,
             "note": f"no fault family at the frequencies {f0:.3f} Hz implies confirms it as the shaft, and "
-                    f"its line family could be a fault comb: {readings or 'of another speed'}"}
+                    f"its line family could be a fault comb ({why}): {readings or 'of another speed'}"}
+
+
+def _fault_comb(raw, cs, f0, lines_h=()):
+    """Why the line family at f0 could be the comb of a fault's impacts, or None.
+
+    A fault's impacts modulate the structural resonances, so their comb shows in an
+    envelope spectrum; a slip-free impact train (a simulation) is also a comb of discrete
+    lines reaching the resonances.  Shaft harmonics of unbalance or misalignment are
+    neither.  The test: the comb k f0 (k = 1..COMB_HARMONICS, each within one bin) passes the
+    noise rule (a fundamental line, MIN_HARMONICS lines) in the pre-whitened envelope spectrum or in that of the kurtogram band when the band is
+    impulsive (spectral kurtosis at least ``SK_MIN``: a band of a few steady lines has an
+    envelope beating at their spacing) and lies above the family's clear lines
+    ``lines_h``, or is a discrete comb up to 0.45 fs
+    (:func:`discrete_comb`)."""
+    for name, spec in zip(("pre-whitened", "kurtogram band's"), _spectra(cs, f0)):
+        if spec is None or getattr(spec, "kurtosis", SK_MIN) < SK_MIN:
+            continue  # a band without impulsiveness holds no impact comb (its lines beat)
+        band = getattr(spec, "band", None)
+        if band is not None and band[0] < (max(lines_h, default=0) + 1) * f0:
+            continue  # the band holds the family's own lines: its envelope beats at f0 anyway
+        k = np.arange(1, COMB_HARMONICS + 1)
+        if k[-1] * f0 + 2 * spec.df >= spec.f[-1]:
+            continue
+        _, snr = spec.best(k * f0, 1)  # lines within one bin: f0 is known to a fraction of a bin
+        if snr[0] >= FUNDAMENTAL_SNR_DB and np.count_nonzero(snr > 0) >= MIN_HARMONICS:
+            return f"a comb of {np.count_nonzero(snr > 0)} lines in the {name} envelope spectrum"
+    if raw.x is not None:
+        discrete, frac, count = discrete_comb(raw.x, raw.fs, f0)
+        if discrete:
+            return f"a comb of discrete lines up to 0.45 fs ({100 * frac:.0f} % of {count} harmonics)"
+    if cs is None:
+        return "no envelope spectrum to tell"
+    return None
 
 
 def _blind(raw, cs, geometry, tolerance, lo, hi):
@@ -356,8 +452,18 @@ def _blind(raw, cs, geometry, tolerance, lo, hi):
                     f"explain in {lo:g}-{hi:g} Hz"}
 
 
+def _own_comb(geometry, prior_hz, f_hz, tolerance):
+    """Name of the fault family of ``prior_hz`` whose carrier lies at ``f_hz`` within the
+    slip tolerance, or None: a stored speed is never overridden by its own fault comb."""
+    factors = geometry.frequency_factors()
+    for name, key, mult in FAULT_RATIOS:
+        if abs(f_hz / (prior_hz * mult * factors[key]) - 1) <= tolerance:
+            return name
+    return None
+
+
 def resolve_speed(x, fs, geometry, *, rpm=None, rpm_source="given", cs=None, tolerance=0.02,
-                  blind_range_hz=BLIND_RANGE_HZ):
+                  blind_range_hz=BLIND_RANGE_HZ, min_family_rms=None):
     """Shaft frequency from a prior speed or the signal alone (module docstring).
 
     Parameters
@@ -378,6 +484,9 @@ def resolve_speed(x, fs, geometry, *, rpm=None, rpm_source="given", cs=None, tol
         Slip tolerance of fault frequencies.
     blind_range_hz : (float, float)
         Search range without a prior.
+    min_family_rms : float, optional
+        Measurability floor (signal units, rms) a plain 1x family must reach to name a
+        blind speed without a fault family to confirm it.
 
     Returns
     -------
@@ -393,6 +502,7 @@ def resolve_speed(x, fs, geometry, *, rpm=None, rpm_source="given", cs=None, tol
     prior = None if rpm is None else float(rpm) / 60.0
     hi_all = max(hi_b, prior * (1 + PRIOR_TOLERANCE) if prior else 0.0)
     raw = RawLines(x, fs, top_hz=min(0.45 * fs, N_SHAFT_HARMONICS * hi_all * 1.03))
+    raw.min_rms = min_family_rms
     lowest = prior * (1 - PRIOR_TOLERANCE) if prior else lo_b
     if 4 * raw.df > lowest:
         msg = (f"the record lasts {x.size / fs:.3g} s: its 1/T = {raw.df:.3g} Hz bins cannot resolve shaft "
@@ -411,6 +521,11 @@ def resolve_speed(x, fs, geometry, *, rpm=None, rpm_source="given", cs=None, tol
         out.update(source="estimated" if res["resolved"] else "unresolved",
                    status="resolved" if res["resolved"] else "unresolved")
         return out
+    return _with_prior(raw, cs, geometry, out, prior, rpm_source, tolerance, lo_b, hi_b)
+
+
+def _with_prior(raw, cs, geometry, out, prior, rpm_source, tolerance, lo_b, hi_b):
+    """Rules 2 and 4: refine a given or stored speed, or keep it, or mark it contradicted."""
     lo, hi = prior * (1 - PRIOR_TOLERANCE), prior * (1 + PRIOR_TOLERANCE)
     for f0 in raw.candidates(lo, hi, count=3):
         fam = raw.family(f0, hi)
@@ -425,7 +540,14 @@ def resolve_speed(x, fs, geometry, *, rpm=None, rpm_source="given", cs=None, tol
         out["candidates"].append(_summary(fam, why or "outside the window"))
     blind = _blind(raw, cs, geometry, tolerance, lo_b, hi_b)
     f_b = blind["family"]["shaft_hz"] if blind["family"] else None
-    if blind["resolved"] and not lo <= f_b <= hi:
+    own = _own_comb(geometry, prior, f_b, tolerance) if blind["resolved"] else None
+    if own is not None:
+        out.update(status="unconfirmed",
+                   note=f"no 1x line family within +-{100 * PRIOR_TOLERANCE:g} % of the {rpm_source} speed; the "
+                        f"signal's line family at {f_b:.3f} Hz is the {own} comb of the {rpm_source} speed, which "
+                        "is used as it is")
+        out["candidates"].append(_summary(blind["family"], f"{own} comb of the {rpm_source} speed"))
+    elif blind["resolved"] and not lo <= f_b <= hi:
         out.update(status="contradicted", deviation_pct=100 * (f_b / prior - 1),
                    note=f"no 1x family near the {rpm_source} speed, but the signal's own 1x family is at "
                         f"{f_b:.3f} Hz ({60 * f_b:.1f} r/min): the {rpm_source} speed may be wrong")

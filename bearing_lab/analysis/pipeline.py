@@ -41,6 +41,8 @@ from ..errors import AnalysisError, BearingLabError
 from ._diagnosis import (coincidences, combine, deciding_route, interpretations, route_summary, run_routes,
                          runner_up, spectrum_top)
 from ._families import LABELS, CyclicSpectrum
+from ._floor import band_rms, floor_in_units
+from ._hump import apply as apply_humps
 from ._impulse import excitation_period
 from ._metrics import METRIC_NAMES, metrics
 from ._shaft import BLIND_RANGE_HZ, resolve_speed
@@ -91,7 +93,7 @@ def _tacho_speed(x, fs, tacho, pulses_per_rev):
 
 
 def _speed(x, fs, geom, *, rpm, rpm_source, shaft_hz, tacho, pulses_per_rev, tolerance, n_harmonics,
-           fallback=True):
+           fallback=True, units="m s-2"):
     """(signal to analyse, speed dict, pre-whitened signal or None)."""
     if shaft_hz is not None:
         fr = float(shaft_hz)
@@ -121,15 +123,17 @@ def _speed(x, fs, geom, *, rpm, rpm_source, shaft_hz, tacho, pulses_per_rev, tol
         nb = int(2 ** np.floor(np.log2(max(1.0, fs / 2 / line_top))))
         if nb not in cache:
             try:
-                band = fast_kurtogram(x, fs, min_bandwidth=fs / 2 / nb).band
+                kg = fast_kurtogram(x, fs, min_bandwidth=fs / 2 / nb)
                 top = min(0.49 * fs, spectrum_top(geom.fault_frequencies(BLIND_RANGE_HZ[1]), BLIND_RANGE_HZ[1],
                                                   tolerance=tolerance, n_harmonics=n_harmonics))
-                cache[nb] = CyclicSpectrum(*squared_envelope_spectrum(x, fs, window="hann", band=band, fmax=top))
+                cache[nb] = CyclicSpectrum(*squared_envelope_spectrum(x, fs, window="hann", band=kg.band, fmax=top))
+                cache[nb].band, cache[nb].kurtosis = kg.band, float(kg.kurtosis_max)
             except AnalysisError:
                 cache[nb] = None
         return [cache["cpw"], cache[nb]]
 
-    sp = resolve_speed(x, fs, geom, rpm=rpm, rpm_source=rpm_source, cs=spectra, tolerance=tolerance)
+    sp = resolve_speed(x, fs, geom, rpm=rpm, rpm_source=rpm_source, cs=spectra, tolerance=tolerance,
+                       min_family_rms=floor_in_units(units))
     if sp["shaft_hz"] is None and fallback:
         # nothing to go by: the strongest harmonic family, for the fault-frequency table only
         sp["shaft_hz"] = float(shaft_frequency(x, fs, window="boxcar")[0])
@@ -167,7 +171,7 @@ def _evidence(res, verdict, speed, fs, n, tolerance, n_harmonics, decided):
 
 
 def _run(x, fs, *, bearing, rpm=None, shaft_hz=None, tolerance=0.02, n_harmonics=5, prewhiten=False,
-         rpm_source="given", tacho=None, pulses_per_rev=1):
+         rpm_source="given", tacho=None, pulses_per_rev=1, units="m s-2"):
     fs = check_fs(fs, func="analyze")
     x = check_signal(x, func="analyze", min_samples=1024)
     if x.ndim != 1:
@@ -175,20 +179,28 @@ def _run(x, fs, *, bearing, rpm=None, shaft_hz=None, tolerance=0.02, n_harmonics
     geom = _bearing(bearing)
     m = metrics(x)
     xa, speed, xw = _speed(x, fs, geom, rpm=rpm, rpm_source=rpm_source, shaft_hz=shaft_hz, tacho=tacho,
-                           pulses_per_rev=pulses_per_rev, tolerance=tolerance, n_harmonics=n_harmonics)
+                           pulses_per_rev=pulses_per_rev, tolerance=tolerance, n_harmonics=n_harmonics,
+                           units=units)
     fr = float(speed["shaft_hz"])
     if speed["status"] == "unresolved":
-        return _unresolved(speed, geom, fs, xa.size, m, tolerance, n_harmonics)
+        out = _unresolved(speed, geom, fs, xa.size, m, tolerance, n_harmonics)
+        return _below_floor_unresolved(out, band_rms(xa, fs, None), floor_in_units(units, fs / 2), units)
     res = run_routes(xa, fs, geom, fr, tolerance=tolerance, n_harmonics=n_harmonics, prewhiten=prewhiten,
                      xw=xw if xa is x else None)
     routes = res["routes"]
-    verdict = combine(routes, speed)
+    verdict, humps = apply_humps(combine(routes, speed), routes, res["fault_hz"], shaft_hz=fr,
+                                 factors=geom.frequency_factors(), speed_status=speed["status"], tolerance=tolerance)
+    width = fs / 2 if res["band"] is None else res["band"][1] - res["band"][0]
+    floor = floor_in_units(units, width)
+    verdict = _floor_verdict(verdict, band_rms(xa, fs, res["band"]), floor, units)
     decided = deciding_route(routes)
     key = {v: k for k, v in LABELS.items()}.get(verdict["diagnosis"]) if verdict["verdict"] == "diagnosed" else None
     period = None
     if key is not None:
         by = verdict["decided_by"]
-        if by == ["ees"]:
+        if verdict.get("hump"):  # a smeared family has no line to refine: the kinematic rate
+            period = 1.0 / (2.0 * res["fault_hz"]["bsf"])
+        elif by == ["ees"]:
             period = 1.0 / routes["ees"]["families"][key]["measured_hz"]
         else:
             period = _period(routes, by[0], key, xa, res["xw"], fs, res["band"])
@@ -205,8 +217,36 @@ def _run(x, fs, *, bearing, rpm=None, shaft_hz=None, tolerance=0.02, n_harmonics
             "detected": bool(ln["detected"] and ln.get("explained_by") is None)}
     result["evidence"] = _evidence(res, verdict, speed, fs, xa.size, tolerance, n_harmonics, decided)
     result["evidence"]["reported_route"] = decided
+    result["evidence"]["band"].update(rms=verdict["band_rms"], floor_rms=floor)
+    result["evidence"]["ball_humps"] = humps
     extras = {"f": routes[decided]["f"], "ses": routes[decided]["spectrum"], "band": res["band"],
               "lines": fams, "bearing": geom, "routes": routes, "route": decided}
+    return result, extras
+
+
+def _floor_verdict(verdict, rms, floor, units):
+    """No fault evidence when the demodulation band carries less than the 1 mg floor (:mod:`._floor`)."""
+    verdict = dict(verdict, band_rms=rms)
+    if floor is None or rms >= floor or verdict["verdict"] == "no fault evidence":
+        return verdict
+    said = verdict["diagnosis"] if verdict["verdict"] == "diagnosed" else "uncertain"
+    return dict(verdict, diagnosis="none", verdict="no fault evidence", decided_by=[],
+                reason=f"the demodulation band carries {rms:.3g} {units} rms, {rms / floor:.2g} times the "
+                       f"measurability floor of an accelerometer chain ({floor:.3g} {units} in this band: 1 mg "
+                       f"over 10 kHz): the routes' reading ({said}: {verdict['reason']}) is not evidence of a "
+                       "fault")
+
+
+def _below_floor_unresolved(out, rms, floor, units):
+    """An unresolved speed on a signal below the floor: nothing measurable, no fault evidence."""
+    result, extras = out
+    if floor is not None and rms < floor:
+        ev = result["evidence"]
+        result.update(diagnosis="none", verdict="no fault evidence")
+        ev["reason"] = (f"the signal carries {rms:.3g} {units} rms, {rms / floor:.2g} times the measurability "
+                        f"floor of an accelerometer chain ({floor:.3g} {units} over 0-fs/2: 1 mg over 10 kHz); the "
+                        f"speed is unresolved too ({ev['reason']})")
+        ev["candidates"] = []
     return result, extras
 
 
@@ -248,7 +288,8 @@ def _unresolved(speed, geom, fs, n, m, tolerance, n_harmonics):
     return result, extras
 
 
-def shaft_speed(x, fs, *, bearing, rpm=None, rpm_source="given", tolerance=0.02, n_harmonics=5):
+def shaft_speed(x, fs, *, bearing, rpm=None, rpm_source="given", tolerance=0.02, n_harmonics=5,
+                units="m s-2"):
     """Shaft speed of a vibration signal, checked against the bearing's kinematics.
 
     The speed step of :func:`analyze` on its own: a given or stored ``rpm`` is a
@@ -265,8 +306,8 @@ def shaft_speed(x, fs, *, bearing, rpm=None, rpm_source="given", tolerance=0.02,
         Prior speed, r/min (None: blind).
     rpm_source : {"given", "file"}
         Where ``rpm`` comes from.
-    tolerance, n_harmonics
-        As in :func:`analyze`.
+    tolerance, n_harmonics, units
+        As in :func:`analyze` (``units`` sets the 1 mg floor a plain 1x family must reach).
 
     Returns
     -------
@@ -297,7 +338,7 @@ def shaft_speed(x, fs, *, bearing, rpm=None, rpm_source="given", tolerance=0.02,
     if x.ndim != 1:
         raise AnalysisError(f"shaft_speed: x must be one channel (1-D), got shape {x.shape}")
     _, sp, _ = _speed(x, fs, _bearing(bearing), rpm=rpm, rpm_source=rpm_source, shaft_hz=None, tacho=None,
-                      pulses_per_rev=1, tolerance=tolerance, n_harmonics=n_harmonics, fallback=False)
+                      pulses_per_rev=1, tolerance=tolerance, n_harmonics=n_harmonics, fallback=False, units=units)
     return sp
 
 
@@ -382,7 +423,7 @@ def analyze(x, fs, *, bearing, rpm=None, shaft_hz=None, channel="", units="m s-2
     """
     result, _ = _run(x, fs, bearing=bearing, rpm=rpm, shaft_hz=shaft_hz, tolerance=tolerance,
                      n_harmonics=n_harmonics, prewhiten=prewhiten, rpm_source=rpm_source, tacho=tacho,
-                     pulses_per_rev=pulses_per_rev)
+                     pulses_per_rev=pulses_per_rev, units=units)
     result["channel"] = str(channel)
     result["units"] = str(units)
     return result
@@ -421,7 +462,7 @@ def plot_analysis(x, fs, *, bearing, rpm=None, shaft_hz=None, channel="", units=
         # a bare Figure (no pyplot): no backend switch, no global state; savefig works headless
         from matplotlib.figure import Figure
         fig = Figure(figsize=(10, 9), layout="constrained")
-    result, ex = _run(x, fs, bearing=bearing, rpm=rpm, shaft_hz=shaft_hz, **kwargs)
+    result, ex = _run(x, fs, bearing=bearing, rpm=rpm, shaft_hz=shaft_hz, units=units, **kwargs)
     result["channel"], result["units"] = str(channel), str(units)
     x = np.asarray(x, float)
     ax1, ax2, ax3 = fig.subplots(3, 1)

@@ -208,7 +208,9 @@ def _print(result, path, name, fs, bearing, units, tacho_name, note, plot):
     if ev.get("band") and ev["band"]["low_hz"] is not None:
         b = ev["band"]
         print(f"  demodulation band {b['low_hz']:.0f}-{b['high_hz']:.0f} Hz, spectral kurtosis "
-              f"{b['spectral_kurtosis']:.2f}{'' if b['impulsive'] else ' (not impulsive)'}")
+              f"{b['spectral_kurtosis']:.2f}{'' if b['impulsive'] else ' (not impulsive)'}"
+              + (f", {b['rms']:.3g} {units} rms" if b.get("rms") is not None else "")
+              + (f" (measurability floor {b['floor_rms']:.3g})" if b.get("floor_rms") else ""))
     for route, r in ev.get("routes", {}).items():
         print(f"  route {route}: {r['verdict']} ({r['reason']})")
     for r in ev.get("interpretations", []):

@@ -120,11 +120,16 @@ class CwruReader(RecordingReader):
         m = load_mat(path)
         if channels is None and record is None:
             self._check_unclaimed(b, m, found, rec, rpm_var)
-        # sampling rate: the file name's record first, then the variables' record
+        # sampling rate: the registry entry with this file's sha256 first (renamed files, and
+        # files whose variables carry another record's number), then the file name's record,
+        # then the variables' record
         cands = [n for n in dict.fromkeys([file_no, rec]) if n is not None]
+        by_sha = _registered_by_content(path)
         regs = {n: datasets.cwru_record(n) for n in cands}
         rates = {r.fs_hz for r in regs.values() if r is not None and r.fs_hz}
         reg = regs.get(file_no) or regs.get(rec)
+        if by_sha is not None and by_sha.fs_hz:
+            reg, rates = by_sha, {by_sha.fs_hz}
         if fs is None:
             if len(rates) == 1:
                 fs = rates.pop()
@@ -134,7 +139,8 @@ class CwruReader(RecordingReader):
                        "--fs) as the data centre lists it")
             else:
                 b.fail(f"records {cands} have different registered rates {sorted(rates)}; pass fs=")
-            b.attrs["sampling_rate_source"] = "registry data/recordings.csv"
+            b.attrs["sampling_rate_source"] = "registry data/recordings.csv" + (
+                f" (file content, sha256, of {by_sha.name})" if reg is by_sha else "")
         else:
             b.attrs["sampling_rate_source"] = "user"
         order = [c for c in ("DE", "FE", "BA") if c in found[rec]]
@@ -159,6 +165,19 @@ class CwruReader(RecordingReader):
                             "cwru_defect_position": reg.defect_position or None,
                             "bearing": reg.bearing, "registry_name": reg.name})
         return b.build(fs=fs, shaft_speed_rpm=rpm, default_channel="DE", channels=channels)
+
+
+def _registered_by_content(path):
+    """The registry entry whose sha256 is this file's (None if none, or the file is large)."""
+    from .. import datasets
+    from .._files import sha256_file
+    if path.stat().st_size > 256 * 2 ** 20:
+        return None
+    known = [r for r in datasets.load_registry().values() if r.sha256 and r.dataset.startswith("cwru")]
+    if not known:
+        return None
+    digest = sha256_file(path)
+    return next((r for r in known if r.sha256 == digest), None)
 
 
 ENGINES["cwru"] = CwruReader

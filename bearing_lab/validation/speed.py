@@ -3,11 +3,11 @@
 Why the care: every fault frequency scales with the speed, and a simulation at a wrong
 speed compares nothing.  A case says ``speed = <r/min>`` (given), ``"file"`` (stored in
 the recording, e.g. by ``bearing-lab import --rpm``) or ``"estimate"`` (from the
-signal).  The estimate goes through :func:`estimate_speed`, the one adapter to the
-analysis layer's tacholess estimator, so a better estimator plugs in here.  An estimate
-that cannot tell the shaft family from a fault family (an outer-race comb at BPFO looks
-like shaft harmonics at BPFO) is *unresolved*: the case stops with the candidates,
-never simulating at a guessed speed.
+signal).  The estimate is the analysis layer's public estimator,
+:func:`bearing_lab.analysis.shaft_speed`, with its guards: a line family that could
+be a fault comb of the bearing (an outer-race comb at BPFO looks like shaft harmonics
+at BPFO) is never taken for the shaft.  An estimate the signal cannot settle is
+*unresolved*: the case stops with the candidates, never simulating at a guessed speed.
 
 Public API
 ----------
@@ -19,16 +19,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import numpy as np
-
 from ..errors import AnalysisError, ValidationCaseError
 
 __all__ = ["Speed", "estimate_speed", "resolve_speed"]
-
-#: a harmonic family this long in a signal this impulsive (Pearson kurtosis; Gaussian = 3) looks like an
-#: impact train, not like the few shaft harmonics unbalance and misalignment give
-_COMB_LINES = 10
-_IMPULSIVE = 4.0
 
 
 @dataclass(frozen=True)
@@ -41,60 +34,42 @@ class Speed:
     candidates: tuple = ()
 
 
-def _has_line(x, fs, f0) -> bool:
-    """Whether a line stands at ``f0`` (+-1 %) in the amplitude spectrum (the fault search's threshold)."""
-    from ..analysis.measurement import shaft_line
-    try:
-        return shaft_line(x, fs, f0, tolerance=0.01)[0] is not None
-    except AnalysisError:
-        return False
+def _candidates(sp, first=None):
+    out = [] if first is None else [float(first)]
+    for c in sp.get("candidates", ()):
+        if c.get("shaft_hz") and all(abs(60.0 * c["shaft_hz"] / o - 1) > 1e-3 for o in out):
+            out.append(60.0 * float(c["shaft_hz"]))
+    return tuple(out)
 
 
 def estimate_speed(x, fs, *, bearing, prior_rpm=None) -> Speed:
-    """Estimate the shaft speed from the signal (the analysis layer's estimator) and check it.
+    """Estimate the shaft speed with :func:`bearing_lab.analysis.shaft_speed` (one estimator).
 
-    A result of the estimator that returns a ``speed_source`` (and may say ``unresolved``)
-    is passed through.  Today's estimator returns a frequency only: it is then checked
-    against the fault families of ``bearing``: when the found family could equally be
-    a BPFO or BPFI comb of a slower shaft (whose own line is present, or the family is
-    long and the signal impulsive, as an impact train is), the estimate is unresolved
-    and the candidates are returned.
+    Without a prior, the estimate is resolved only when the analysis layer resolves it
+    (a 1x family confirmed by a fault family of ``bearing`` in the pre-whitened envelope
+    spectrum, or a plain 1x family no fault reading explains).  With a stored prior, the
+    signal's 1x family within 5 % refines it; a prior the signal does not confirm is used
+    as it is (and said so); a prior the signal contradicts stops the case.
     """
-    from ..analysis import shaft_frequency
-    from ..bearings import get_bearing
-    geom = get_bearing(bearing) if isinstance(bearing, str) else bearing
+    from .. import analysis
     try:
-        res = shaft_frequency(x, fs, window="hann", rpm=prior_rpm)
+        sp = analysis.shaft_speed(x, fs, bearing=bearing, rpm=prior_rpm, rpm_source="file")
     except AnalysisError as exc:
         return Speed(float("nan"), f"estimate failed: {exc}", False)
-    if isinstance(res, dict):  # an estimator that reports its own source and resolution
-        rpm = 60.0 * float(res.get("shaft_hz", float("nan")))
-        ok = res.get("speed_source", "") != "unresolved" and rpm > 0
-        return Speed(rpm, f"estimated from the recording ({res.get('speed_source', '')})", ok,
-                     tuple(60.0 * float(c) for c in res.get("candidates", ())))
-    fr, nlines = float(res[0]), int(res[1])
-    source = f"estimated from the recording's shaft line family ({nlines} harmonics at {fr:.3f} Hz)"
-    if prior_rpm is not None:
-        return Speed(60.0 * fr, source + f", searched within 5 % of {prior_rpm:g} r/min")
-    factors = geom.frequency_factors()
-    rivals = [(60.0 * fr / factors[k], k) for k in ("bpfo", "bpfi") if fr / factors[k] > 2.0
-              and _has_line(x, fs, fr / factors[k])]
-    if not rivals and nlines >= _COMB_LINES and _kurtosis(x) > _IMPULSIVE:
-        # a long harmonic family in an impulsive signal is what an impact train looks like: without a
-        # shaft line of its own, nothing says it is the shaft's family and not a fault comb
-        rivals = [(60.0 * fr / factors[k], k) for k in ("bpfo", "bpfi") if fr / factors[k] > 2.0]
-    if rivals:
-        cands = (60.0 * fr,) + tuple(r for r, _ in rivals)
-        what = "; ".join(f"{r:.1f} r/min if the lines are its {k.upper()}" for r, k in rivals)
-        return Speed(60.0 * fr, f"unresolved: a line family at {fr:.3f} Hz ({60 * fr:.1f} r/min as the shaft), "
-                                f"or {what}", False, cands)
-    return Speed(60.0 * fr, source)
-
-
-def _kurtosis(x) -> float:
-    x = np.asarray(x, float) - np.mean(x)
-    v = np.mean(x * x)
-    return float(np.mean(x ** 4) / v ** 2) if v > 0 else 0.0
+    fr = sp["shaft_hz"]
+    rpm = float("nan") if fr is None else 60.0 * float(fr)
+    if prior_rpm is None:
+        if sp["source"] == "estimated":
+            return Speed(rpm, f"estimated from the recording ({sp['harmonics']} shaft harmonics at {fr:.3f} Hz; "
+                              f"{sp['note']})")
+        return Speed(rpm, f"unresolved: {sp['note']}", False, _candidates(sp, None if fr is None else rpm))
+    if sp["status"] == "confirmed":
+        return Speed(rpm, f"estimated from the recording within 5 % of the stored {prior_rpm:g} r/min "
+                          f"({sp['harmonics']} shaft harmonics)")
+    if sp["status"] == "contradicted":
+        return Speed(float(prior_rpm), f"unresolved: {sp['note']}", False, _candidates(sp, prior_rpm))
+    return Speed(float(prior_rpm), f"stored in the recording ({prior_rpm:g} r/min), not confirmed by the "
+                                   f"signal: {sp['note']}")
 
 
 def resolve_speed(spec, dataset, x, *, bearing, case_name, where="speed") -> Speed:

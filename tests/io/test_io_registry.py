@@ -153,3 +153,25 @@ def test_fetch_of_an_unhashed_row_warns(tmp_path, monkeypatch):
     monkeypatch.setattr(datasets, "load_registry", lambda path=None: reg)
     with pytest.warns(datasets.UnverifiedWarning, match="not verified"):
         datasets.fetch(name, mirror=_fake_mirror(tmp_path), dest=tmp_path / "d", download=False)
+
+
+def test_cwru_files_open_with_their_registered_rate_by_content(datafile, tmp_path):
+    """Every 48 kHz drive-end file opens at 48 kHz without fs=, also IR014_0 whose variables
+    carry record 173 while the data centre lists it as 174, and also under another name: the
+    registry is found by the file's sha256.  Breaking it: without the content lookup, IR014_0
+    asks for fs= (record 173 is not registered)."""
+    import shutil
+    import warnings
+
+    from bearing_lab.io import open_recording
+    for name in ("B007_0", "IR007_0", "IR014_0"):
+        src = datafile(f"cwru/48k_DE/{name}.mat")
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            ds = open_recording(src, checksum=False)
+            assert ds.attrs["sampling_rate_hz"] == 48000.0, name
+            renamed = tmp_path / f"renamed_{name}.mat"
+            shutil.copyfile(src, renamed)
+            ds2 = open_recording(renamed, checksum=False)
+        assert ds2.attrs["sampling_rate_hz"] == 48000.0 and "sha256" in ds2.attrs["sampling_rate_source"]
+        assert ds2.attrs["registry_name"] == f"cwru/48k_DE/{name}.mat"
