@@ -28,6 +28,9 @@ def register(subparsers):
     p.add_argument("--no-refine", action="store_true", help="no refinement around the best coarse scene")
     p.add_argument("--workers", type=int, default=2, help="Dask worker processes (default 2)")
     p.add_argument("--serial", action="store_true", help="run in this process, no Dask")
+    p.add_argument("--cache", default=None, metavar="DIR",
+                   help="keep the simulated scenes in this sweep cache (about 3.6 MB per scene of 1 s at 20 kHz; "
+                        "default: not kept; contact tables are always cached)")
     p.add_argument("--amplitude-weight", type=float, default=None,
                    help="weight of the amplitude in the score (default: 1 with an independent path, else 0)")
     p.add_argument("--report", action="store_true", help="add the result to DIR/<case>/index.html (run validate first)")
@@ -55,7 +58,7 @@ def run(args) -> int:
               + ("" if args.no_refine else f" + up to {2 * len(grid)} refinements"), file=sys.stderr)
     res = identify(case, grid=grid, refine=not args.no_refine, scheduler="serial" if args.serial else "local",
                    n_workers=args.workers, progress=not args.no_progress, level_weight=args.amplitude_weight,
-                   mirror=args.mirror)
+                   mirror=args.mirror, cache_dir=args.cache or False)
     paths = write_identification(res, args.output, report=args.report)
     if args.json:
         from .._json import clean
