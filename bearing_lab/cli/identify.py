@@ -17,8 +17,8 @@ def register(subparsers):
         description=("Search simulated scenes around the case's declared defect (length 0.5-2x, offset 0-B/2, "
                      "skew -60..60 deg by default) for the one whose impact signature after the fixed structural "
                      "path and background matches the recording; report an interval per parameter, or that it "
-                     "is not identifiable.  The default grid is 140 scenes plus 6 refinements (about 0.7 s CPU "
-                     "each for a 1 s record at 20 kHz)."))
+                     "is not identifiable.  The default grid is 140 scenes plus up to 6 refinements (about 0.8 s CPU "
+                     "each for a 1 s record at 20 kHz, 0.2 s once the contact tables are cached)."))
     p.add_argument("case", metavar="CASE", help="case TOML file (docs/case-format.md) with one [[defect]]")
     p.add_argument("-o", "--output", default="reports", metavar="DIR", help="output directory (default: reports)")
     p.add_argument("--length-mm", type=float, nargs="+", default=None, help="along-track lengths to search, mm")
@@ -26,8 +26,9 @@ def register(subparsers):
     p.add_argument("--skew-deg", type=float, nargs="+", default=None, help="skews θ to search, degrees")
     p.add_argument("--depth-mm", type=float, nargs="+", default=None, help="depths to search, mm (default: not searched)")
     p.add_argument("--no-refine", action="store_true", help="no refinement around the best coarse scene")
-    p.add_argument("--workers", type=int, default=2, help="Dask worker processes (default 2)")
-    p.add_argument("--serial", action="store_true", help="run in this process, no Dask")
+    p.add_argument("--workers", type=int, default=1,
+                   help="Dask worker processes (default 1: in this process, no Dask; measured faster on a "
+                        "shared 2-core machine, see docs/identification.md)")
     p.add_argument("--cache", default=None, metavar="DIR",
                    help="keep the simulated scenes in this sweep cache (about 3.6 MB per scene of 1 s at 20 kHz; "
                         "default: not kept; contact tables are always cached)")
@@ -44,6 +45,9 @@ def run(args) -> int:
     from ..validation import load_case
     from ..validation.identify import default_grid, identify
     from ..validation.identify_report import write_identification
+    from ..errors import ValidationCaseError
+    if args.workers < 1:
+        raise ValidationCaseError(f"--workers {args.workers}: give 1 (in this process) or more Dask worker processes")
     case = load_case(args.case)
     grid = default_grid(case)
     for key, given in (("defect.length_mm", args.length_mm), ("defect.offset_mm", args.offset_mm),
@@ -56,7 +60,7 @@ def run(args) -> int:
     if not args.json:
         print(f"identify {case.name}: {n} scenes on the coarse grid"
               + ("" if args.no_refine else f" + up to {2 * len(grid)} refinements"), file=sys.stderr)
-    res = identify(case, grid=grid, refine=not args.no_refine, scheduler="serial" if args.serial else "local",
+    res = identify(case, grid=grid, refine=not args.no_refine, scheduler="serial" if args.workers <= 1 else "local",
                    n_workers=args.workers, progress=not args.no_progress, level_weight=args.amplitude_weight,
                    mirror=args.mirror, cache_dir=args.cache or False)
     paths = write_identification(res, args.output, report=args.report)

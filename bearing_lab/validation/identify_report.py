@@ -78,11 +78,13 @@ def figures(result) -> list:
         ax.plot(v, s, "o-", color="k", ms=3)
         ax.axhline(min(s) + result.threshold_db, color="tab:red", lw=0.8, ls="--")
         ax.axvspan(*p["interval"], color="tab:red", alpha=0.12)
-        ax.set_xlabel(f"{k.split('.')[1]} ({p['unit']})")
+        from .identify import PARAMS
+        ax.set_xlabel(f"{PARAMS[k][0]} ({p['unit']})")
         ax.set_title(("" if p["identifiable"] else "not identifiable: ") + f"best {p['best']:g}", fontsize=9)
     axes[0].set_ylabel("profile misfit (dB)")
-    out.append((fig2, f"Misfit profiles: the best score over the other parameters at each value; dashed: best + "
-                      f"{result.threshold_db:.2f} dB (the interval threshold); shaded: the interval."))
+    out.append((fig2, f"Misfit profiles: the best score over the other parameters at each value (at a refinement "
+                      f"value: its single scene); dashed: best + {result.threshold_db:.2f} dB (the interval "
+                      f"threshold); shaded: the interval."))
     return out
 
 

@@ -55,7 +55,7 @@ def test_a_flat_profile_is_called_not_identifiable(found):
 def test_cli_identify_writes_json_netcdf_and_figures(found, capsys):
     import xarray as xr
     d, case, _ = found
-    args = ["identify", str(case), "-o", str(d / "out"), "--json", "--no-progress", "--serial",
+    args = ["identify", str(case), "-o", str(d / "out"), "--json", "--no-progress",
             "--length-mm", "3.0", "--offset-mm", "0.25", "0.5", "--skew-deg", "30", "--no-refine"]
     assert main(args) == 0
     out = json.loads(capsys.readouterr().out)
