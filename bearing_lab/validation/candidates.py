@@ -48,8 +48,9 @@ class Setting:
 
 
 def _level_weight(prep, path, level_weight):
+    from .recording_parts import context
     sp = prep.case.section("structural_path")
-    fitted_here = sp.get("method", "fit") == "fit" and not sp.get("from_case") and not sp.get("file")
+    fitted_here = context(prep.case, prep, path)["path_fitted_here"]
     if level_weight is not None:
         return float(level_weight), "set by the caller"
     if sp.get("method") == "none":

@@ -144,7 +144,9 @@ def _profile(points, key, threshold):
     # the profile is known at the sampled values only: a minimum between samples cannot be excluded
     # up to the next sampled value on each side of the accepted ones
     lo, hi = vals[max(min(ok) - 1, 0)], vals[min(max(ok) + 1, len(vals) - 1)]
-    if flat:
+    if len(vals) == 1:
+        text = f"{name}: held at {vals[0]:g} {unit} (one value searched)"
+    elif flat:
         text = (f"{name}: not identifiable from this recording (the misfit changes by at most "
                 f"{max(prof) - min(prof):.2f} dB over {vals[0]:g}-{vals[-1]:g} {unit}, within the {threshold:.2f} dB "
                 "threshold)")
@@ -153,7 +155,8 @@ def _profile(points, key, threshold):
         text = (f"{name}: {vals[best_i]:g} {unit}, interval {lo:g}-{hi:g} {unit}"
                 + (f" (reaches the {' and '.join(edge)} end of the searched range: the interval may extend beyond it)"
                    if edge else ""))
-    return {"best": vals[best_i], "interval": [lo, hi], "identifiable": not flat, "statement": text,
+    return {"best": vals[best_i], "interval": [lo, hi], "identifiable": not flat, "searched": len(vals) > 1,
+            "statement": text,
             "unit": unit, "profile": [[v, s] for v, s in zip(vals, prof)]}
 
 

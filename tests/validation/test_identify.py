@@ -60,8 +60,48 @@ def test_cli_identify_writes_json_netcdf_and_figures(found, capsys):
     assert main(args) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["n_scenes"] == 2 and set(out["parameters"]) == set(GRID)
-    assert out["parameters"]["defect.length_mm"]["identifiable"] is False   # one value: nothing to tell
+    length = out["parameters"]["defect.length_mm"]      # one value: nothing to tell, and said so
+    assert length["identifiable"] is False and length["searched"] is False and "held at 3 mm" in length["statement"]
     ds = xr.open_dataset(d / "out" / "rig" / "identification.nc")
     assert ds["score_db"].dims == ("defect_length_mm", "defect_offset_mm", "defect_skew_deg")
     assert ds["score_db"].attrs["units"] == "dB" and np.isfinite(ds["score_db"]).all()
     assert (d / "out" / "rig" / "identification.html").is_file()
+
+
+@pytest.mark.parametrize("defects,needle", [("", "exactly one [[defect]]"),
+                                            ('[[defect]]\nrace = "outer"\nwidth_mm = 1.0\n', "length_mm")])
+def test_bad_input_is_a_clear_error_before_anything_runs(tmp_path, capsys, defects, needle):
+    case = tmp_path / "c.toml"
+    case.write_text(f'name = "c"\nbearing = "6308"\nspeed = 1793.0\n[recording]\nfile = "none.uff"\n'
+                    f'[tolerances]\nbpfo = {{}}\n[load]\nradial_n = 320.0\n{defects}')
+    assert main(["identify", str(case), "-o", str(tmp_path), "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    assert needle in err and "'c'" in err, err
+
+
+def test_bad_grid_and_workers_are_refused(tmp_path, capsys):
+    from bearing_lab.errors import ValidationCaseError
+    case = tmp_path / "c.toml"
+    case.write_text('name = "c"\nbearing = "6308"\nspeed = 1793.0\n[recording]\nfile = "none.uff"\n'
+                    '[tolerances]\nbpfo = {}\n[load]\nradial_n = 320.0\n'
+                    '[[defect]]\nrace = "outer"\nlength_mm = 3.0\nwidth_mm = 1.0\n')
+    with pytest.raises(ValidationCaseError, match="defect.widht_mm"):
+        identify(case, grid={"defect.widht_mm": [1.0]}, progress=False)
+    assert main(["identify", str(case), "--workers", "0", "--no-progress"]) == 2
+    assert "--workers 0" in capsys.readouterr().err
+
+
+def test_report_adds_the_identification_to_an_existing_case_page(found, tmp_path):
+    from bearing_lab.report import Report
+    from bearing_lab.validation.identify_report import add_to_case_report
+    _, _, r = found
+    page = Report("rig: validation")
+    page.add_html("<p>the comparison table</p>", "Comparison table")
+    page.save(tmp_path / "report.json")
+    add_to_case_report(r, tmp_path)
+    add_to_case_report(r, tmp_path)              # twice: replaced, not repeated
+    html = (tmp_path / "index.html").read_text()
+    assert "the comparison table" in html and html.count("<h2") >= 3
+    assert Report.load(tmp_path / "report.json").sections[0]["title"] == "Comparison table"
+    titles = [s["title"] for s in Report.load(tmp_path / "report.json").sections]
+    assert titles == ["Comparison table", "Defect identification", "Defect identification: figures"]
