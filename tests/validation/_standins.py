@@ -48,15 +48,17 @@ def calibration(d: Path) -> Path:
     return case
 
 
-def hidden(d: Path, scene, offset_mm, skew_deg, *, seed, calib: Path, name=None, **case_kw) -> Path:
-    """A recording of a hidden defect; its case declares the nominal size at H = 0, theta = 0 and takes
-    the structural path from the calibration case."""
+def hidden(d: Path, scene, offset_mm, skew_deg, *, seed, calib: Path, name=None, declared_length_mm=None,
+           **case_kw) -> Path:
+    """A recording of a hidden defect; its case declares the nominal size (or ``declared_length_mm``) at
+    H = 0, theta = 0 and takes the structural path from the calibration case."""
     name = name or f"{scene[-2:]}_H{offset_mm:g}_t{skew_deg:g}"
     rec = d / f"{name}.uff"
     make_standin_recording(rec, scene=scene, rpm=RPM, duration=2.0, seed=seed,
                            overrides={"load.radial_n": LOAD_N, "defect.offset_mm": offset_mm,
                                       "defect.skew_deg": skew_deg})
     length, width = SIZES[scene]
+    length = length if declared_length_mm is None else declared_length_mm
     case = d / f"{name}.toml"
     case.write_text(case_text(name, rec, length_mm=length, width_mm=width, path_from=calib, **case_kw))
     return case
