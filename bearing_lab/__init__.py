@@ -29,6 +29,9 @@ def __getattr__(name):
     if name == "sweep":
         from .sweeps import sweep
         return sweep
+    if name == "identify":
+        from .validation.identify import identify
+        return identify
     raise AttributeError(f"module 'bearing_lab' has no attribute {name!r}")
 
 

@@ -22,6 +22,7 @@ COMMAND_MODULES = [
     "study",      # study
     "validate",   # validate
     "case",       # case new, case standin
+    "identify",   # identify (defect geometry from a recording)
     "bench",      # bench
     "sweep",      # sweep (bearing_lab.sweep on Dask)
 ]

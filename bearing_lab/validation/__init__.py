@@ -38,6 +38,9 @@ def __getattr__(name):
     if name in ("make_standin_recording", "StandIn"):
         from . import standin
         return getattr(standin, name)
+    if name == "identify":
+        from .identify import identify
+        return identify
     if name == "new_case_text":
         from .newcase import new_case_text
         return new_case_text

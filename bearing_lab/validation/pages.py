@@ -132,6 +132,7 @@ def write_case(case, result, out, *, wall) -> str:
     if result.path is not None and result.path.resonances:
         result.path.save(out / "structural_path.json")
     report.save(out / "index.html")
+    report.save(out / "report.json")      # reloadable: `bearing-lab identify --report` adds its sections
     s = summary(case, result, wall)
     with atomic_open(out / "summary.json", "w", encoding="utf-8") as fh:
         json.dump(s, fh, indent=1, default=str)

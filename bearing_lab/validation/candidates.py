@@ -1,0 +1,145 @@
+"""Candidate defect geometries scored against a recording through the fixed path and background.
+
+The recording is prepared once (:func:`~bearing_lab.validation.recording_case.prepare`);
+every candidate is simulated, passed through the *same* structural path and background
+(never re-fitted), and its impact signature (:mod:`.signature`) compared with the
+recording's.  The lower the score, the better the candidate explains the recording.
+
+Public API
+----------
+Setting                                                   -- what every candidate is compared with
+setting_for(prep, path, background, *, level_weight=None, band_hz=None) -> Setting
+candidate_signature(setting, x) -> Signature              -- a simulated signal's signature (path + background applied)
+score_candidates(prep, path, background, candidates, **kw) -> {label: misfit dict}, best first
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..analysis.impacts import impact_times
+from ..errors import AnalysisError, ValidationCaseError
+from .signature import WINDOW_S, impact_signature, misfit
+
+__all__ = ["Setting", "setting_for", "candidate_signature", "score_candidates", "DEFAULT_BAND_HZ"]
+
+#: the signature's band: above the machine tones and the shaft harmonics (all below 1 kHz on
+#: bench rigs), up to 0.45 fs (the anti-alias filter's flat part); a broad band keeps the
+#: entry and exit events apart in time (a narrow band would smear them over 1/bandwidth)
+DEFAULT_BAND_HZ = (1000.0, None)
+
+
+@dataclass
+class Setting:
+    """The recording side of a comparison, fixed for every candidate."""
+
+    prep: object
+    path: object
+    background: object
+    period_s: float
+    band_hz: tuple
+    measured: object                    # Signature of the recording
+    level_weight: float
+    level_reason: str
+    noise_db: float                     # misfit of the recording's two halves of impacts
+    seed: int = 0
+    notes: list = field(default_factory=list)
+
+
+def _level_weight(prep, path, level_weight):
+    from .recording_parts import context
+    sp = prep.case.section("structural_path")
+    fitted_here = context(prep.case, prep, path)["path_fitted_here"]
+    if level_weight is not None:
+        return float(level_weight), "set by the caller"
+    if sp.get("method") == "none":
+        return 0.0, ("no structural path (method = \"none\"): the simulated amplitude is the outer ring's, "
+                     "not the sensor's, so only the shape is compared")
+    if fitted_here:
+        return 0.0, ("the structural path's gain was fitted on this recording against the declared defect, so "
+                     "the amplitude is not independent of the geometry: only the shape is compared (use a path "
+                     "identified on another recording of the rig, from_case or file, to use the amplitude)")
+    return 1.0, f"the structural path is independent of this recording ({path.source})"
+
+
+def _halves_noise(x, fs, times, band):
+    """Misfit between the signatures of the odd and the even impacts: the score's own noise."""
+    if times.size < 6:
+        return float("nan")
+    a = impact_signature(x, fs, times[0::2], band=band)
+    b = impact_signature(x, fs, times[1::2], band=band)
+    return float(misfit(a, b, level_weight=1.0)["score_db"])
+
+
+_FAMILY = {"outer": "bpfo", "inner": "bpfi"}
+
+
+def _period(prep) -> tuple:
+    """The impact period: the measured one, else the declared race's measured fault line."""
+    m = prep.measured["record"]
+    period = float(m["excitation_period"])
+    if np.isfinite(period):
+        return period, ""
+    races = {str(d.get("race", "outer")) for d in prep.case.data.get("defect", [])}
+    fam = _FAMILY.get(races.pop()) if len(races) == 1 else None
+    if fam and np.isfinite(m[fam]):
+        return 1.0 / float(m[fam]), (f"no fault was diagnosed on its own; the impacts are timed at the measured "
+                                     f"{fam.upper()} line ({float(m[fam]):.2f} Hz) of the declared defect's race")
+    return float("nan"), ""
+
+
+def setting_for(prep, path, background, *, level_weight=None, band_hz=None, seed=None) -> Setting:
+    """The measured signature, period, band and level weight every candidate is scored with."""
+    m = prep.measured["record"]
+    period, period_note = _period(prep)
+    if not np.isfinite(period):
+        raise ValidationCaseError(
+            f"validation case {prep.case.name!r}: the recording shows no impact train, so there is no defect "
+            f"event to identify ({m['extras']['notes'].get('excitation_period', '')})")
+    if path.status == "failed":
+        raise ValidationCaseError(f"validation case {prep.case.name!r}: the structural path failed "
+                                  f"({'; '.join(path.problems)}); a geometry cannot be compared through it")
+    lo, hi = band_hz or DEFAULT_BAND_HZ
+    band = (float(lo), float(hi) if hi else 0.45 * prep.fs)
+    x = prep.recording.segment(prep.n)
+    times = impact_times(x, prep.fs, period, band=band)
+    try:
+        meas = impact_signature(x, prep.fs, times, band=band)
+    except AnalysisError as exc:
+        raise ValidationCaseError(f"validation case {prep.case.name!r}: {exc}") from None
+    w, why = _level_weight(prep, path, level_weight)
+    seed = int(prep.case.section("background").get("seed", 0)) if seed is None else int(seed)
+    notes = [] if path.status == "ok" else [f"the structural path is {path.status}: " + "; ".join(path.problems)]
+    notes += [period_note] if period_note else []
+    return Setting(prep, path, background, period, band, meas, w, why,
+                   _halves_noise(x, prep.fs, times, band), seed, notes)
+
+
+def candidate_signature(setting: Setting, x):
+    """Signature of a simulated outer-ring signal ``x`` after the fixed path and background."""
+    prep = setting.prep
+    x = np.asarray(x, float)[: prep.n]
+    y = setting.path.apply(x, prep.fs)
+    if setting.background is not None:
+        y = y + setting.background.synthesize(y.size, seed=setting.seed)
+    times = impact_times(y, prep.fs, setting.period_s, band=setting.band_hz)
+    return impact_signature(y, prep.fs, times, band=setting.band_hz, window_s=WINDOW_S)
+
+
+def score_candidates(prep, path, background, candidates: dict, *, level_weight=None, band_hz=None) -> dict:
+    """Score candidate geometries (label -> scene keys, e.g. ``{"defect.offset_mm": 0.33}``).
+
+    Returns label -> misfit dict (``score_db``, ``shape_db``, ``level_db``, ``lag_s``), ordered
+    best (lowest score) first; ``"_setting"`` is not a key, see :func:`setting_for` for that.
+    """
+    from . import simulation
+    from .recording_case import _scene_overrides
+    st = setting_for(prep, path, background, level_weight=level_weight, band_hz=band_hz)
+    out = {}
+    for label, ov in candidates.items():
+        scene = simulation.build_scene(prep.case, rpm=prep.speed.rpm, fs=prep.fs, duration=prep.n / prep.fs,
+                                       overrides={**_scene_overrides(prep.case), **ov})
+        sig = candidate_signature(st, simulation.signal(simulation.run(scene)))
+        out[label] = misfit(sig, st.measured, level_weight=st.level_weight)
+    return dict(sorted(out.items(), key=lambda kv: kv[1]["score_db"]))
