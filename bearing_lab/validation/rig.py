@@ -97,8 +97,12 @@ def path_for(case, rec, measured, sim_x, *, mirror=None) -> StructuralPath:
         path.source = f"read from {p.name} ({path.source})"
         return path
     if sp.get("from_case"):
-        from .case import load_case
-        other = load_case(sp["from_case"])
+        from .case import load_case, shipped_cases
+        ref = str(sp["from_case"])
+        if ref not in shipped_cases() and case.base_dir is not None and not Path(ref).expanduser().is_absolute():
+            beside = Path(str(case.base_dir)) / ref      # a relative file is read beside this case's file
+            ref = str(beside) if beside.is_file() else ref
+        other = load_case(ref)
         path = identify_path(other, mirror=mirror)
         return StructuralPath(path.resonances, path.gain, f"identified by case {other.name!r}: {path.source}",
                               dict(path.fit), dict(path.curves))

@@ -123,3 +123,21 @@ def test_the_fit_takes_a_recording_and_a_simulated_dataset():
     assert path.resonances[0].frequency_hz == pytest.approx(3100.0, rel=0.03)
     with pytest.raises(AnalysisError, match="simulate at the recording's rate"):
         fit_structural_path(ds(measured), ds(_impacts(), fs=2 * FS), None, PERIOD)
+
+
+def test_from_case_file_is_read_beside_the_case(tmp_path, monkeypatch):
+    """A relative ``from_case`` file names a case beside the case file, wherever the user runs from."""
+    from tests.validation._standins import case_text
+    from bearing_lab.validation import rig
+    from bearing_lab.validation.case import load_case
+    rigdir, elsewhere = tmp_path / "rig", tmp_path / "elsewhere"
+    rigdir.mkdir(), elsewhere.mkdir()
+    (rigdir / "calib.toml").write_text(case_text("calib", "calib.uff", length_mm=3.0, width_mm=1.0))
+    (rigdir / "run2.toml").write_text(case_text("run2", "run2.uff", length_mm=3.0, width_mm=1.0,
+                                                path_from="calib.toml"))
+    seen = []
+    monkeypatch.setattr(rig, "identify_path",
+                        lambda other, mirror=None: seen.append(other.name) or StructuralPath.identity())
+    monkeypatch.chdir(elsewhere)
+    path = rig.path_for(load_case(str(rigdir / "run2.toml")), None, None, None)
+    assert seen == ["calib"] and "calib" in path.source
