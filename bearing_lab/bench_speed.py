@@ -40,8 +40,8 @@ OURS = ([("dp54", r, None) for r in (1e-3, 1e-4, 1e-5, 1e-6)]
         + [("bs32", r, None) for r in (1e-3, 1e-4, 1e-5)]
         + [("rk4", 0.0, h) for h in (2e-5, 1e-5, 5e-6)])
 #: scipy's methods, each from loose to tight
-SCIPY = {"LSODA": (1e-4, 1e-5, 1e-6, 1e-7, 1e-8), "RK45": (1e-3, 1e-4, 1e-5, 1e-6),
-         "BDF": (1e-4, 1e-5, 1e-6, 1e-7), "Radau": (1e-4, 1e-5, 1e-6, 1e-7)}
+SCIPY = {"LSODA": (1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8), "RK45": (1e-2, 1e-3, 1e-4, 1e-5, 1e-6),
+         "BDF": (1e-3, 1e-4, 1e-5, 1e-6, 1e-7), "Radau": (1e-3, 1e-4, 1e-5, 1e-6, 1e-7)}
 MAX_STEP = 2.5e-5
 
 

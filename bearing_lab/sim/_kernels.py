@@ -50,6 +50,9 @@ P_UNB = 53      # shaft unbalance U = m e (kg m): a force U omega^2 turning with
 P_DRATE = 54    # damping rate over a defect: 0 the bodies' approach rate, 1 the rate of the
                 # contact law's equivalent penetration (including the rolling term)
 P_SIZE = 55
+# after P_SIZE: cos(2 pi j / Z) for j < Z, then sin(2 pi j / Z) (ball offsets around the cage,
+# so the right-hand side rotates them with 4 products instead of calling cos/sin per ball)
+P_TRIG = P_SIZE
 
 # ---- defect table layout: dint[k] = race, kind, npsi, ndelta, h_off, g_off, ball
 #   race 0: outer race, 1: inner race, 2: ball defect meeting the outer race,
@@ -322,10 +325,7 @@ def rhs(t, y, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, dy, fi_out, fo_out):
     dyn = p[P_CAGE] > 0.5
     c0 = math.cos(phic)
     s0 = math.sin(phic)
-    dc = math.cos(TWO_PI / z)
-    ds = math.sin(TWO_PI / z)
-    c = c0
-    s = s0
+    sp = TWO_PI / z
     pocket_torque = 0.0
     for j in range(z):
         if dyn:
@@ -335,14 +335,12 @@ def rhs(t, y, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, dy, fi_out, fo_out):
             c = math.cos(phi)
             s = math.sin(phi)
         else:
-            if j > 0:
-                # rotate by 2π/Z; re-anchor every 4 balls to keep rounding at 1e-16
-                if j % 4 == 0:
-                    c = math.cos(phic + TWO_PI * j / z)
-                    s = math.sin(phic + TWO_PI * j / z)
-                else:
-                    c, s = c * dc - s * ds, s * dc + c * ds
-            phi = phic + TWO_PI * j / z
+            # the cage angle rotated by the ball's offset (tabulated cos/sin of 2 pi j / Z)
+            cj = p[P_TRIG + j]
+            sj = p[P_TRIG + z + j]
+            c = c0 * cj - s0 * sj
+            s = s0 * cj + c0 * sj
+            phi = phic + sp * j
         if qs:
             dtot = (xi - xo) * c + (yi - yo) * s - 2.0 * pd4
             drate = (vxi - vxo) * c + (vyi - vyo) * s + ((xi - xo) * (-s) + (yi - yo) * c) * phidot
@@ -448,167 +446,3 @@ def rhs(t, y, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, dy, fi_out, fo_out):
         dy[sb + 1] = y[sb + 3]
         dy[sb + 2] = -2.0 * zt * w * y[sb + 2] - w * w * y[sb] - axo
         dy[sb + 3] = -2.0 * zt * w * y[sb + 3] - w * w * y[sb + 1] - ayo
-
-
-@njit(cache=True, error_model="numpy")
-def _step_limit(t, y, h, p, sp_t, sp_w, sp_th, dint, dflt, nsteps_def, hmax):
-    """Bound the step near defects: land on zone entry, then take >= nsteps_def steps inside."""
-    ndef = int(p[P_NDEF])
-    if ndef == 0:
-        return h
-    z = int(p[P_Z])
-    theta_s, omega_s = shaft_state(t, sp_t, sp_w, sp_th)
-    phic = p[P_PHI0] + p[P_FTF] * theta_s
-    phidot = p[P_FTF] * omega_s
-    spin = p[P_SPIN]
-    hh = h
-    for kk in range(ndef):
-        zlo = dflt[kk, F_ZLO]
-        zhi = dflt[kk, F_ZHI]
-        for j in range(z):
-            if p[P_CAGE] > 0.5:
-                rel, reld = rel_angle(kk, j, y[8 + 2 * z + j], y[8 + 3 * z + j], theta_s, omega_s, spin,
-                                      dint, dflt)
-            else:
-                rel, reld = rel_angle(kk, j, phic + TWO_PI * j / z, phidot, theta_s, omega_s, spin, dint, dflt)
-            if rel > 5.0 or abs(reld) < 1e-12:
-                continue
-            if zlo <= rel <= zhi:
-                hdef = (zhi - zlo) / abs(reld) / nsteps_def
-                if hdef < hh:
-                    hh = hdef
-            elif reld > 0.0 and rel < zlo:
-                tt = (zlo - rel) / reld
-                if tt < hh:
-                    hh = tt * (1.0 + 1e-9) + 1e-15
-            elif reld < 0.0 and rel > zhi:
-                tt = (rel - zhi) / (-reld)
-                if tt < hh:
-                    hh = tt * (1.0 + 1e-9) + 1e-15
-    return hh
-
-
-@njit(cache=True, error_model="numpy")
-def _hermite(y0, y1, f0, f1, h, th):
-    h00 = (1 + 2 * th) * (1 - th) ** 2
-    h10 = th * (1 - th) ** 2
-    h01 = th * th * (3 - 2 * th)
-    h11 = th * th * (th - 1)
-    return h00 * y0 + h10 * h * f0 + h01 * y1 + h11 * h * f1
-
-
-@njit(cache=True, error_model="numpy")
-def integrate(y, t, t_stop, h, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf,
-              a_tab, b_tab, e_tab, c_tab, order, fsal, adaptive, rtol, atol, hmax, nsteps_def,
-              vel_idx, vel_sign, fine_t, fine_out, fine_pos, out_t, out_state, out_pos, stats):
-    """Integrate from t to t_stop, writing dense output on two grids.
-
-    fine grid (``fine_t``): the accelerometer velocity channels (sum over
-    ``vel_idx`` rows with ``vel_sign``) for the anti-alias stage; output grid
-    (``out_t``): the whole state.  Returns (t, h, fine_pos, out_pos, status):
-    status 0 ok, 1 non-finite state, 2 step underflow.
-    """
-    n = y.shape[0]
-    s = b_tab.shape[0]
-    k = np.zeros((s, n))
-    ytmp = np.empty(n)
-    ynew = np.empty(n)
-    err = np.empty(n)
-    fi = np.empty(int(p[P_Z]))
-    fo = np.empty(int(p[P_Z]))
-    rhs(t, y, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, k[0], fi, fo)
-    nch = vel_idx.shape[0]
-    while t < t_stop:
-        hstep = h
-        if hstep > hmax:
-            hstep = hmax
-        if t + hstep > t_stop:
-            hstep = t_stop - t
-        hstep = _step_limit(t, y, hstep, p, sp_t, sp_w, sp_th, dint, dflt, nsteps_def, hstep)
-        if hstep < 1e-14:
-            hstep = 1e-14
-        for i in range(1, s):
-            for m in range(n):
-                acc = 0.0
-                for jj in range(i):
-                    acc += a_tab[i, jj] * k[jj, m]
-                ytmp[m] = y[m] + hstep * acc
-            rhs(t + c_tab[i] * hstep, ytmp, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, k[i], fi, fo)
-        for m in range(n):
-            acc = 0.0
-            acce = 0.0
-            for jj in range(s):
-                acc += b_tab[jj] * k[jj, m]
-                acce += e_tab[jj] * k[jj, m]
-            ynew[m] = y[m] + hstep * acc
-            err[m] = hstep * acce
-        accept = True
-        fac = 1.0
-        if adaptive:
-            en = 0.0
-            for m in range(n):
-                sc = atol[m] + rtol * max(abs(y[m]), abs(ynew[m]))
-                en += (err[m] / sc) ** 2
-            en = math.sqrt(en / n)
-            if not math.isfinite(en):
-                en = 1e10
-            if en > 1.0:
-                accept = False
-                fac = max(0.2, 0.9 * en ** (-1.0 / order))
-            else:
-                fac = 5.0 if en < 1e-10 else min(5.0, 0.9 * en ** (-1.0 / order))
-        if not accept:
-            h = hstep * fac
-            stats[1] += 1
-            if h < 1e-13:
-                return t, h, fine_pos, out_pos, 2
-            continue
-        # f at the new point: the FSAL stage, or one more evaluation
-        if fsal:
-            for m in range(n):
-                ytmp[m] = k[s - 1, m]
-        else:
-            rhs(t + hstep, ynew, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, ytmp, fi, fo)
-            stats[2] += 1
-        tn = t + hstep
-        # dense output: fine grid (accelerometer velocity), output grid (state)
-        while fine_pos < fine_t.shape[0] and fine_t[fine_pos] <= tn:
-            th = (fine_t[fine_pos] - t) / hstep
-            for ch in range(nch):
-                v = 0.0
-                for r in range(vel_idx.shape[1]):
-                    idx = vel_idx[ch, r]
-                    if idx >= 0:
-                        v += vel_sign[ch, r] * _hermite(y[idx], ynew[idx], k[0, idx], ytmp[idx], hstep, th)
-                fine_out[fine_pos, ch] = v
-            fine_pos += 1
-        while out_pos < out_t.shape[0] and out_t[out_pos] <= tn:
-            th = (out_t[out_pos] - t) / hstep
-            for m in range(n):
-                out_state[out_pos, m] = _hermite(y[m], ynew[m], k[0, m], ytmp[m], hstep, th)
-            out_pos += 1
-        for m in range(n):
-            y[m] = ynew[m]
-            k[0, m] = ytmp[m]
-            if not math.isfinite(y[m]):
-                return tn, h, fine_pos, out_pos, 1
-        t = tn
-        stats[0] += 1
-        if adaptive:
-            h = hstep * fac
-    return t, h, fine_pos, out_pos, 0
-
-
-@njit(cache=True, error_model="numpy")
-def loads_at(out_t, out_state, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, fi_all, fo_all):
-    """Ball loads (N) at the output samples from the interpolated states."""
-    n = out_state.shape[1]
-    dy = np.empty(n)
-    z = int(p[P_Z])
-    fi = np.empty(z)
-    fo = np.empty(z)
-    for i in range(out_t.shape[0]):
-        rhs(out_t[i], out_state[i], p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, dy, fi, fo)
-        for j in range(z):
-            fi_all[j, i] = fi[j]
-            fo_all[j, i] = fo[j]

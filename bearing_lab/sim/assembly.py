@@ -349,8 +349,10 @@ def assemble(scene: Scene, *, fidelity: str | None = None) -> Assembly:
     hbuf = np.concatenate(hparts) if hparts else np.zeros(1)
     gbuf = np.concatenate(gparts) if gparts and goff else np.zeros(1)
 
-    p = np.zeros(K.P_SIZE)
+    p = np.zeros(K.P_SIZE + 2 * z)
     p[K.P_Z] = z
+    p[K.P_TRIG:K.P_TRIG + z] = np.cos(2 * np.pi * np.arange(z) / z)
+    p[K.P_TRIG + z:K.P_TRIG + 2 * z] = np.sin(2 * np.pi * np.arange(z) / z)
     p[K.P_RP] = b.pitch_diameter / 2
     p[K.P_PD] = scene.clearance
     p[K.P_KI], p[K.P_KO], p[K.P_KEFF] = hi.stiffness, ho.stiffness, k_eff
