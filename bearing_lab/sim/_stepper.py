@@ -8,7 +8,7 @@ inlines it.
 Step-size control: the PI controller of Gustafsson (Hairer & Wanner, Solving ODEs II, IV.2;
 Hairer, Nørsett & Wanner I, II.4 and the DOPRI5 code):
 ``h_new = h · safe · err^-(1/q − 0.75 β) · err_prev^β`` with q the order of the error
-estimate plus one, β = 0.04 (dp54) / 0.08 (bs32), growth ≤ 5, shrink ≥ 0.2, and no growth
+estimate plus one, β = 0.08, growth ≤ 5, shrink ≥ 0.2, and no growth
 right after a rejected step.  Against the plain (I) controller it damps the oscillation of the
 step size at the stability bound of the ball-race contact mode, where most rejections came from.
 
@@ -48,7 +48,7 @@ C_DP = np.array([0.0, 0.2, 0.3, 0.8, 8.0 / 9.0, 1.0, 1.0])
 C_BS = np.array([0.0, 0.5, 0.75, 1.0])
 C_RK = np.array([0.0, 0.5, 0.5, 1.0])
 ORDER = np.array([5.0, 3.0, 4.0])
-BETA = np.array([0.04, 0.08, 0.0])
+BETA = np.array([0.08, 0.08, 0.0])
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -115,7 +115,7 @@ def _finish(method, y, k, h, ynew, err):
             err[m] = 0.0
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def step_limit(t, y, h, p, sp_t, sp_w, sp_th, dint, dflt, nsteps_def):
     """Bound the step near defects: land on zone entry, then take >= nsteps_def steps inside."""
     ndef = int(p[K.P_NDEF])
@@ -181,7 +181,7 @@ def _hermite(y0, y1, f0, f1, h, th):
     return h00 * y0 + h10 * h * f0 + h01 * y1 + h11 * h * f1
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def _dense(t, hstep, y, ynew, f0, f1, vel_idx, vel_sign, fine_t, fine_out, fine_pos, out_t, out_state, out_pos):
     """Cubic Hermite output on the fine (accelerometer velocity) and output (state) grids."""
     tn = t + hstep
@@ -243,7 +243,7 @@ def integrate(y, t, t_stop, h, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, met
             if fsal and st == ns:
                 for m in range(n):
                     ynew[m] = ytmp[m]
-            K.rhs(t + c[st] * hstep, ytmp, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, k[st], fi, fo)
+            K.rhs_inline(t + c[st] * hstep, ytmp, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, k[st], fi, fo)
         _finish(method, y, k, hstep, ynew, err)
         fac = 1.0
         if adaptive:
@@ -262,12 +262,14 @@ def integrate(y, t, t_stop, h, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, met
                 if h < 1e-13:
                     return t, h, fine_pos, out_pos, 2
                 continue
-            e = en if en > 1e-4 else 1e-4
-            fac = 0.9 * e ** (-expo) * ctrl[0] ** beta if en > 1e-10 else 5.0
+            # PI: h_new = h 0.9 err^-(1/q - 0.75 beta) err_prev^beta (one exp, one log: the
+            # previous error is kept as its logarithm)
+            le = math.log(en if en > 1e-4 else 1e-4)
+            fac = 0.9 * math.exp(-expo * le + beta * ctrl[0]) if en > 1e-10 else 5.0
             fac = min(5.0, max(0.2, fac))
             if ctrl[1] > 0.5 and fac > 1.0:
                 fac = 1.0
-            ctrl[0] = e
+            ctrl[0] = le
             ctrl[1] = 0.0
         # f at the new point: the FSAL stage, or one more evaluation
         f1 = k[ns]
@@ -299,7 +301,46 @@ def loads_at(out_t, out_state, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, fi_
     fi = np.empty(z)
     fo = np.empty(z)
     for i in range(out_t.shape[0]):
-        K.rhs(out_t[i], out_state[i], p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, dy, fi, fo)
+        K.rhs_inline(out_t[i], out_state[i], p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, dy, fi, fo)
         for j in range(z):
             fi_all[j, i] = fi[j]
             fo_all[j, i] = fo[j]
+
+
+@njit(cache=True, error_model="numpy")
+def fir_decimate(a_fine, taps_rev, s0, R, out):
+    """out[k, ch] = Σ_i a_fine[s0 + k R + i, ch] taps_rev[i]: the anti-alias FIR evaluated at
+    the kept samples only, on one thread (a BLAS product here spins up threads whose waiting
+    costs more CPU than the product)."""
+    nt = taps_rev.shape[0]
+    for kk in range(out.shape[0]):
+        b = s0 + kk * R
+        for ch in range(out.shape[1]):
+            acc = 0.0
+            for i in range(nt):
+                acc += a_fine[b + i, ch] * taps_rev[i]
+            out[kk, ch] = acc
+
+
+def _drop_stale_cache():
+    """numba keys a cached function on its own source file only, and these functions compile the
+    right-hand side of ``_kernels.py`` into themselves: when that file changes (a development
+    install), drop this module's cached machine code so it is compiled anew."""
+    import hashlib
+    from pathlib import Path
+    stamp = hashlib.sha256(Path(K.__file__).read_bytes() + Path(__file__).read_bytes()).hexdigest()
+    for fn in (integrate, loads_at, step_limit):
+        cache = getattr(fn, "_cache", None)
+        path = getattr(cache, "cache_path", None)
+        if not path:
+            continue
+        marker = Path(path) / f"{__name__.rsplit('.', 1)[-1]}.{fn.__name__}.sources"
+        try:
+            if not marker.is_file() or marker.read_text() != stamp:
+                cache.flush()
+                marker.write_text(stamp)
+        except OSError:  # a read-only cache: numba will not write there either
+            pass
+
+
+_drop_stale_cache()
