@@ -121,6 +121,45 @@ def equal_accuracy(label, base, ov, *, duration=0.1, scipy=True, repeats=2, prog
     return rows, info
 
 
+#: quasi-static settings: (method, rtol, step ceiling s) -- massless balls leave the ring modes
+#: (3-6 kHz) as the fastest, so the ceiling can rise to 100 µs
+QS_SETTINGS = [("bs32", 1e-3, 1e-4), ("bs32", 1e-4, 1e-4), ("dp54", 1e-4, 1e-4), ("dp54", 1e-5, 2.5e-5)]
+
+
+def quasi_static(label, base, ov, *, duration=0.1, repeats=2):
+    """Quasi-static rows: CPU s/s, and the error against the multibody reference (what a user
+    gets: model plus numerical error) and against its own converged run (numerical error)."""
+    from .bench import _measures, _scene
+    from .sim.assembly import assemble
+    from .sim.integrate import _run
+    sc_mb = _scene(base, ov, duration)
+    sc = _scene(base, ov, duration, "quasi-static")
+    asm = assemble(sc)
+    ref_mb = _measures(_run(assemble(sc_mb), 0, 1e-9, progress=False, max_step=2e-6)["acc"][:, 1], sc.fs_out, sc_mb)
+    ref_qs = _measures(_run(asm, 0, 1e-9, progress=False, max_step=2e-6)["acc"][:, 1], sc.fs_out, sc)
+    rows = []
+    from .sim.integrate import METHODS
+    for method, rtol, mx in QS_SETTINGS:
+        res, cpu = _cpu(_run, asm, METHODS[method], rtol, progress=False, max_step=mx, repeats=repeats)
+        m = _measures(res["acc"][:, 1], sc.fs_out, sc)
+        row = dict(scene=label, setting=f"{method} rtol={rtol:g} max_step={mx:g}", cost=cpu / res["t_end"],
+                   err_peak=_err(m["peak"], ref_mb["peak"]), err_period=_err(m["period"], ref_mb["period"]),
+                   num_err_peak=_err(m["peak"], ref_qs["peak"]), steps=int(res["stats"][0]),
+                   rejected=int(res["stats"][1]))
+        row["ok"] = _ok(row, ref_mb["period"])
+        rows.append(row)
+    return rows
+
+
+def quasi_static_table(rows) -> str:
+    out = ["| scene | quasi-static setting | CPU s/s | peak err vs multibody | period err | numerical peak err | "
+           "steps | rejected | within tolerance |", "|---|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        out.append(f"| {r['scene']} | {r['setting']} | {r['cost']:.3f} | {r['err_peak']:.1e} | {r['err_period']:.1e} | "
+                   f"{r['num_err_peak']:.1e} | {r['steps']} | {r['rejected']} | {'yes' if r['ok'] else 'no'} |")
+    return "\n".join(out)
+
+
 def best_per_method(rows):
     """{(scene, solver, method): the cheapest row within tolerance, or None}."""
     out = {}
@@ -237,12 +276,13 @@ def all_rows_table(rows) -> str:
     return "\n".join(out)
 
 
-def run_speed(scenes=None, *, duration=0.1, default_duration=1.0, scipy=True, progress=True):
-    """Both measurements on the speed scenes; returns (markdown summary, rows, infos, defaults)."""
+def run_speed(scenes=None, *, duration=0.1, default_duration=1.0, scipy=True, progress=True, qs=True):
+    """Both measurements (and the quasi-static fidelity) on the speed scenes; returns (markdown
+    summary, rows, infos, defaults, quasi-static rows)."""
     from .sim.integrate import _warm_up
     _warm_up()
     chosen = [s for s in SPEED_SCENES if scenes is None or s[0] in scenes]
-    rows, infos, defaults, accs = [], [], [], []
+    rows, infos, defaults, accs, qrows = [], [], [], [], []
     say = (lambda r: print(f"  {r['scene']} {r['solver']} {r['method']} {r['setting']}: {r['cost']:.3f} s/s, "
                            f"peak {r['err_peak']:.1e}, period {r['err_period']:.1e}", flush=True)) if progress else None
     for label, base, ov in chosen:
@@ -251,4 +291,9 @@ def run_speed(scenes=None, *, duration=0.1, default_duration=1.0, scipy=True, pr
         infos.append(info)
         accs.append(default_accuracy(label, base, ov, duration=duration))
         defaults.append(default_cost(label, base, ov, duration=default_duration))
-    return tables(rows, infos, defaults, accs), rows, infos, defaults
+        if qs:
+            qrows += quasi_static(label, base, ov, duration=duration)
+    md = tables(rows, infos, defaults, accs)
+    if qrows:
+        md += "\n\n" + quasi_static_table(qrows)
+    return md, rows, infos, defaults, qrows

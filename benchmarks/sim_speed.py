@@ -6,6 +6,8 @@ For paper-slot, paper-O1 (H = B/2), paper-O2 (theta = 60 deg) and cwru-or007-6:
   same compiled right-hand side -- at its cheapest setting within 1 % peak-acceleration and
   0.1 % period error of a converged reference (dp54 rtol 1e-9 / 2 us, checked against
   rtol 1e-10 / 1 us), and the ratio ours / scipy's best, all in one run;
+- the quasi-static fidelity (massless balls) at a few settings: its cost and its error against
+  the multibody reference;
 - ``simulate(scene)`` with the defaults (fidelity and solver "auto") on 1 s records with warm
   numba and defect-table caches: the time loop, the whole call, wall_time_s and table_time_s,
   and the default's own error on the equal-accuracy record.
@@ -26,11 +28,11 @@ if __name__ == "__main__":
     ap.add_argument("--no-scipy", action="store_true")
     ap.add_argument("--json", default=None, help="write every row here")
     args = ap.parse_args()
-    md, rows, infos, defaults = run_speed(args.scene, duration=args.duration, default_duration=args.default_duration,
+    md, rows, infos, defaults, qrows = run_speed(args.scene, duration=args.duration, default_duration=args.default_duration,
                                           scipy=not args.no_scipy)
     print(md)
     print()
     print(all_rows_table(rows))
     if args.json:
         with open(args.json, "w") as fh:
-            json.dump({"rows": rows, "reference": infos, "default": defaults}, fh, indent=1)
+            json.dump({"rows": rows, "reference": infos, "default": defaults, "quasi_static": qrows}, fh, indent=1)
