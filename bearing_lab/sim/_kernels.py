@@ -1,4 +1,4 @@
-"""numba kernels of the bearing model: contact laws, right-hand side, integrator.
+"""numba kernels of the bearing model: contact laws and the right-hand side (the integrator is in ``_stepper``).
 
 Why numba: the model is a small ODE system (rings, balls, sensor) whose
 right-hand side is evaluated millions of times per simulated second because
@@ -616,7 +616,3 @@ def rhs(t, y, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, dy, fi_out, fo_out):
         dy[sb + 2] = -2.0 * zt * w * y[sb + 2] - w * w * y[sb] - axo
         dy[sb + 3] = -2.0 * zt * w * y[sb + 3] - w * w * y[sb + 1] - ayo
 
-
-#: the same right-hand side, inlined (numba IR) where the integrator evaluates its stages: a call
-#: passing the model's 13 arrays costs reference counting on each of them, per evaluation
-rhs_inline = njit(cache=True, error_model="numpy", inline="always")(rhs.py_func)
