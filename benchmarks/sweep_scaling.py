@@ -117,7 +117,7 @@ def main(argv=None):
     ap.add_argument("--modes", nargs="+", default=["end_to_end", "steady"], choices=["end_to_end", "steady"])
     ap.add_argument("--json", default=None, help="write the results here")
     args = ap.parse_args(argv)
-    import bearing_lab.sweep as sw
+    import bearing_lab.sweeps as sw
     info = {"simulator_fingerprint": sw.code_fingerprint()[:16], "scene": args.scene, "scenes": args.scenes,
             "duration_s": args.duration, "cpus": os.cpu_count(), "python": platform.python_version(),
             "load_avg_start": os.getloadavg(), "started": time.strftime("%Y-%m-%d %H:%M:%S")}

@@ -11,8 +11,11 @@ def _bench(args) -> int:
             from ..errors import BearingLabError
             raise BearingLabError(f"--scene {bad[0]!r}: allowed values are " + ", ".join(names))
     ds = run_bench(args.output, duration=args.duration, scenes=args.scene, progress=not args.quiet,
-                   scipy=not args.no_scipy)
+                   scipy=not args.no_scipy,
+                   scipy_duration=args.scipy_duration)
     print(summary_table(ds))
+    if ds.attrs.get("equal_accuracy_md"):
+        print("\nSpeed at equal accuracy (CPU s per simulated s):\n" + ds.attrs["equal_accuracy_md"])
     print(f"\nwrote {args.output}/index.html, performance.nc, auto_rules.toml and work-precision PNGs")
     return 0
 
@@ -22,6 +25,8 @@ def register(sub) -> None:
     p.add_argument("-o", "--output", default="reports/performance", metavar="DIR")
     p.add_argument("--duration", type=float, default=0.3, metavar="S", help="simulated seconds per run")
     p.add_argument("--scene", action="append", metavar="NAME", help="only these bench scenes")
-    p.add_argument("--no-scipy", action="store_true", help="skip the scipy solve_ivp baseline")
+    p.add_argument("--scipy-duration", type=float, default=0.1, metavar="S",
+                   help="simulated seconds of the equal-accuracy comparison with scipy")
+    p.add_argument("--no-scipy", action="store_true", help="skip the equal-accuracy comparison with scipy")
     p.add_argument("-q", "--quiet", action="store_true")
     p.set_defaults(func=_bench)

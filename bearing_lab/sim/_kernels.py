@@ -1,4 +1,4 @@
-"""numba kernels of the bearing model: contact laws, right-hand side, integrator.
+"""numba kernels of the bearing model: contact laws and the right-hand side (the integrator is in ``_stepper``).
 
 Why numba: the model is a small ODE system (rings, balls, sensor) whose
 right-hand side is evaluated millions of times per simulated second because
@@ -50,6 +50,9 @@ P_UNB = 53      # shaft unbalance U = m e (kg m): a force U omega^2 turning with
 P_DRATE = 54    # damping rate over a defect: 0 the bodies' approach rate, 1 the rate of the
                 # contact law's equivalent penetration (including the rolling term)
 P_SIZE = 55
+# after P_SIZE: cos(2 pi j / Z) for j < Z, then sin(2 pi j / Z) (ball offsets around the cage,
+# so the right-hand side rotates them with 4 products instead of calling cos/sin per ball)
+P_TRIG = P_SIZE
 
 # ---- defect table layout: dint[k] = race, kind, npsi, ndelta, h_off, g_off, ball
 #   race 0: outer race, 1: inner race, 2: ball defect meeting the outer race,
@@ -112,7 +115,11 @@ def impact(pen, pen_rate, k, e, cmax, dpen):
         f = k * pen * math.sqrt(pen)
     else:
         f = k * pen ** e
-    f += step_fn(pen, 0.0, 0.0, dpen, cmax) * pen_rate
+    if pen >= dpen:
+        f += cmax * pen_rate
+    else:
+        sr = pen / dpen
+        f += cmax * sr * sr * (3.0 - 2.0 * sr) * pen_rate
     return f if f > 0.0 else 0.0
 
 
@@ -179,7 +186,16 @@ def _interp_g(k, psi, delta, dint, dflt, gbuf):
 
 @njit(cache=True, error_model="numpy")
 def defect_force(kk, rel, reld, delta, delta_rate, k, p, dint, dflt, hbuf, gbuf):
-    """Normal force of a ball at relative angle ``rel`` inside the zone of defect kk.
+    """Normal force of a ball at relative angle ``rel`` inside the zone of defect kk (the
+    contact's own damping coefficient); see :func:`contact_force`."""
+    return contact_force(kk, rel, reld, delta, delta_rate, k, p[P_CMAX], p, dint, dflt, hbuf, gbuf)
+
+
+@njit(cache=True, error_model="numpy")
+def contact_force(kk, rel, reld, delta, delta_rate, k, cmax, p, dint, dflt, hbuf, gbuf):
+    """Normal force of a contact at relative angle ``rel`` inside the zone of defect kk, with
+    stiffness ``k`` and damping coefficient ``cmax`` (one ball-race contact, or for a drop
+    profile the quasi-static ball's two contacts in series).
 
     Elastic part from the defect's law at the approach ``delta``; IMPACT damping
     ``STEP(pen, 0, 0, d, c_max) * rate`` with ``pen`` the law's own penetration (``delta
@@ -195,12 +211,12 @@ def defect_force(kk, rel, reld, delta, delta_rate, k, p, dint, dflt, hbuf, gbuf)
         if pen <= 0.0:
             return 0.0
         rate = delta_rate - dh * reld if rolling else delta_rate
-        return impact(pen, rate, k, p[P_EXP], p[P_CMAX], p[P_DPEN])
+        return impact(pen, rate, k, p[P_EXP], cmax, p[P_DPEN])
     g, dg_dd, dg_dpsi = _interp_g23(kk, rel, delta, dint, dflt, gbuf)
     if g <= 0.0:
         return 0.0
     rate = dg_dd * delta_rate + dg_dpsi * reld if rolling else delta_rate
-    f = k * g * math.sqrt(g) + step_fn(g, 0.0, 0.0, p[P_DPEN], p[P_CMAX]) * rate
+    f = k * g * math.sqrt(g) + step_fn(g, 0.0, 0.0, p[P_DPEN], cmax) * rate
     return f if f > 0.0 else 0.0
 
 
@@ -246,9 +262,8 @@ def _qs_ball(kk, rel, reld, dtot, dtot_rate, p, dint, dflt, hbuf, gbuf):
     pen = dtot - h
     if pen <= 0.0:
         return 0.0
-    if dint[kk, D_KIND] == 0:
-        rate = dtot_rate - dh * reld if rolling else dtot_rate
-        return impact(pen, rate, p[P_KEFF], e, cser, dpen)
+    if dint[kk, D_KIND] == 0:  # a drop: the two contacts in series as one law
+        return contact_force(kk, rel, reld, dtot, dtot_rate, p[P_KEFF], cser, p, dint, dflt, hbuf, gbuf)
     # 2-D table on one contact, Hertz on the other: split the approach by bisection
     outer = dint[kk, D_RACE] % 2 == 0
     k_def = p[P_KO] if outer else p[P_KI]
@@ -299,6 +314,255 @@ def _qs_ball(kk, rel, reld, dtot, dtot_rate, p, dint, dflt, hbuf, gbuf):
     return f if f > 0.0 else 0.0
 
 
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _ball_dir(p, z, j, c0, s0):
+    """cos, sin of ball j's angle for a kinematic cage: the cage angle rotated by the ball's
+    tabulated offset 2 pi j / Z."""
+    cj = p[P_TRIG + j]
+    sj = p[P_TRIG + z + j]
+    return c0 * cj - s0 * sj, s0 * cj + c0 * sj
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _zone_candidates(kk, z, phic, theta_s, dint, dflt):
+    """Balls that may sit in defect kk's zone (kinematic cage), found in O(1): (first, second,
+    count); count == z means every ball must be checked (a zone wider than the ball spacing)."""
+    race = dint[kk, D_RACE]
+    if race >= 2:  # a ball defect: its own ball
+        return dint[kk, D_BALL], -1, 1
+    sp = TWO_PI / z
+    zlo = dflt[kk, F_ZLO]
+    if dflt[kk, F_ZHI] - zlo >= sp:
+        return 0, 0, z
+    u = phic - dflt[kk, F_PSI0] - (theta_s if race == 1 else 0.0) - zlo
+    # ball j sits u + j sp past the zone's start: j = -floor(u / sp) is the one within a ball
+    # spacing past it; its predecessor, in case rounding put the boundary on the other side
+    ja = (-int(math.floor(u / sp))) % z
+    return ja, (ja - 1) % z, 2
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _approaches(y, z, j, c, s, phidot, pd4):
+    """Ball j's outer and inner contact approaches (m) and their rates (multibody)."""
+    qj = y[8 + j]
+    qd = y[8 + z + j]
+    d_o = qj - (y[4] * c + y[5] * s) - pd4
+    d_or = qd - (y[6] * c + y[7] * s) - (y[4] * (-s) + y[5] * c) * phidot
+    d_i = -qj + (y[0] * c + y[1] * s) - pd4
+    d_ir = -qd + (y[2] * c + y[3] * s) + (y[0] * (-s) + y[1] * c) * phidot
+    return d_o, d_or, d_i, d_ir
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _balls_kinematic(y, p, z, c0, s0, phic, phidot, theta_s, omega_s, dint, dflt, hbuf, gbuf, dy, fi_out, fo_out):
+    """Ball loads and ball equations for multibody balls in a kinematic cage.
+
+    Every contact as intact first (one loop without branches on defects), then for each defect
+    the O(1) candidate balls in its zone get the defect's law, with the ball's equation and the
+    ring sums corrected (the lowest-numbered defect wins where zones overlap).  Returns the
+    ball forces on the inner and outer ring (x, y)."""
+    xi, yi, vxi, vyi = y[0], y[1], y[2], y[3]
+    xo, yo, vxo, vyo = y[4], y[5], y[6], y[7]
+    pd4 = 0.25 * p[P_PD]
+    ko = p[P_KO]
+    ki = p[P_KI]
+    e = p[P_EXP]
+    cmax = p[P_CMAX]
+    dpen = p[P_DPEN]
+    inv_mb = 1.0 / p[P_MB]
+    rp = p[P_RP]
+    g = p[P_G]
+    w2 = phidot * phidot
+    fix = 0.0
+    fiy = 0.0
+    fox = 0.0
+    foy = 0.0
+    for j in range(z):
+        c, s = _ball_dir(p, z, j, c0, s0)
+        qj = y[8 + j]
+        qd = y[8 + z + j]
+        d_o = qj - (xo * c + yo * s) - pd4
+        d_or = qd - (vxo * c + vyo * s) - (xo * (-s) + yo * c) * phidot
+        d_i = -qj + (xi * c + yi * s) - pd4
+        d_ir = -qd + (vxi * c + vyi * s) + (xi * (-s) + yi * c) * phidot
+        fo = impact(d_o, d_or, ko, e, cmax, dpen)
+        fi = impact(d_i, d_ir, ki, e, cmax, dpen)
+        fo_out[j] = fo
+        fi_out[j] = fi
+        dy[8 + j] = qd
+        dy[8 + z + j] = (fi - fo) * inv_mb + (rp + qj) * w2 - g * s
+        fix -= fi * c
+        fiy -= fi * s
+        fox += fo * c
+        foy += fo * s
+    ndef = int(p[P_NDEF])
+    if ndef == 0:
+        return fix, fiy, fox, foy
+    sp = TWO_PI / z
+    spin = p[P_SPIN]
+    for m in range(ndef):
+        kk = ndef - 1 - m
+        ja, jb, cnt = _zone_candidates(kk, z, phic, theta_s, dint, dflt)
+        outer = dint[kk, D_RACE] % 2 == 0
+        for q in range(cnt):
+            j = q if cnt == z else (ja if q == 0 else jb)
+            rel, reld = rel_angle(kk, j, phic + sp * j, phidot, theta_s, omega_s, spin, dint, dflt)
+            if not (dflt[kk, F_ZLO] <= rel <= dflt[kk, F_ZHI]):
+                continue
+            c, s = _ball_dir(p, z, j, c0, s0)
+            d_o, d_or, d_i, d_ir = _approaches(y, z, j, c, s, phidot, pd4)
+            if outer:
+                f = contact_force(kk, rel, reld, d_o, d_or, ko, cmax, p, dint, dflt, hbuf, gbuf)
+                df = f - fo_out[j]
+                fo_out[j] = f
+                fox += df * c
+                foy += df * s
+            else:
+                f = contact_force(kk, rel, reld, d_i, d_ir, ki, cmax, p, dint, dflt, hbuf, gbuf)
+                df = f - fi_out[j]
+                fi_out[j] = f
+                fix -= df * c
+                fiy -= df * s
+            dy[8 + z + j] = (fi_out[j] - fo_out[j]) * inv_mb + (rp + y[8 + j]) * w2 - g * s
+    return fix, fiy, fox, foy
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _balls_quasi_static(y, p, z, c0, s0, phic, phidot, theta_s, omega_s, dint, dflt, hbuf, gbuf, fi_out, fo_out):
+    """Ball loads of massless (quasi-static) balls: the two contacts of a ball in series, the
+    same load on both.  Intact first, then the O(1) candidate balls of each defect zone (an
+    outer-race defect wins over an inner-race one, the lowest-numbered over the others).
+    Returns the ball forces on the inner and outer ring (x, y)."""
+    pd4 = 0.25 * p[P_PD]
+    keff = p[P_KEFF]
+    e = p[P_EXP]
+    cser = 0.5 * p[P_CMAX]  # two equal dampers in series
+    dpen = p[P_DPEN]
+    dx = y[0] - y[4]
+    dyy = y[1] - y[5]
+    dvx = y[2] - y[6]
+    dvy = y[3] - y[7]
+    for j in range(z):
+        c, s = _ball_dir(p, z, j, c0, s0)
+        dtot = dx * c + dyy * s - 2.0 * pd4
+        drate = dvx * c + dvy * s + (dx * (-s) + dyy * c) * phidot
+        q = impact(dtot, drate, keff, e, cser, dpen)
+        fi_out[j] = q
+        fo_out[j] = q
+    ndef = int(p[P_NDEF])
+    sp = TWO_PI / z
+    spin = p[P_SPIN]
+    for m in range(2 * ndef):
+        # inner-race defects first, then outer-race ones, each from the last to the first
+        kk = ndef - 1 - (m % ndef)
+        if dint[kk, D_RACE] % 2 != (1 if m < ndef else 0):
+            continue
+        ja, jb, cnt = _zone_candidates(kk, z, phic, theta_s, dint, dflt)
+        for q in range(cnt):
+            j = q if cnt == z else (ja if q == 0 else jb)
+            rel, reld = rel_angle(kk, j, phic + sp * j, phidot, theta_s, omega_s, spin, dint, dflt)
+            if not (dflt[kk, F_ZLO] <= rel <= dflt[kk, F_ZHI]):
+                continue
+            c, s = _ball_dir(p, z, j, c0, s0)
+            dtot = dx * c + dyy * s - 2.0 * pd4
+            drate = dvx * c + dvy * s + (dx * (-s) + dyy * c) * phidot
+            qd = _qs_ball(kk, rel, reld, dtot, drate, p, dint, dflt, hbuf, gbuf)
+            fi_out[j] = qd
+            fo_out[j] = qd
+    fix = 0.0
+    fiy = 0.0
+    fox = 0.0
+    foy = 0.0
+    for j in range(z):
+        c, s = _ball_dir(p, z, j, c0, s0)
+        fix -= fi_out[j] * c
+        fiy -= fi_out[j] * s
+        fox += fo_out[j] * c
+        foy += fo_out[j] * s
+    return fix, fiy, fox, foy
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _balls_dynamic(y, p, z, phic, theta_s, omega_s, dint, dflt, hbuf, gbuf, dy, fi_out, fo_out):
+    """Multibody balls in a dynamic cage: each ball's orbital angle, speed and spin are states;
+    traction at both contacts (regularised Coulomb), cage pockets.  Returns the ball forces on
+    the inner and outer ring (x, y) and the pockets' torque on the cage."""
+    xi, yi, vxi, vyi = y[0], y[1], y[2], y[3]
+    xo, yo, vxo, vyo = y[4], y[5], y[6], y[7]
+    pd4 = 0.25 * p[P_PD]
+    mb = p[P_MB]
+    ndef = int(p[P_NDEF])
+    spin = p[P_SPIN]
+    base = 8
+    fix = 0.0
+    fiy = 0.0
+    fox = 0.0
+    foy = 0.0
+    pocket_torque = 0.0
+    for j in range(z):
+        phi = y[base + 2 * z + j]
+        phidot = y[base + 3 * z + j]
+        c = math.cos(phi)
+        s = math.sin(phi)
+        qj = y[base + j]
+        qd = y[base + z + j]
+        d_o, d_or, d_i, d_ir = _approaches(y, z, j, c, s, phidot, pd4)
+        ko = -1
+        ki = -1
+        if ndef > 0:
+            ko, relo, reldo = find_zone(0, j, phi, phidot, theta_s, omega_s, spin, ndef, dint, dflt)
+            ki, reli, reldi = find_zone(1, j, phi, phidot, theta_s, omega_s, spin, ndef, dint, dflt)
+        if ko >= 0:
+            fo = defect_force(ko, relo, reldo, d_o, d_or, p[P_KO], p, dint, dflt, hbuf, gbuf)
+        else:
+            fo = impact(d_o, d_or, p[P_KO], p[P_EXP], p[P_CMAX], p[P_DPEN])
+        if ki >= 0:
+            fi = defect_force(ki, reli, reldi, d_i, d_ir, p[P_KI], p, dint, dflt, hbuf, gbuf)
+        else:
+            fi = impact(d_i, d_ir, p[P_KI], p[P_EXP], p[P_CMAX], p[P_DPEN])
+        dy[base + j] = qd
+        dy[base + z + j] = (fi - fo) / mb + (p[P_RP] + qj) * phidot * phidot - p[P_G] * s
+        r = p[P_RP] + qj
+        om_b = y[base + 4 * z + j]
+        rb = p[P_RB]
+        vt_o = r * phidot - (vxo * (-s) + vyo * c)
+        vt_i = r * phidot - (vxi * (-s) + vyi * c)
+        slip_o = vt_o + rb * om_b
+        slip_i = vt_i - rb * om_b - omega_s * (p[P_RP] - rb)
+        ft_o = -p[P_MU] * fo * math.tanh(slip_o / p[P_VREF])
+        ft_i = -p[P_MU] * fi * math.tanh(slip_i / p[P_VREF])
+        gap = r * wrap(phi - y[base + 5 * z] - TWO_PI * j / z)
+        gap_rate = r * (phidot - y[base + 5 * z + 1])
+        fp = 0.0
+        cp = p[P_CPOCK]
+        if gap > cp:
+            fp = -(p[P_KPOCK] * (gap - cp) + p[P_DPOCK] * gap_rate)
+            if fp > 0.0:
+                fp = 0.0
+        elif gap < -cp:
+            fp = -(p[P_KPOCK] * (gap + cp) + p[P_DPOCK] * gap_rate)
+            if fp < 0.0:
+                fp = 0.0
+        pocket_torque -= fp * r
+        dy[base + 2 * z + j] = phidot
+        dy[base + 3 * z + j] = (ft_o + ft_i + fp - mb * p[P_G] * c - 2.0 * mb * qd * phidot) / (mb * r)
+        dy[base + 4 * z + j] = rb * (ft_o - ft_i) / p[P_IB]
+        # reactions of the traction on the rings (tangential direction -s, c)
+        fix += -ft_i * (-s)
+        fiy += -ft_i * c
+        fox += -ft_o * (-s)
+        foy += -ft_o * c
+        fix -= fi * c
+        fiy -= fi * s
+        fox += fo * c
+        foy += fo * s
+        fi_out[j] = fi
+        fo_out[j] = fo
+    return fix, fiy, fox, foy, pocket_torque
+
+
 @njit(cache=True, error_model="numpy")
 def rhs(t, y, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, dy, fi_out, fo_out):
     """dy/dt of the bearing model; also writes the ball loads into fi_out/fo_out."""
@@ -308,115 +572,18 @@ def rhs(t, y, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, dy, fi_out, fo_out):
     theta_s, omega_s = shaft_state(t, sp_t, sp_w, sp_th)
     phic = p[P_PHI0] + p[P_FTF] * theta_s
     phidot = p[P_FTF] * omega_s
-    pd4 = 0.25 * p[P_PD]
-    fix = 0.0
-    fiy = 0.0
-    fox = 0.0
-    foy = 0.0
-    mb = p[P_MB]
     qs = p[P_FID] > 0.5
-    ndef = int(p[P_NDEF])
-    has_def = ndef > 0
-    spin = p[P_SPIN]
-    base = 8
     dyn = p[P_CAGE] > 0.5
-    c0 = math.cos(phic)
-    s0 = math.sin(phic)
-    dc = math.cos(TWO_PI / z)
-    ds = math.sin(TWO_PI / z)
-    c = c0
-    s = s0
     pocket_torque = 0.0
-    for j in range(z):
-        if dyn:
-            # dynamic cage: each ball's own orbital angle and speed are states
-            phi = y[base + 2 * z + j]
-            phidot = y[base + 3 * z + j]
-            c = math.cos(phi)
-            s = math.sin(phi)
-        else:
-            if j > 0:
-                # rotate by 2π/Z; re-anchor every 4 balls to keep rounding at 1e-16
-                if j % 4 == 0:
-                    c = math.cos(phic + TWO_PI * j / z)
-                    s = math.sin(phic + TWO_PI * j / z)
-                else:
-                    c, s = c * dc - s * ds, s * dc + c * ds
-            phi = phic + TWO_PI * j / z
-        if qs:
-            dtot = (xi - xo) * c + (yi - yo) * s - 2.0 * pd4
-            drate = (vxi - vxo) * c + (vyi - vyo) * s + ((xi - xo) * (-s) + (yi - yo) * c) * phidot
-            kz = -1
-            if has_def:
-                kz, relz, reldz = find_zone(0, j, phi, phidot, theta_s, omega_s, spin, ndef, dint, dflt)
-                if kz < 0:
-                    kz, relz, reldz = find_zone(1, j, phi, phidot, theta_s, omega_s, spin, ndef, dint, dflt)
-            if kz >= 0:
-                q = _qs_ball(kz, relz, reldz, dtot, drate, p, dint, dflt, hbuf, gbuf)
-            else:
-                q = impact(dtot, drate, p[P_KEFF], p[P_EXP], 0.5 * p[P_CMAX], p[P_DPEN])
-            fi = q
-            fo = q
-        else:
-            qj = y[base + j]
-            qd = y[base + z + j]
-            d_o = qj - (xo * c + yo * s) - pd4
-            d_or = qd - (vxo * c + vyo * s) - (xo * (-s) + yo * c) * phidot
-            d_i = -qj + (xi * c + yi * s) - pd4
-            d_ir = -qd + (vxi * c + vyi * s) + (xi * (-s) + yi * c) * phidot
-            ko = -1
-            ki = -1
-            if has_def:
-                ko, relo, reldo = find_zone(0, j, phi, phidot, theta_s, omega_s, spin, ndef, dint, dflt)
-                ki, reli, reldi = find_zone(1, j, phi, phidot, theta_s, omega_s, spin, ndef, dint, dflt)
-            if ko >= 0:
-                fo = defect_force(ko, relo, reldo, d_o, d_or, p[P_KO], p, dint, dflt, hbuf, gbuf)
-            else:
-                fo = impact(d_o, d_or, p[P_KO], p[P_EXP], p[P_CMAX], p[P_DPEN])
-            if ki >= 0:
-                fi = defect_force(ki, reli, reldi, d_i, d_ir, p[P_KI], p, dint, dflt, hbuf, gbuf)
-            else:
-                fi = impact(d_i, d_ir, p[P_KI], p[P_EXP], p[P_CMAX], p[P_DPEN])
-            dy[base + j] = qd
-            dy[base + z + j] = (fi - fo) / mb + (p[P_RP] + qj) * phidot * phidot - p[P_G] * s
-            if dyn:
-                # traction at both contacts (regularised Coulomb), cage pocket, spin
-                r = p[P_RP] + qj
-                om_b = y[base + 4 * z + j]
-                rb = p[P_RB]
-                vt_o = r * phidot - (vxo * (-s) + vyo * c)
-                vt_i = r * phidot - (vxi * (-s) + vyi * c)
-                slip_o = vt_o + rb * om_b
-                slip_i = vt_i - rb * om_b - omega_s * (p[P_RP] - rb)
-                ft_o = -p[P_MU] * fo * math.tanh(slip_o / p[P_VREF])
-                ft_i = -p[P_MU] * fi * math.tanh(slip_i / p[P_VREF])
-                gap = r * wrap(phi - y[base + 5 * z] - TWO_PI * j / z)
-                gap_rate = r * (phidot - y[base + 5 * z + 1])
-                fp = 0.0
-                cp = p[P_CPOCK]
-                if gap > cp:
-                    fp = -(p[P_KPOCK] * (gap - cp) + p[P_DPOCK] * gap_rate)
-                    if fp > 0.0:
-                        fp = 0.0
-                elif gap < -cp:
-                    fp = -(p[P_KPOCK] * (gap + cp) + p[P_DPOCK] * gap_rate)
-                    if fp < 0.0:
-                        fp = 0.0
-                pocket_torque -= fp * r
-                dy[base + 2 * z + j] = phidot
-                dy[base + 3 * z + j] = (ft_o + ft_i + fp - mb * p[P_G] * c - 2.0 * mb * qd * phidot) / (mb * r)
-                dy[base + 4 * z + j] = rb * (ft_o - ft_i) / p[P_IB]
-                # reactions of the traction on the rings (tangential direction -s, c)
-                fix += -ft_i * (-s)
-                fiy += -ft_i * c
-                fox += -ft_o * (-s)
-                foy += -ft_o * c
-        fix -= fi * c
-        fiy -= fi * s
-        fox += fo * c
-        foy += fo * s
-        fi_out[j] = fi
-        fo_out[j] = fo
+    if dyn and not qs:
+        fix, fiy, fox, foy, pocket_torque = _balls_dynamic(y, p, z, phic, theta_s, omega_s, dint, dflt, hbuf, gbuf,
+                                                           dy, fi_out, fo_out)
+    elif qs:
+        fix, fiy, fox, foy = _balls_quasi_static(y, p, z, math.cos(phic), math.sin(phic), phic, phidot, theta_s,
+                                                 omega_s, dint, dflt, hbuf, gbuf, fi_out, fo_out)
+    else:
+        fix, fiy, fox, foy = _balls_kinematic(y, p, z, math.cos(phic), math.sin(phic), phic, phidot, theta_s,
+                                              omega_s, dint, dflt, hbuf, gbuf, dy, fi_out, fo_out)
     if t >= p[P_TSTEP]:
         lix, liy, lox, loy = p[P_FIX2], p[P_FIY2], p[P_FOX2], p[P_FOY2]
     else:
@@ -438,8 +605,8 @@ def rhs(t, y, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, dy, fi_out, fo_out):
     dy[6] = axo
     dy[7] = ayo
     if dyn and not qs:
-        dy[base + 5 * z] = y[base + 5 * z + 1]
-        dy[base + 5 * z + 1] = (pocket_torque - p[P_CDRAG] * y[base + 5 * z + 1]) / p[P_IC]
+        dy[8 + 5 * z] = y[8 + 5 * z + 1]
+        dy[8 + 5 * z + 1] = (pocket_torque - p[P_CDRAG] * y[8 + 5 * z + 1]) / p[P_IC]
     if p[P_SENS] > 0.5:
         sb = int(p[P_SENSOFF])
         w = p[P_SW]
@@ -449,166 +616,3 @@ def rhs(t, y, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, dy, fi_out, fo_out):
         dy[sb + 2] = -2.0 * zt * w * y[sb + 2] - w * w * y[sb] - axo
         dy[sb + 3] = -2.0 * zt * w * y[sb + 3] - w * w * y[sb + 1] - ayo
 
-
-@njit(cache=True, error_model="numpy")
-def _step_limit(t, y, h, p, sp_t, sp_w, sp_th, dint, dflt, nsteps_def, hmax):
-    """Bound the step near defects: land on zone entry, then take >= nsteps_def steps inside."""
-    ndef = int(p[P_NDEF])
-    if ndef == 0:
-        return h
-    z = int(p[P_Z])
-    theta_s, omega_s = shaft_state(t, sp_t, sp_w, sp_th)
-    phic = p[P_PHI0] + p[P_FTF] * theta_s
-    phidot = p[P_FTF] * omega_s
-    spin = p[P_SPIN]
-    hh = h
-    for kk in range(ndef):
-        zlo = dflt[kk, F_ZLO]
-        zhi = dflt[kk, F_ZHI]
-        for j in range(z):
-            if p[P_CAGE] > 0.5:
-                rel, reld = rel_angle(kk, j, y[8 + 2 * z + j], y[8 + 3 * z + j], theta_s, omega_s, spin,
-                                      dint, dflt)
-            else:
-                rel, reld = rel_angle(kk, j, phic + TWO_PI * j / z, phidot, theta_s, omega_s, spin, dint, dflt)
-            if rel > 5.0 or abs(reld) < 1e-12:
-                continue
-            if zlo <= rel <= zhi:
-                hdef = (zhi - zlo) / abs(reld) / nsteps_def
-                if hdef < hh:
-                    hh = hdef
-            elif reld > 0.0 and rel < zlo:
-                tt = (zlo - rel) / reld
-                if tt < hh:
-                    hh = tt * (1.0 + 1e-9) + 1e-15
-            elif reld < 0.0 and rel > zhi:
-                tt = (rel - zhi) / (-reld)
-                if tt < hh:
-                    hh = tt * (1.0 + 1e-9) + 1e-15
-    return hh
-
-
-@njit(cache=True, error_model="numpy")
-def _hermite(y0, y1, f0, f1, h, th):
-    h00 = (1 + 2 * th) * (1 - th) ** 2
-    h10 = th * (1 - th) ** 2
-    h01 = th * th * (3 - 2 * th)
-    h11 = th * th * (th - 1)
-    return h00 * y0 + h10 * h * f0 + h01 * y1 + h11 * h * f1
-
-
-@njit(cache=True, error_model="numpy")
-def integrate(y, t, t_stop, h, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf,
-              a_tab, b_tab, e_tab, c_tab, order, fsal, adaptive, rtol, atol, hmax, nsteps_def,
-              vel_idx, vel_sign, fine_t, fine_out, fine_pos, out_t, out_state, out_pos, stats):
-    """Integrate from t to t_stop, writing dense output on two grids.
-
-    fine grid (``fine_t``): the accelerometer velocity channels (sum over
-    ``vel_idx`` rows with ``vel_sign``) for the anti-alias stage; output grid
-    (``out_t``): the whole state.  Returns (t, h, fine_pos, out_pos, status):
-    status 0 ok, 1 non-finite state, 2 step underflow.
-    """
-    n = y.shape[0]
-    s = b_tab.shape[0]
-    k = np.zeros((s, n))
-    ytmp = np.empty(n)
-    ynew = np.empty(n)
-    err = np.empty(n)
-    fi = np.empty(int(p[P_Z]))
-    fo = np.empty(int(p[P_Z]))
-    rhs(t, y, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, k[0], fi, fo)
-    nch = vel_idx.shape[0]
-    while t < t_stop:
-        hstep = h
-        if hstep > hmax:
-            hstep = hmax
-        if t + hstep > t_stop:
-            hstep = t_stop - t
-        hstep = _step_limit(t, y, hstep, p, sp_t, sp_w, sp_th, dint, dflt, nsteps_def, hstep)
-        if hstep < 1e-14:
-            hstep = 1e-14
-        for i in range(1, s):
-            for m in range(n):
-                acc = 0.0
-                for jj in range(i):
-                    acc += a_tab[i, jj] * k[jj, m]
-                ytmp[m] = y[m] + hstep * acc
-            rhs(t + c_tab[i] * hstep, ytmp, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, k[i], fi, fo)
-        for m in range(n):
-            acc = 0.0
-            acce = 0.0
-            for jj in range(s):
-                acc += b_tab[jj] * k[jj, m]
-                acce += e_tab[jj] * k[jj, m]
-            ynew[m] = y[m] + hstep * acc
-            err[m] = hstep * acce
-        accept = True
-        fac = 1.0
-        if adaptive:
-            en = 0.0
-            for m in range(n):
-                sc = atol[m] + rtol * max(abs(y[m]), abs(ynew[m]))
-                en += (err[m] / sc) ** 2
-            en = math.sqrt(en / n)
-            if not math.isfinite(en):
-                en = 1e10
-            if en > 1.0:
-                accept = False
-                fac = max(0.2, 0.9 * en ** (-1.0 / order))
-            else:
-                fac = 5.0 if en < 1e-10 else min(5.0, 0.9 * en ** (-1.0 / order))
-        if not accept:
-            h = hstep * fac
-            stats[1] += 1
-            if h < 1e-13:
-                return t, h, fine_pos, out_pos, 2
-            continue
-        # f at the new point: the FSAL stage, or one more evaluation
-        if fsal:
-            for m in range(n):
-                ytmp[m] = k[s - 1, m]
-        else:
-            rhs(t + hstep, ynew, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, ytmp, fi, fo)
-            stats[2] += 1
-        tn = t + hstep
-        # dense output: fine grid (accelerometer velocity), output grid (state)
-        while fine_pos < fine_t.shape[0] and fine_t[fine_pos] <= tn:
-            th = (fine_t[fine_pos] - t) / hstep
-            for ch in range(nch):
-                v = 0.0
-                for r in range(vel_idx.shape[1]):
-                    idx = vel_idx[ch, r]
-                    if idx >= 0:
-                        v += vel_sign[ch, r] * _hermite(y[idx], ynew[idx], k[0, idx], ytmp[idx], hstep, th)
-                fine_out[fine_pos, ch] = v
-            fine_pos += 1
-        while out_pos < out_t.shape[0] and out_t[out_pos] <= tn:
-            th = (out_t[out_pos] - t) / hstep
-            for m in range(n):
-                out_state[out_pos, m] = _hermite(y[m], ynew[m], k[0, m], ytmp[m], hstep, th)
-            out_pos += 1
-        for m in range(n):
-            y[m] = ynew[m]
-            k[0, m] = ytmp[m]
-            if not math.isfinite(y[m]):
-                return tn, h, fine_pos, out_pos, 1
-        t = tn
-        stats[0] += 1
-        if adaptive:
-            h = hstep * fac
-    return t, h, fine_pos, out_pos, 0
-
-
-@njit(cache=True, error_model="numpy")
-def loads_at(out_t, out_state, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, fi_all, fo_all):
-    """Ball loads (N) at the output samples from the interpolated states."""
-    n = out_state.shape[1]
-    dy = np.empty(n)
-    z = int(p[P_Z])
-    fi = np.empty(z)
-    fo = np.empty(z)
-    for i in range(out_t.shape[0]):
-        rhs(out_t[i], out_state[i], p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, dy, fi, fo)
-        for j in range(z):
-            fi_all[j, i] = fi[j]
-            fo_all[j, i] = fo[j]

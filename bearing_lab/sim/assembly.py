@@ -70,34 +70,13 @@ def ball_contact_loads(e, phis, k_in, k_out, pd, body_force, exponent=1.5):
     ``K_o d_o^n - K_i (T - d_o)^n = body_force`` (increasing in ``d_o``), by Newton's
     method kept inside a bracket.  A ball that cannot touch both races rests on one.
     """
-    n = exponent
+    from ._equilibrium_kernel import split_contacts
     u = np.stack([np.cos(phis), np.sin(phis)])
-    T = e @ u - pd / 2
-    fb = np.broadcast_to(np.asarray(body_force, dtype=float), T.shape)
-    lo = (np.maximum(fb, 0.0) / k_out) ** (1 / n)          # Q_i = 0: on the outer race only
-    hi = T - (np.maximum(-fb, 0.0) / k_in) ** (1 / n)       # Q_o = 0: on the inner race only
-    both = hi > lo
-    x = np.where(both, 0.5 * (lo + hi), lo)
-    lo_b, hi_b = lo.copy(), hi.copy()
-    for _ in range(60):
-        di = np.maximum(T - x, 0.0)
-        do = np.maximum(x, 0.0)
-        f = k_out * do ** n - k_in * di ** n - fb
-        df = n * (k_out * do ** (n - 1) + k_in * di ** (n - 1))
-        lo_b = np.where(f < 0, x, lo_b)
-        hi_b = np.where(f > 0, x, hi_b)
-        step = np.where(df > 0, f / np.where(df > 0, df, 1.0), 0.0)
-        xn = x - step
-        out = (xn <= lo_b) | (xn >= hi_b)
-        xn = np.where(out, 0.5 * (lo_b + hi_b), xn)
-        if np.all(np.abs(xn - x)[both] <= 1e-15 + 1e-13 * np.abs(x[both])):
-            x = xn
-            break
-        x = np.where(both, xn, x)
-    q_in = np.where(both, k_in * np.maximum(T - x, 0.0) ** n, np.maximum(-fb, 0.0) * (T > 0))
-    q_out = np.where(both, k_out * np.maximum(x, 0.0) ** n, np.maximum(fb, 0.0))
-    # a ball touching neither race (negative approach) carries nothing
-    q_in = np.where((~both) & (fb < 0) & (T <= 0), 0.0, q_in)
+    T = np.ascontiguousarray(np.asarray(e, dtype=float) @ u - pd / 2, dtype=float)
+    fb = np.ascontiguousarray(np.broadcast_to(np.asarray(body_force, dtype=float), T.shape))
+    q_in = np.empty_like(T)
+    q_out = np.empty_like(T)
+    split_contacts(T, fb, float(k_in), float(k_out), float(exponent), q_in, q_out)
     return q_in, q_out
 
 
@@ -349,8 +328,10 @@ def assemble(scene: Scene, *, fidelity: str | None = None) -> Assembly:
     hbuf = np.concatenate(hparts) if hparts else np.zeros(1)
     gbuf = np.concatenate(gparts) if gparts and goff else np.zeros(1)
 
-    p = np.zeros(K.P_SIZE)
+    p = np.zeros(K.P_SIZE + 2 * z)
     p[K.P_Z] = z
+    p[K.P_TRIG:K.P_TRIG + z] = np.cos(2 * np.pi * np.arange(z) / z)
+    p[K.P_TRIG + z:K.P_TRIG + 2 * z] = np.sin(2 * np.pi * np.arange(z) / z)
     p[K.P_RP] = b.pitch_diameter / 2
     p[K.P_PD] = scene.clearance
     p[K.P_KI], p[K.P_KO], p[K.P_KEFF] = hi.stiffness, ho.stiffness, k_eff

@@ -29,33 +29,14 @@ from scipy import signal
 
 from .. import __version__
 from ..errors import BearingLabError, SolverError
-from . import _kernels as K
+from . import _stepper as S
 from .assembly import assemble
 from .scene import load_scene
 from ..schema import DEFAULT_CHANNEL, QUANTITY_OF_UNITS
 
-# Butcher tableaus: (A, b, b - b_hat, c, order used for step control, FSAL)
-_DP54 = (
-    np.array([[0, 0, 0, 0, 0, 0, 0],
-              [1 / 5, 0, 0, 0, 0, 0, 0],
-              [3 / 40, 9 / 40, 0, 0, 0, 0, 0],
-              [44 / 45, -56 / 15, 32 / 9, 0, 0, 0, 0],
-              [19372 / 6561, -25360 / 2187, 64448 / 6561, -212 / 729, 0, 0, 0],
-              [9017 / 3168, -355 / 33, 46732 / 5247, 49 / 176, -5103 / 18656, 0, 0],
-              [35 / 384, 0, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84, 0]]),
-    np.array([35 / 384, 0, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84, 0]),
-    np.array([35 / 384 - 5179 / 57600, 0, 500 / 1113 - 7571 / 16695, 125 / 192 - 393 / 640,
-              -2187 / 6784 + 92097 / 339200, 11 / 84 - 187 / 2100, -1 / 40]),
-    np.array([0, 1 / 5, 3 / 10, 4 / 5, 8 / 9, 1, 1]), 5, True)
-_BS32 = (
-    np.array([[0, 0, 0, 0], [1 / 2, 0, 0, 0], [0, 3 / 4, 0, 0], [2 / 9, 1 / 3, 4 / 9, 0]]),
-    np.array([2 / 9, 1 / 3, 4 / 9, 0]),
-    np.array([2 / 9 - 7 / 24, 1 / 3 - 1 / 4, 4 / 9 - 1 / 3, -1 / 8]),
-    np.array([0, 1 / 2, 3 / 4, 1]), 3, True)
-_RK4 = (
-    np.array([[0, 0, 0, 0], [0.5, 0, 0, 0], [0, 0.5, 0, 0], [0, 0, 1, 0]], dtype=float),
-    np.array([1 / 6, 1 / 3, 1 / 3, 1 / 6]), np.zeros(4), np.array([0, 0.5, 0.5, 1.0]), 4, False)
-METHODS = {"dp54": _DP54, "bs32": _BS32, "rk4": _RK4}
+#: the integration methods (written out in _stepper): Dormand-Prince 5(4) and Bogacki-Shampine
+#: 3(2), adaptive with PI step control, and classic RK4 at a fixed step
+METHODS = {"dp54": 0, "bs32": 1, "rk4": 2}
 
 _COMPILED = {"done": False, "seconds": 0.0}
 
@@ -78,13 +59,14 @@ def _warm_up():
     for fid in ("multibody",):
         asm = assemble(scene, fidelity=fid)
         _run(asm, METHODS["dp54"], 1e-3, progress=False, t_end_override=2e-5)
+    S.fir_decimate(np.zeros((4, 2)), np.ones(2), 0, 1, np.zeros((2, 2)))
     _COMPILED["done"] = True
     _COMPILED["seconds"] = _time.perf_counter() - t0
     return _COMPILED["seconds"]
 
 
 def _run(asm, method, rtol, *, progress, t_end_override=None, step=None, max_step=None,
-         defect_steps=40, chunk_s=0.01, loads=True):
+         defect_steps=40, chunk_s=0.05, loads=True):
     """Integrate in chunks and stream the output: nothing finer than the output rate is kept
     beyond one chunk plus the anti-alias filter's length.
 
@@ -126,10 +108,10 @@ def _run(asm, method, rtol, *, progress, t_end_override=None, step=None, max_ste
     cage_speed = np.zeros(n_out) if dyn else None
     fi_all = np.zeros((z, n_out)) if loads else None
     fo_all = np.zeros((z, n_out)) if loads else None
-    A, b, e, c, order, fsal = method
+    method = int(method)
     rtol = float(rtol)
     defect_steps = float(defect_steps)
-    adaptive = bool(np.any(e != 0))
+    adaptive = method != METHODS["rk4"]
     hmax = max_step if max_step is not None else (d["solver"]["max_step_s"] or 2.5e-5)
     if not adaptive:
         h = float(step if step is not None else d["solver"]["step_s"])
@@ -141,6 +123,7 @@ def _run(asm, method, rtol, *, progress, t_end_override=None, step=None, max_ste
     y = asm.y0.copy()
     t = 0.0
     stats = np.zeros(3, dtype=np.int64)
+    ctrl = np.array([math.log(1e-4), 0.0])  # step controller memory: log previous error, last step rejected
     m_next = 0                      # next fine velocity index to produce
     o_next = 0                      # next output index whose state is produced
     k_acc = 0                       # next output index whose acceleration is computed
@@ -166,9 +149,9 @@ def _run(asm, method, rtol, *, progress, t_end_override=None, step=None, max_ste
                 o_hi += 1
             out_t = out_t_all[o_next:o_hi]
             out_state = np.zeros((out_t.size, n))
-            t_new, h, fpos, opos, status = K.integrate(
-                y, t, t_stop, h, *args, A, b, e, c, order, fsal, adaptive, rtol, atol, hmax,
-                defect_steps, vel_idx, vel_sign, fine_t, fine_out, 0, out_t, out_state, 0, stats)
+            t_new, h, fpos, opos, status = S.integrate(
+                y, t, t_stop, h, *args, method, rtol, atol, hmax,
+                defect_steps, vel_idx, vel_sign, fine_t, fine_out, 0, out_t, out_state, 0, stats, ctrl)
             if status != 0:
                 what = "the state became NaN/Inf" if status == 1 else "the step size underflowed"
                 raise SolverError(f"scene {scene.name!r}: integration failed at t = {t_new:.6g} s: {what} "
@@ -180,7 +163,7 @@ def _run(asm, method, rtol, *, progress, t_end_override=None, step=None, max_ste
                 if dyn:
                     cage_speed[o_next:o_hi] = out_state[:, cage_idx]
                 if loads:
-                    K.loads_at(out_t, out_state, *args, fi_all[:, o_next:o_hi], fo_all[:, o_next:o_hi])
+                    S.loads_at(out_t, out_state, *args, fi_all[:, o_next:o_hi], fo_all[:, o_next:o_hi])
                 o_next = o_hi
             # accelerometer: fine-interval mean acceleration, FIR, decimate; keep the tail
             m_next += fine_t.size
@@ -191,9 +174,7 @@ def _run(asm, method, rtol, *, progress, t_end_override=None, step=None, max_ste
             k_hi = min(n_out, (last - half - m_pad) // R + 1) if last - half - m_pad >= 0 else k_acc
             if k_hi > k_acc:
                 s0 = m_pad + k_acc * R - half - v_start
-                win = np.lib.stride_tricks.sliding_window_view(a_fine, len(taps), axis=0)
-                # a strided view (no copy): every R-th window from s0
-                acc[k_acc:k_hi] = win[s0:s0 + R * (k_hi - k_acc - 1) + 1:R] @ taps_rev
+                S.fir_decimate(a_fine, taps_rev, s0, R, acc[k_acc:k_hi])
                 k_acc = k_hi
             # drop the velocities no later output needs; v_buf[0] is always fine index v_start
             drop = min(max(m_pad + k_acc * R - half - v_start, 0), v_buf.shape[0])
