@@ -1,4 +1,4 @@
-"""Recording import: a rig's file -> the recording Dataset of contract.md.
+"""Recording import: a rig's file -> the recording Dataset of :mod:`bearing_lab.schema`.
 
 Public API
 ----------

@@ -10,17 +10,18 @@ key and the reason.
 Defaults where the paper is silent (each settable; see ``docs`` in
 :data:`SCHEMA`):
 
-- steel balls and rings: E = 208 GPa, ν = 0.3, ρ = 7850 kg/m³ (reference.md's
-  assumptions, AISI 52100 handbook values);
-- groove conformities f_i = 0.52, f_o = 0.53 (reference.md; Harris & Kotzalas's
-  typical deep-groove values);
+- steel balls and rings: E = 208 GPa, ν = 0.3, ρ = 7850 kg/m³ (AISI 52100
+  handbook values);
+- groove conformities f_i = 0.52, f_o = 0.53 (Harris & Kotzalas,
+  *Rolling Bearing Analysis*, typical deep-groove values);
 - radial internal clearance 0 (mounted: an interference fit takes most of a C0
   6308's 6–20 µm, ISO 5753-1);
 - ring masses from the ring envelope (steel annuli between bore / outer
   diameter and the raceway shoulders), ball mass from D_b and ρ;
 - shaft (inner ring to ground) and mount (outer-ring bushing) stiffness
   1e8 N/m: the order of the bearing's own linearised radial stiffness
-  (≈1.2e8 N/m near 1 kN, reference.md), as in lumped rotor–bearing–pedestal
+  (≈1.2e8 N/m near 1 kN from the Hertz
+  constants, and the 13e6·Z^(2/3)·D_b^(1/3)·F^(1/3) rule of thumb), as in lumped rotor–bearing–pedestal
   models (e.g. Sawalhi & Randall, MSSP 22 (2008) 1924–1951);
 - their damping 1000 N·s/m: ~1e-5 × stiffness, inside the paper's
   0.25–2.5e-5 rule (its section 2.1, citing Liu & Shao);
@@ -32,7 +33,7 @@ Defaults where the paper is silent (each settable; see ``docs`` in
   whole load goes through the balls, as in the paper's experiment where the
   load is applied through the bearing.  ``load.path = "springs"`` leaves both
   supports unstressed at the nominal centre (most load then bypasses the
-  bearing and amplitudes drop three- to five-fold, paper.md).
+  bearing and amplitudes drop three- to five-fold).
 """
 from __future__ import annotations
 
