@@ -418,9 +418,8 @@ def plot_analysis(x, fs, *, bearing, rpm=None, shaft_hz=None, channel="", units=
     3
     """
     if fig is None:
-        # a bare Figure (no pyplot): no backend switch, no global state; savefig works headless
-        from matplotlib.figure import Figure
-        fig = Figure(figsize=(10, 9), layout="constrained")
+        from ..figures import new_figure   # detached from pyplot, shown inline as a cell's value
+        fig = new_figure(figsize=(10, 9), layout="constrained")
     result, ex = _run(x, fs, bearing=bearing, rpm=rpm, shaft_hz=shaft_hz, **kwargs)
     result["channel"], result["units"] = str(channel), str(units)
     x = np.asarray(x, float)

@@ -72,8 +72,8 @@ class Report:
         """A :class:`~bearing_lab.compare.ComparisonResult`: its table, and its figures."""
         self.add_rows(result.rows, title, intro=intro, tags=tags)
         if figures:
-            from matplotlib.figure import Figure
-            fig = Figure(figsize=(10, 9), layout="constrained")
+            from ..figures import new_figure
+            fig = new_figure(figsize=(10, 9), layout="constrained")
             axes = fig.subplots(3, 1)
             result.plot_waveforms(ax=axes[0], window_s=(0, 0.1))
             result.plot_spectra(ax=axes[1])
