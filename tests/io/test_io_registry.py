@@ -16,7 +16,7 @@ def test_registry_covers_mirror_and_cwru_12k(mirror):
     if mirror is not None:
         files = sorted(str(p.relative_to(mirror)) for p in Path(mirror).glob("*/*") if p.is_file())
         for f in files:
-            assert f in reg, f"{f} missing from data/recordings.csv"
+            assert f in reg, f"{f} missing from bearing_lab/data/recordings.csv"
             assert len(reg[f].sha256) == 64
     r = datasets.get("130_OR007@6_0.mat")
     assert (r.rpm, r.load_hp, r.defect, r.defect_size_in, r.defect_position) == \
@@ -153,3 +153,16 @@ def test_fetch_of_an_unhashed_row_warns(tmp_path, monkeypatch):
     monkeypatch.setattr(datasets, "load_registry", lambda path=None: reg)
     with pytest.warns(datasets.UnverifiedWarning, match="not verified"):
         datasets.fetch(name, mirror=_fake_mirror(tmp_path), dest=tmp_path / "d", download=False)
+
+
+def test_registry_documentation_lists_its_columns():
+    """data/README.md documents the package's registry: every CSV column, and no other."""
+    import csv
+    import re
+    from pathlib import Path
+    with datasets.REGISTRY_FILE.open(newline="", encoding="utf-8") as fh:
+        header = next(csv.reader(fh))
+    readme = (Path(__file__).resolve().parents[2] / "data" / "README.md").read_text()
+    rows = [line.split("|")[1] for line in readme.splitlines() if line.startswith("| `")]
+    documented = {c for cell in rows for c in re.findall(r"`([a-z_0-9]+)`", cell)}
+    assert documented == set(header), (documented ^ set(header))
