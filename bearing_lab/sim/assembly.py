@@ -13,7 +13,7 @@ import time
 import numpy as np
 from scipy.optimize import brentq, root
 
-from ..errors import SceneError, SolverError
+from ..errors import SceneError, SolverError, check_choice
 from . import _kernels as K
 from .hertz import race_contact, series_stiffness
 from .scene import Scene
@@ -246,11 +246,9 @@ def choose_contact_model(defect, requested: str, bearing) -> str:
     cache.  They stay selectable with ``contact_model = "area"``, ``"drop"`` or
     ``"profile"``.
     """
+    from .defects.contact import CONTACT_MODELS
     if requested and requested != "auto":
-        if requested not in ("profile", "drop", "area", "halfspace"):
-            raise SceneError(f"defect.contact_model={requested!r}; allowed values are "
-                             "'auto', 'profile', 'drop', 'area' and 'halfspace'")
-        return requested
+        return check_choice(requested, ("auto", *CONTACT_MODELS), "defect.contact_model", SceneError)
     return "halfspace"
 
 
@@ -308,6 +306,7 @@ def assemble(scene: Scene, *, fidelity: str | None = None) -> Assembly:
     # defects -> tables (a ball defect gets one table per race it meets)
     import dataclasses
     from .defects import contact_table
+    from .defects.contact import CONTACT_MODELS
     models, tables = [], []
     entries = []  # (race code, defect used for the table, psi0, ball, model)
     static_max = float(np.max(st["ball_loads"])) if len(st["ball_loads"]) else 0.0
@@ -334,7 +333,7 @@ def assemble(scene: Scene, *, fidelity: str | None = None) -> Assembly:
                             material=material)
         tables.append(tab)
         psi = np.asarray(tab.psi, dtype=float)
-        kind = 1 if model in ("area", "halfspace") else 0
+        kind = 1 if CONTACT_MODELS[model].tabulated else 0
         h = np.ascontiguousarray(tab.drop, dtype=float)
         # the kernel interpolates G^(2/3) (see _kernels._interp_g)
         G = np.ascontiguousarray(np.maximum(tab.G, 0.0) ** (2.0 / 3.0), dtype=float)

@@ -47,7 +47,7 @@ import tomllib
 import numpy as np
 
 from ..bearings import BearingGeometry, CATALOG, get_bearing
-from ..errors import SceneError
+from ..errors import SceneError, check_choice
 
 
 class SceneWarning(UserWarning):
@@ -261,9 +261,8 @@ def _check(value, key, spec, where):
     if typ is str:
         if not isinstance(value, str):
             raise SceneError(f"{where}: {value!r} must be a string")
-        if isinstance(check, tuple) and value not in check:
-            raise SceneError(f"{where}: invalid value {value!r}; allowed values are "
-                             + ", ".join(repr(c) for c in check))
+        if isinstance(check, tuple):
+            check_choice(value, check, where, SceneError)
         return value
     if typ is list:
         if not isinstance(value, list):
@@ -335,7 +334,9 @@ class Scene:
         for i, m in enumerate(d["defect"]):
             where = "defect" if len(d["defect"]) == 1 else f"defect[{i}]"
             m = {k: _convert(v, k, f"{where}.{k}") for k, v in m.items()}
-            m.pop("contact_model", None)
+            from .defects.contact import CONTACT_MODELS  # the registry names the allowed models
+            check_choice(m.pop("contact_model", "auto"), ("auto", *CONTACT_MODELS),
+                         f"{where}.contact_model", SceneError)
             defect = Defect.from_mapping(m, where=where)
             defect.validate(bearing)
             defects.append(defect)
