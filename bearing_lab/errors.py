@@ -37,7 +37,8 @@ def check_choice(value, allowed, where: str, error: type = BearingLabError):
 
         <where>: invalid value 'x'; allowed values are 'a', 'b' and 'c'
 
-    ``where`` names the input (a scene key, a parameter, a command-line option).
+    ``where`` names the input (a scene key, a parameter, a command-line option); ``error`` is
+    an exception type, or any callable taking the message and returning the exception.
 
     Examples
     --------

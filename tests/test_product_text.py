@@ -74,3 +74,18 @@ def test_help_walk_matches_the_command_line(cmd, capsys):
     helps = dict(_all_help(build_parser()))
     key = " ".join(["bearing-lab"] + cmd[:-1])
     assert printed.split() == helps[key].split()
+
+
+def test_one_wording_for_allowed_values():
+    """Options that take one of a few values are checked by errors.check_choice, so every such
+    message reads "<input>: invalid value 'x'; allowed values are ...".  Left: two parameters
+    that also take a number or a pair (analysis._impulse: baseline, band) and the spectral-line
+    estimators' method/window in analysis._speed."""
+    old = re.compile(r"Invalid value for|Allowed values are|allowed are")
+    exceptions = {"_impulse.py": 2, "_speed.py": 2}
+    found = {}
+    for p in (ROOT / "bearing_lab").rglob("*.py"):
+        n = len(old.findall(p.read_text()))
+        if n:
+            found[p.name] = n
+    assert found == exceptions, found

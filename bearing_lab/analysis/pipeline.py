@@ -37,7 +37,7 @@ import warnings
 import numpy as np
 
 from ..bearings import BearingGeometry, get_bearing
-from ..errors import AnalysisError, BearingLabError
+from ..errors import AnalysisError, BearingLabError, check_choice
 from ._diagnosis import (coincidences, combine, deciding_route, interpretations, route_summary, run_routes,
                          runner_up, spectrum_top)
 from ._families import LABELS, CyclicSpectrum
@@ -103,9 +103,7 @@ def _speed(x, fs, geom, *, rpm, rpm_source, shaft_hz, tacho, pulses_per_rev, tol
         return xa, sp, None
     if rpm is not None and not (math.isfinite(rpm) and rpm > 0):
         raise AnalysisError(f"analyze: rpm={rpm!r} must be a positive speed in r/min")
-    if rpm_source not in ("given", "file"):
-        raise AnalysisError(f"Invalid value for the 'rpm_source' parameter. Allowed values are 'given' "
-                            f"and 'file', but got {rpm_source!r} instead.")
+    check_choice(rpm_source, ("given", "file"), "analyze: rpm_source", AnalysisError)
     xw = cepstral_prewhitening(x)
     cache = {}
 

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..errors import BearingLabError, RecordingError
+from ..errors import BearingLabError, RecordingError, check_choice
 from ._base import ENGINES, RecordingReader, RecordingWarning, get_warnings  # noqa: F401
 
 # one import line per format: the order is the sniffing order
@@ -154,10 +154,7 @@ def open_recording(path, format=None, **options):
             format = guess_format(path)
         except OSError as exc:
             raise RecordingError(f"{path}: cannot read the file ({exc.strerror or exc})") from None
-    if format not in ENGINES:
-        msg = (f"{path}: invalid value for the 'format' parameter. Allowed values are "
-               f"{', '.join(repr(n) for n in ENGINES)}, but got {format!r} instead")
-        raise RecordingError(msg)
+    check_choice(format, ENGINES, f"{path}: format", RecordingError)
     reader = ENGINES[format]()
     missing = reader.available()
     if missing:

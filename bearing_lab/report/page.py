@@ -6,6 +6,7 @@ import json
 import re
 from pathlib import Path
 
+from ..errors import check_choice
 from .html import (css, esc, figure_html, kv_html, notice_html, rows_table, table_html, template,
                    index_rows)
 
@@ -150,8 +151,7 @@ class Report:
         elif path.suffix in (".html", ".htm"):
             text = self.to_html()
         else:
-            raise ValueError(f"Invalid value for the report path suffix: allowed are '.html' and '.json', "
-                             f"but got {path.suffix!r} instead.")
+            check_choice(path.suffix, (".html", ".htm", ".json"), f"{path}: suffix", ValueError)
         path.parent.mkdir(parents=True, exist_ok=True)
         with atomic_open(path, "w", encoding="utf-8") as fh:
             fh.write(text)
