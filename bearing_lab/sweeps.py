@@ -80,7 +80,7 @@ _UNIT_STRINGS = {
 # simulate()'s keywords and the scene keys they set (the same mapping simulate applies)
 _SIM_KW = {"duration": "output.duration_s", "fs": "output.sample_rate_hz", "rtol": "solver.rtol",
            "method": "solver.method", "step": "solver.step_s", "fidelity": "fidelity"}
-_METRICS = ("rms", "peak", "crest_factor", "kurtosis")
+_METRICS = ("rms", "peak", "crest_factor", "kurtosis")   # the analysis METRICS stored per scene
 _METRIC_SIGNAL = DEFAULT_CHANNEL  # the simulator's accelerometer signal
 _REQUIRED = ("outer_ring_acc_y", "outer_ring_acc_x", "outer_ring_disp_y", "outer_ring_disp_x",
              "inner_ring_disp_y", "inner_ring_disp_x")
@@ -195,24 +195,12 @@ def _coord(key, values):
 
 
 def _metrics(x: np.ndarray) -> dict:
-    """RMS, peak, crest factor, Pearson kurtosis (NaN where undefined)."""
-    try:
-        from .analysis import crest_factor, kurtosis, peak, rms
-        fns = {"rms": rms, "peak": peak, "crest_factor": crest_factor, "kurtosis": kurtosis}
-    except ImportError:  # pragma: no cover - analysis is part of the package
-        fns = None
+    """The sweep's metrics (the analysis table's functions; NaN where undefined)."""
+    from .analysis._metrics import METRICS
     out = {}
     for name in _METRICS:
         try:
-            if fns is not None:
-                out[name] = float(fns[name](x))
-                continue
-            r = float(np.sqrt(np.mean(x * x)))
-            p = float(np.max(np.abs(x)))
-            d = x - x.mean()
-            m2 = float(np.mean(d * d))
-            out[name] = {"rms": r, "peak": p, "crest_factor": p / r if r else math.nan,
-                         "kurtosis": float(np.mean(d ** 4)) / m2 ** 2 if m2 else math.nan}[name]
+            out[name] = float(METRICS[name].func(x))
         except BearingLabError:
             out[name] = math.nan
     return out
@@ -534,12 +522,11 @@ def sweep(scene, params: dict, *, scheduler=None, n_workers: int | None = None, 
     out = acc.dataset(sdims, coords)
     if metrics:
         units = out[_METRIC_SIGNAL].attrs.get("units", "") if _METRIC_SIGNAL in out else ""
-        long = {"rms": "RMS", "peak": "peak (largest |x|)", "crest_factor": "crest factor (peak / RMS)",
-                "kurtosis": "Pearson kurtosis (Gaussian = 3)"}
+        from .analysis._metrics import METRICS, metric_units
         for name in _METRICS:
             out[name] = (sdims, acc.metrics[name].reshape(shape),
-                         {"units": units if name in ("rms", "peak") else "1",
-                          "long_name": f"{long[name]} of {_METRIC_SIGNAL}", "signal": _METRIC_SIGNAL})
+                         {"units": metric_units(name, units),
+                          "long_name": f"{METRICS[name].long_name} of {_METRIC_SIGNAL}", "signal": _METRIC_SIGNAL})
     out["wall_time_s"] = (sdims, acc.wall.reshape(shape),
                           {"units": "s", "long_name": "compute time of the scene (simulate's wall_time_s, "
                                                       "without compilation; from the run that filled the cache)"})
