@@ -65,8 +65,9 @@ import uuid
 import numpy as np
 
 from . import __version__
-from .schema import DEFAULT_CHANNEL
 from .errors import BearingLabError, SceneError
+from ._sweep_store import (CacheWarning, _checksum_path, _from_cache, _METRIC_SIGNAL, _METRICS,  # noqa: F401
+                           _Stack, _write_cache)
 
 __all__ = ["sweep", "scene_hash", "code_fingerprint", "default_cache_dir", "dim_name", "key_units",
            "CacheWarning"]
@@ -80,17 +81,8 @@ _UNIT_STRINGS = {
 # simulate()'s keywords and the scene keys they set (the same mapping simulate applies)
 _SIM_KW = {"duration": "output.duration_s", "fs": "output.sample_rate_hz", "rtol": "solver.rtol",
            "method": "solver.method", "step": "solver.step_s", "fidelity": "fidelity"}
-_METRICS = ("rms", "peak", "crest_factor", "kurtosis")   # the analysis METRICS stored per scene
-_METRIC_SIGNAL = DEFAULT_CHANNEL  # the simulator's accelerometer signal
-_REQUIRED = ("outer_ring_acc_y", "outer_ring_acc_x", "outer_ring_disp_y", "outer_ring_disp_x",
-             "inner_ring_disp_y", "inner_ring_disp_x")
 
 
-class CacheWarning(UserWarning):
-    """A sweep-cache entry was damaged or incomplete and its scene was computed again."""
-
-
-# ---------------------------------------------------------------- helpers
 def default_cache_dir() -> Path:
     """``$BEARING_LAB_CACHE`` or ``~/.cache/bearing_lab/sweeps``."""
     env = os.environ.get("BEARING_LAB_CACHE")
@@ -194,93 +186,7 @@ def _coord(key, values):
     return arr, attrs
 
 
-def _metrics(x: np.ndarray) -> dict:
-    """The sweep's metrics (the analysis table's functions; NaN where undefined)."""
-    from .analysis._metrics import METRICS
-    out = {}
-    for name in _METRICS:
-        try:
-            out[name] = float(METRICS[name].func(x))
-        except BearingLabError:
-            out[name] = math.nan
-    return out
-
-
 # ---------------------------------------------------------------- one scene (runs on workers)
-def _checksum_path(path: Path) -> Path:
-    return path.with_name(path.name + ".sha256")
-
-
-def _write_cache(ds, path: Path) -> None:
-    """Write one scene to the cache: netCDF4, float64 as is, *uncompressed* (zlib costs
-    ~0.12 s per 1 s scene, a third of its simulation, to save a third of 3.5 MB), then its
-    checksum file ``<hash>.nc.sha256`` (``sha256sum -c`` format).  Both are written
-    atomically; an entry without its checksum is incomplete and is never read."""
-    from ._files import atomic_open, atomic_path, sha256_file
-    path.parent.mkdir(parents=True, exist_ok=True)
-    out = ds.copy(deep=False)
-    out.attrs = {k: (int(v) if isinstance(v, (bool, np.bool_)) else "" if v is None else v)
-                 for k, v in ds.attrs.items()}
-    try:
-        with atomic_path(path) as tmp:
-            out.to_netcdf(tmp, engine="netcdf4", format="NETCDF4")
-            digest = sha256_file(tmp)
-        with atomic_open(_checksum_path(path), "w") as fh:
-            fh.write(f"{digest}  {path.name}\n")
-    except (OSError, ValueError, RuntimeError) as exc:
-        raise BearingLabError(f"sweep: cannot write the cache file {path}: {exc}") from None
-
-
-def _cache_problem(ds, digest: str, expect: dict) -> str | None:
-    """What is wrong with a cache entry's content, or None (shape, names, finite values)."""
-    if ds.attrs.get("sweep_scene_hash") != digest:
-        return "it belongs to another scene"
-    for name in _REQUIRED:
-        if name not in ds.data_vars:
-            return f"variable {name} is missing"
-    for dim, n in expect.items():
-        if ds.sizes.get(dim) != n:
-            return f"dimension {dim} has {ds.sizes.get(dim)} entries, the scene needs {n}"
-    for name, var in ds.data_vars.items():
-        if var.dtype.kind in "fc" and not np.all(np.isfinite(var.values)):
-            return f"variable {name} holds NaN/Inf"
-    return None
-
-
-def _read_cache(path: Path, digest: str, expect: dict):
-    """Return (Dataset or None, problem or None): None/None when there is no entry.
-
-    The file's bytes are checked against its checksum file before netCDF reads them
-    (a damaged file never reaches the C library), then the content is validated.
-    """
-    import xarray as xr
-    from ._files import sha256_file
-    if not path.is_file():
-        return None, None
-    sums = _checksum_path(path)
-    try:
-        recorded = sums.read_text().split()[0] if sums.is_file() else None
-    except (OSError, IndexError, UnicodeDecodeError):
-        recorded = None
-    if recorded is None:
-        return None, "no checksum file (an interrupted write)"
-    try:
-        if sha256_file(path) != recorded:
-            return None, "its sha256 does not match the checksum file"
-        ds = xr.load_dataset(path, engine="netcdf4")
-    except (OSError, ValueError, RuntimeError, KeyError) as exc:
-        return None, f"unreadable ({type(exc).__name__}: {exc})"
-    return (None, problem) if (problem := _cache_problem(ds, digest, expect)) else (ds, None)
-
-
-def _drop_entry(path: Path) -> None:
-    for p in (path, _checksum_path(path)):
-        try:
-            p.unlink()
-        except OSError:
-            pass
-
-
 def _simulate_scene(scene_toml: str, digest: str, cache_path: str | None):
     """Simulate one resolved scene (given as TOML); write the cache file if asked.
 
@@ -402,118 +308,69 @@ def _client_for(scheduler, n_workers):
                           "a 'tcp://host:port' address or a dask.distributed.Client")
 
 
-def sweep(scene, params: dict, *, scheduler=None, n_workers: int | None = None, cache_dir=None,
-          progress: bool = True, metrics: bool = True, **simulate_kwargs):
-    """Simulate every combination of swept scene keys; return one labelled Dataset.
-
-    Parameters
-    ----------
-    scene : built-in name, TOML path, dict or Scene (the base of every scene).
-    params : ``{key: [values, ...]}`` with ``--set`` keys (``speed_rpm``,
-        ``load.radial_n``, ``defect.offset_mm``, ``fidelity`` ...).  The grid is the
-        Cartesian product, in the order the keys are given.
-    scheduler : None/"local" (LocalCluster), "serial", "tcp://host:port" or a Client.
-    n_workers : worker processes of the local cluster (default 2).
-    cache_dir : where finished scenes are kept (default ``$BEARING_LAB_CACHE`` or
-        ``~/.cache/bearing_lab/sweeps``); False: no cache.
-    progress : tqdm bar over the scenes as they finish.
-    metrics : add rms, peak, crest_factor, kurtosis of outer_ring_acc_y.
-    **simulate_kwargs : fixed for every scene: ``duration``, ``fs``, ``rtol``,
-        ``method``, ``step``, ``fidelity`` or ``--set`` keys.
-
-    Returns
-    -------
-    xarray.Dataset (see the module docstring).
-
-    Raises
-    ------
-    SceneError : a bad key or value (the message names it), or a sweep that
-        changes the time axis.
-    BearingLabError : scheduler problems; errors of a scene's solve are re-raised
-        with the scene's swept values in the message.
-    """
-    t_start = _time.perf_counter()
-    keys, values, base, scenes = _resolve(scene, params, simulate_kwargs)
-    kw_for_hash = {k: v for k, v in simulate_kwargs.items() if v is not None}
-    tomls = [s.to_toml() for s in scenes]
-    digests = [scene_hash(t, kw_for_hash) for t in tomls]
+def _open_cache_dir(cache_dir) -> Path | None:
     if cache_dir is False:
-        cdir = None
-    else:
-        cdir = Path(cache_dir).expanduser() if cache_dir not in (None, True) else default_cache_dir()
-        try:
-            cdir.mkdir(parents=True, exist_ok=True)
-        except OSError as exc:
-            raise BearingLabError(f"sweep: cannot create the cache directory {cdir}: {exc}") from None
-    shape = tuple(len(v) for v in values)
-    n = len(scenes)
-
-    acc = _Stack(shape, n)
-    hits, todo, rejected = _from_cache(cdir, scenes, digests, acc)
-
-    bar = None
-    if progress:
-        from tqdm.auto import tqdm
-        bar = tqdm(total=n, initial=hits, unit="scene", desc=f"sweep {base.name}", leave=False)
-
-    def label(i):
-        idx = np.unravel_index(i, shape)
-        return ", ".join(f"{k}={values[a][j]!r}" for a, (k, j) in enumerate(zip(keys, idx)))
-
-    def failed(i, exc):
-        if isinstance(exc, BearingLabError):
-            return type(exc)(f"sweep scene {label(i)}: {exc}")
-        return BearingLabError(f"sweep scene {label(i)}: {type(exc).__name__}: {exc}")
-
-    desc = "serial (in process)"
+        return None
+    cdir = Path(cache_dir).expanduser() if cache_dir not in (None, True) else default_cache_dir()
     try:
-        if todo and scheduler == "serial":
-            for i in todo:
-                path = str(cdir / f"{digests[i]}.nc") if cdir is not None else None
-                try:
-                    ds = _simulate_scene(tomls[i], digests[i], path)
-                except Exception as exc:  # noqa: BLE001 - re-raised with the scene's values
-                    raise failed(i, exc) from exc
-                acc.put(i, ds, cached=False)
-                if bar is not None:
-                    bar.update(1)
-        elif todo:
-            client, cluster, own, desc = _client_for(scheduler, n_workers)
-            remote = cluster is None  # an existing cluster's workers may not share our disk
-            try:
-                from dask.distributed import as_completed
-                futures = {}
-                for i in todo:
-                    # workers of a local cluster share our disk and write the cache themselves
-                    path = str(cdir / f"{digests[i]}.nc") if (cdir is not None and not remote) else None
-                    fut = client.submit(_simulate_scene, tomls[i], digests[i], path,
-                                        key=f"bearing_lab-scene-{digests[i][:16]}-{uuid.uuid4().hex[:8]}",
-                                        pure=False)
-                    futures[fut] = i
-                for fut in as_completed(list(futures)):
-                    i = futures.pop(fut)
-                    try:
-                        ds = fut.result()
-                    except Exception as exc:  # noqa: BLE001
-                        for other in futures:
-                            other.cancel()
-                        raise failed(i, exc) from exc
-                    del fut
-                    if remote and cdir is not None:
-                        _write_cache(ds, cdir / f"{digests[i]}.nc")
-                    acc.put(i, ds, cached=False)
-                    if bar is not None:
-                        bar.update(1)
-            finally:
-                if own:
-                    client.close()
-                if cluster is not None:
-                    cluster.close()
-    finally:
-        if bar is not None:
-            bar.close()
+        cdir.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise BearingLabError(f"sweep: cannot create the cache directory {cdir}: {exc}") from None
+    return cdir
 
-    # ---- assemble
+
+def _compute(todo, tomls, digests, cdir, acc, scheduler, n_workers, bar, failed) -> str:
+    """Simulate the scenes ``todo`` (serially or on Dask) into ``acc``; return the scheduler used."""
+    if not todo:
+        return "serial (in process)"
+    if scheduler == "serial":
+        for i in todo:
+            path = str(cdir / f"{digests[i]}.nc") if cdir is not None else None
+            try:
+                ds = _simulate_scene(tomls[i], digests[i], path)
+            except Exception as exc:  # noqa: BLE001 - re-raised with the scene's values
+                raise failed(i, exc) from exc
+            acc.put(i, ds, cached=False)
+            if bar is not None:
+                bar.update(1)
+        return "serial (in process)"
+    client, cluster, own, desc = _client_for(scheduler, n_workers)
+    remote = cluster is None  # an existing cluster's workers may not share our disk
+    try:
+        from dask.distributed import as_completed
+        futures = {}
+        for i in todo:
+            # workers of a local cluster share our disk and write the cache themselves
+            path = str(cdir / f"{digests[i]}.nc") if (cdir is not None and not remote) else None
+            fut = client.submit(_simulate_scene, tomls[i], digests[i], path,
+                                key=f"bearing_lab-scene-{digests[i][:16]}-{uuid.uuid4().hex[:8]}",
+                                pure=False)
+            futures[fut] = i
+        for fut in as_completed(list(futures)):
+            i = futures.pop(fut)
+            try:
+                ds = fut.result()
+            except Exception as exc:  # noqa: BLE001
+                for other in futures:
+                    other.cancel()
+                raise failed(i, exc) from exc
+            del fut
+            if remote and cdir is not None:
+                _write_cache(ds, cdir / f"{digests[i]}.nc")
+            acc.put(i, ds, cached=False)
+            if bar is not None:
+                bar.update(1)
+    finally:
+        if own:
+            client.close()
+        if cluster is not None:
+            cluster.close()
+    return desc
+
+
+def _assemble(acc, keys, values, shape, digests, metrics):
+    """The sweep Dataset: the stacked scenes on the swept dimensions, per-scene metrics,
+    times, cache flags and the attributes that differ between scenes."""
     coords = {}
     for key, vals in zip(keys, values):
         arr, attrs = _coord(key, vals)
@@ -551,13 +408,79 @@ def sweep(scene, params: dict, *, scheduler=None, n_workers: int | None = None, 
         out[var] = (sdims, arr.reshape(shape), {"units": key_units(name) or "1",
                                                 "long_name": f"simulation attribute {name!r} of each "
                                                              "scene (it differs across the sweep)"})
+    return out
+
+
+def sweep(scene, params: dict, *, scheduler=None, n_workers: int | None = None, cache_dir=None,
+          progress: bool = True, metrics: bool = True, **simulate_kwargs):
+    """Simulate every combination of swept scene keys; return one labelled Dataset.
+
+    Parameters
+    ----------
+    scene : built-in name, TOML path, dict or Scene (the base of every scene).
+    params : ``{key: [values, ...]}`` with ``--set`` keys (``speed_rpm``,
+        ``load.radial_n``, ``defect.offset_mm``, ``fidelity`` ...).  The grid is the
+        Cartesian product, in the order the keys are given.
+    scheduler : None/"local" (LocalCluster), "serial", "tcp://host:port" or a Client.
+    n_workers : worker processes of the local cluster (default 2).
+    cache_dir : where finished scenes are kept (default ``$BEARING_LAB_CACHE`` or
+        ``~/.cache/bearing_lab/sweeps``); False: no cache.
+    progress : tqdm bar over the scenes as they finish.
+    metrics : add rms, peak, crest_factor, kurtosis of outer_ring_acc_y.
+    **simulate_kwargs : fixed for every scene: ``duration``, ``fs``, ``rtol``,
+        ``method``, ``step``, ``fidelity`` or ``--set`` keys.
+
+    Returns
+    -------
+    xarray.Dataset (see the module docstring).
+
+    Raises
+    ------
+    SceneError : a bad key or value (the message names it), or a sweep that
+        changes the time axis.
+    BearingLabError : scheduler problems; errors of a scene's solve are re-raised
+        with the scene's swept values in the message.
+    """
+    t_start = _time.perf_counter()
+    keys, values, base, scenes = _resolve(scene, params, simulate_kwargs)
+    kw_for_hash = {k: v for k, v in simulate_kwargs.items() if v is not None}
+    tomls = [s.to_toml() for s in scenes]
+    digests = [scene_hash(t, kw_for_hash) for t in tomls]
+    cdir = _open_cache_dir(cache_dir)
+    shape = tuple(len(v) for v in values)
+    n = len(scenes)
+
+    acc = _Stack(shape, n)
+    hits, todo, rejected = _from_cache(cdir, scenes, digests, acc)
+
+    bar = None
+    if progress:
+        from tqdm.auto import tqdm
+        bar = tqdm(total=n, initial=hits, unit="scene", desc=f"sweep {base.name}", leave=False)
+
+    def label(i):
+        idx = np.unravel_index(i, shape)
+        return ", ".join(f"{k}={values[a][j]!r}" for a, (k, j) in enumerate(zip(keys, idx)))
+
+    def failed(i, exc):
+        if isinstance(exc, BearingLabError):
+            return type(exc)(f"sweep scene {label(i)}: {exc}")
+        return BearingLabError(f"sweep scene {label(i)}: {type(exc).__name__}: {exc}")
+
+    try:
+        desc = _compute(todo, tomls, digests, cdir, acc, scheduler, n_workers, bar, failed)
+    finally:
+        if bar is not None:
+            bar.close()
+
+    out = _assemble(acc, keys, values, shape, digests, metrics)
     out.attrs.update({
         "title": f"bearing_lab sweep of scene {base.name!r}",
         "scene_name": base.name,
         "scene_toml": base.to_toml(),
         "bearing_lab_version": __version__,
         "sweep_params": json.dumps({k: v for k, v in zip(keys, values)}),
-        "sweep_dims": " ".join(sdims),
+        "sweep_dims": " ".join(dim_name(k) for k in keys),
         "sweep_n_scenes": int(n),
         "sweep_cache_hits": int(hits),
         "sweep_cache_rejected": int(len(rejected)),
@@ -570,104 +493,3 @@ def sweep(scene, params: dict, *, scheduler=None, n_workers: int | None = None, 
     })
     out.attrs.setdefault("Conventions", "CF-1.8")
     return out
-
-
-def _from_cache(cdir, scenes, digests, acc):
-    """Put every valid cached scene into ``acc``; return (hits, indices to compute, rejected).
-
-    A damaged or incomplete entry is deleted, listed in ``rejected`` and warned about
-    (:class:`CacheWarning`): its scene is computed again.
-    """
-    hits, todo, rejected = 0, [], []
-    for i, dg in enumerate(digests):
-        ds, problem = (None, None)
-        if cdir is not None:
-            expect = {"time": int(round(scenes[i].duration * scenes[i].fs_out)),
-                      "ball": scenes[i].bearing.n_balls}
-            ds, problem = _read_cache(cdir / f"{dg}.nc", dg, expect)
-        if problem is not None:
-            rejected.append(f"{dg[:12]} ({problem})")
-            _drop_entry(cdir / f"{dg}.nc")
-        if ds is None:
-            todo.append(i)
-        else:
-            acc.put(i, ds, cached=True)
-            hits += 1
-    if rejected:
-        import warnings
-        warnings.warn(f"sweep: {len(rejected)} damaged cache entr{'y' if len(rejected) == 1 else 'ies'} "
-                      f"in {cdir} computed again: {'; '.join(rejected)}", CacheWarning, stacklevel=3)
-    return hits, todo, rejected
-
-
-# attributes that differ per scene or are replaced by the sweep's own
-_PER_SCENE_ATTRS = {"title", "scene_toml", "wall_time_s", "table_time_s", "compile_time_s", "solver_steps",
-                    "solver_rejected_steps", "sweep_scene_hash", "scene_name"}
-
-
-class _Stack:
-    """Places each scene's variables at its grid index as results arrive (any order)."""
-
-    def __init__(self, shape, n):
-        self.shape, self.n = shape, n
-        self.arrays = None
-        self.template = None
-        self.metrics = {m: np.full(n, np.nan) for m in _METRICS}
-        self.wall = np.full(n, np.nan)
-        self.steps = np.zeros(n, dtype=np.int64)
-        self.cached = np.zeros(n, dtype=bool)
-        self.common_attrs = None
-        self.scene_attrs = {}  # scalar per-scene attributes, name -> values by scene index
-
-    def put(self, i, ds, *, cached):
-        if self.arrays is None:
-            self.template = ds
-            self.arrays = {name: np.empty((self.n, *var.shape), dtype=var.dtype)
-                           for name, var in ds.data_vars.items()}
-            self.common_attrs = {k: v for k, v in ds.attrs.items() if k not in _PER_SCENE_ATTRS}
-        else:
-            t0 = self.template
-            if set(ds.data_vars) != set(self.arrays):
-                raise BearingLabError("sweep: scenes returned different variables "
-                                      f"({sorted(ds.data_vars)} vs {sorted(self.arrays)})")
-            if not np.array_equal(ds["time"].values, t0["time"].values):
-                raise SceneError("sweep: scenes have different time axes; all scenes of a sweep "
-                                 "must share output.duration_s and output.sample_rate_hz")
-            for k in list(self.common_attrs):
-                if not _same(ds.attrs.get(k), self.common_attrs[k]):
-                    del self.common_attrs[k]
-        for name, arr in self.arrays.items():
-            v = ds[name].transpose(*self.template[name].dims).values
-            if v.shape != arr.shape[1:]:
-                raise BearingLabError(f"sweep: variable {name} has shape {v.shape} in one scene "
-                                      f"and {arr.shape[1:]} in another")
-            arr[i] = v
-        if _METRIC_SIGNAL in ds:
-            for k, val in _metrics(np.asarray(ds[_METRIC_SIGNAL].values)).items():
-                self.metrics[k][i] = val
-        for k, v in ds.attrs.items():
-            if k not in _PER_SCENE_ATTRS and isinstance(v, (str, int, float, np.number)):
-                self.scene_attrs.setdefault(k, [None] * self.n)[i] = v.item() if isinstance(v, np.generic) else v
-        self.wall[i] = float(ds.attrs.get("wall_time_s", np.nan))
-        self.steps[i] = int(ds.attrs.get("solver_steps", 0))
-        self.cached[i] = cached
-
-    def dataset(self, sdims, coords):
-        import xarray as xr
-        t = self.template
-        data_vars = {}
-        for name, arr in self.arrays.items():
-            var = t[name]
-            data_vars[name] = ((*sdims, *var.dims), arr.reshape(*self.shape, *var.shape), dict(var.attrs))
-        all_coords = dict(coords)
-        for cname, c in t.coords.items():
-            all_coords[cname] = (c.dims, c.values, dict(c.attrs))
-        self.arrays = None  # hand the memory to the Dataset
-        return xr.Dataset(data_vars, coords=all_coords)
-
-
-def _same(a, b) -> bool:
-    try:
-        return bool(np.array_equal(np.asarray(a), np.asarray(b)))
-    except Exception:  # noqa: BLE001 - incomparable attributes are simply not common
-        return False
