@@ -24,6 +24,7 @@ from pathlib import Path
 
 from ..errors import BearingLabError, RecordingError, check_choice
 from ._base import ENGINES, RecordingReader, RecordingWarning, get_warnings  # noqa: F401
+from .. import _accessor  # noqa: F401,E402  (registers da.bearing for the recordings)
 
 #: The built-in readers (one module each, named like the format), in sniffing order: the first
 #: reader whose ``guess_can_open`` says yes reads the file.
