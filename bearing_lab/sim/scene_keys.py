@@ -128,3 +128,49 @@ SCHEMA: dict[str, dict[str, tuple]] = {
 }
 DEFECT_KEYS = {"race", "shape", "length_mm", "width_mm", "depth_mm", "offset_mm", "skew_deg",
                "angle_deg", "vertices_mm", "diameter_mm", "contact_model"}
+
+#: the keys of one ``[[defect]]`` table: default and meaning (validated by the defect model)
+DEFECT_DOCS = {
+    "race": ("outer", "'outer', 'inner' or 'ball'"),
+    "shape": ("rectangle", "'rectangle', 'ellipse' or 'polygon'"),
+    "length_mm": (None, "extent along the track (required unless polygon or diameter_mm)"),
+    "width_mm": (None, "extent across the track (required unless polygon or diameter_mm)"),
+    "diameter_mm": (None, "a circular ellipse: sets length and width"),
+    "depth_mm": (0.5, "depth below the intact surface"),
+    "offset_mm": (0.0, "axial offset H of the centre from the raceway centre line"),
+    "skew_deg": (0.0, "rotation of the outline on the raceway"),
+    "angle_deg": (0.0, "position around the ring, from the load-zone centre"),
+    "vertices_mm": (None, "polygon: [[along, across], ...] about the centre"),
+    "contact_model": ("auto", "'auto', or a defect-contact model (sim/defects/contact.py CONTACT_MODELS)"),
+}
+
+
+def _cell(v) -> str:
+    if v is None:
+        return "—"
+    if v == "":
+        return '`""`'
+    if isinstance(v, (list, tuple)):
+        return ", ".join(f"`{x}`" for x in v)
+    return f"`{v}`"
+
+
+def keys_markdown() -> str:
+    """docs/scene-keys.md: every scene key with its default, check and meaning."""
+    checks = {"pos": "> 0", "nonneg": ">= 0", "frac": "in [0, 0.5)", "any": "any number", None: ""}
+    out = ["# Scene keys", "",
+           "Every key a scene (TOML file, dict or `--set KEY=VALUE`) accepts, with its default, the",
+           "check applied when the scene loads, and its meaning. Keys carry their unit in the name; a",
+           "value may also be a string with a unit (`\"1 mm\"`, `\"1800 rpm\"`). Generated from",
+           "`bearing_lab/sim/scene_keys.py` (the test suite keeps this page in step with it).", ""]
+    for sec, keys in SCHEMA.items():
+        out += [f"## {'top level' if sec == '' else '[' + sec + ']'}", "",
+                "| key | default | allowed | meaning |", "|---|---|---|---|"]
+        for k, (default, _typ, check, doc) in keys.items():
+            allowed = _cell(check) if isinstance(check, tuple) else checks.get(check, "")
+            out.append(f"| `{k}` | {_cell(default)} | {allowed} | {doc.replace('|', '/')} |")
+        out.append("")
+    out += ["## [[defect]] (one table per defect; none: a healthy bearing)", "",
+            "| key | default | meaning |", "|---|---|---|"]
+    out += [f"| `{k}` | {_cell(d)} | {doc} |" for k, (d, doc) in DEFECT_DOCS.items()]
+    return "\n".join(out) + "\n"
