@@ -1,6 +1,6 @@
 """``da.bearing.<name>(...)``: the analysis functions where a Jupyter user looks.
 
-Registered as soon as a recording or a simulation can exist (:mod:`bearing_lab.io`,
+Registered as soon as a recording or a simulation can exist (``open_recording``,
 :mod:`bearing_lab.sim` and :mod:`bearing_lab.analysis` import this module), so
 ``bl.open_recording(path).DE.bearing...`` works without importing the analysis package
 first.  Registration is cheap: every method imports :mod:`bearing_lab.analysis.xr` when
@@ -10,7 +10,7 @@ for parameters and units.
 Examples
 --------
 >>> import numpy as np, xarray as xr
->>> import bearing_lab.io  # registers the accessor
+>>> import bearing_lab.sim  # registers the accessor (as do open_recording and bearing_lab.analysis)
 >>> t = np.arange(2000) / 1000.0
 >>> da = xr.DataArray(np.cos(2 * np.pi * 50 * t), dims="time", coords={"time": t},
 ...                   attrs={"units": "m s-2"})

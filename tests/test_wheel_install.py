@@ -38,9 +38,16 @@ def _clean_source(dest: Path) -> Path:
     """The checkout's files that git knows or would add (no build/, *.egg-info, .venv): a stale
     egg-info's file list would otherwise smuggle files into the wheel that the package-data
     declaration misses."""
-    files = subprocess.run(["git", "-C", str(ROOT), "ls-files", "-z", "--cached", "--others",
-                            "--exclude-standard"], capture_output=True, text=True, check=True).stdout
-    for rel in filter(None, files.split("\0")):
+    try:
+        files = subprocess.run(["git", "-C", str(ROOT), "ls-files", "-z", "--cached", "--others",
+                                "--exclude-standard"], capture_output=True, text=True, check=True).stdout
+        rels = list(filter(None, files.split("\0")))
+    except (OSError, subprocess.CalledProcessError):   # a source archive without git
+        skip = {".git", ".venv", "build", "dist", "reports", "__pycache__", ".pytest_cache", ".hypothesis"}
+        rels = [str(f.relative_to(ROOT)) for f in ROOT.rglob("*")
+                if f.is_file() and not skip & set(f.relative_to(ROOT).parts)
+                and not any(part.endswith(".egg-info") for part in f.parts)]
+    for rel in rels:
         f = ROOT / rel
         if f.is_file():
             (dest / rel).parent.mkdir(parents=True, exist_ok=True)

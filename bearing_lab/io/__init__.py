@@ -24,7 +24,6 @@ from pathlib import Path
 
 from ..errors import BearingLabError, RecordingError, check_choice
 from ._base import ENGINES, RecordingReader, RecordingWarning, get_warnings  # noqa: F401
-from .. import _accessor  # noqa: F401,E402  (registers da.bearing for the recordings)
 
 #: The built-in readers (one module each, named like the format), in sniffing order: the first
 #: reader whose ``guess_can_open`` says yes reads the file.
@@ -193,6 +192,7 @@ def open_recording(path, format=None, **options):
         except OSError as exc:
             raise RecordingError(f"{path}: cannot read the file ({exc.strerror or exc})") from None
     check_choice(format, ENGINES, f"{path}: format", RecordingError)
+    from .. import _accessor  # noqa: F401  (registers da.bearing on the recordings; imports xarray)
     reader = ENGINES[format]()
     missing = reader.available()
     if missing:
