@@ -273,9 +273,7 @@ def _png(fig):
 
 
 def _report(out, rows, notes, speed_md=""):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from .figures import new_figure
     scenes = list(dict.fromkeys(r["scene"] for r in rows))
     html = ["<!DOCTYPE html><html><head><meta charset='utf-8'><title>bearing_lab: speed against error"
             "</title><style>body{font-family:sans-serif;max-width:1100px;margin:auto}table{border-collapse:"
@@ -286,7 +284,8 @@ def _report(out, rows, notes, speed_md=""):
             "Cost: CPU seconds (process time) per simulated second, one core, including the settling time.</p>"]
     for sc in scenes:
         rs = [r for r in rows if r["scene"] == sc]
-        fig, ax = plt.subplots(figsize=(6.5, 4.2))
+        fig = new_figure(figsize=(6.5, 4.2))
+        ax = fig.subplots()
         groups = [(f"{fid} ({solver})", mk, col,
                    lambda r, fid=fid, solver=solver: (r["fidelity"] == fid and r["solver"] == solver
                                                       and r["contact"] in (REF_CONTACT, "none")))
@@ -321,7 +320,6 @@ def _report(out, rows, notes, speed_md=""):
             html.append(f"<p><b>Fastest within tolerance:</b> {best['fidelity']}, {best['contact']}, "
                         f"{best['setting']}: {best['cost']:.4f} s/s, peak error {best['err_peak']:.2e}</p>")
         html.append(f"<img src='data:image/png;base64,{_png(fig)}'>")
-        plt.close(fig)
         html.append("<table><tr><th>fidelity</th><th>contact</th><th>setting</th><th>s/s</th><th>peak err</th>"
                     "<th>RMS err</th><th>period err</th><th>duration err</th></tr>")
         for r in sorted(rs, key=lambda r: r["cost"]):

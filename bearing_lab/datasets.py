@@ -2,7 +2,7 @@
 
 Why: recordings are never committed (their publishers' terms, and their size);
 the project keeps only their names, sha256, publisher addresses and test
-conditions in ``data/recordings.csv`` (one row per file, path relative to a
+conditions in ``bearing_lab/data/recordings.csv`` (one row per file, path relative to a
 mirror root such as ``../shared/data``).  A file is brought in from a local
 mirror (``--mirror DIR`` or ``BEARING_LAB_MIRROR``) with a hash check, or
 downloaded with pooch where a network allows.  The CWRU reader asks this module
@@ -11,7 +11,7 @@ for a record's sampling rate, because CWRU files do not store it (record 97 is
 
 Public API
 ----------
-load_registry()                     -- {name: Recording} from data/recordings.csv
+load_registry()                     -- {name: Recording} from bearing_lab/data/recordings.csv
 get(name)                           -- one Recording (name, or a unique suffix such as "130_OR007@6_0.mat")
 cwru_record(number)                 -- the Recording of a CWRU record number, or None
 cwru_sampling_rate(number)          -- its rate in Hz, or None if unknown
@@ -25,18 +25,22 @@ from __future__ import annotations
 
 import csv
 import functools
+import importlib.resources
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from .errors import RecordingError
 
-REGISTRY_FILE = Path(__file__).resolve().parents[1] / "data" / "recordings.csv"
+# package data: present in a wheel install as in a checkout (data/README.md documents it)
+REGISTRY_FILE = importlib.resources.files("bearing_lab") / "data" / "recordings.csv"
+# a checkout's git-ignored download folder (absent in a wheel install)
+_CHECKOUT_DATA = Path(__file__).resolve().parents[1] / "data"
 
 
 @dataclass(frozen=True)
 class Recording:
-    """One registered public recording (a row of data/recordings.csv)."""
+    """One registered public recording (a row of bearing_lab/data/recordings.csv)."""
 
     name: str
     sha256: str
@@ -62,9 +66,9 @@ def _num(text, kind=float):
 
 
 @functools.lru_cache(maxsize=4)
-def _load(path: str) -> dict:
+def _load(path) -> dict:
     out = {}
-    with open(path, newline="", encoding="utf-8") as fh:
+    with path.open("r", newline="", encoding="utf-8") as fh:
         for row in csv.DictReader(fh):
             rec = Recording(
                 name=row["name"], sha256=row["sha256"].strip().lower(), url=row["url"].strip(),
@@ -78,19 +82,18 @@ def _load(path: str) -> dict:
 
 
 def load_registry(path=None) -> dict[str, Recording]:
-    """Return ``{name: Recording}`` from ``data/recordings.csv`` (or ``path``).
+    """Return ``{name: Recording}`` from the package's ``data/recordings.csv`` (or ``path``).
 
     Raises
     ------
     RecordingError
-        If the registry file is missing (a non-editable install without ``data/``).
+        If the registry file is missing.
     """
     p = Path(path) if path else REGISTRY_FILE
     if not p.is_file():
-        msg = (f"data registry {p} not found; bearing_lab reads it from the project's data/ "
-               "directory: install the project in editable mode (make install)")
-        raise RecordingError(msg)
-    return dict(_load(str(p)))
+        why = "" if path else ": bearing_lab's package data is missing, the install is broken; reinstall it"
+        raise RecordingError(f"data registry {p} not found{why}")
+    return dict(_load(p))
 
 
 def get(name: str) -> Recording:
@@ -129,12 +132,12 @@ def pooch_registry() -> dict[str, str | None]:
 
 def data_dir() -> Path:
     """Return where fetched recordings go: ``BEARING_LAB_DATA``, else ``data/cache`` of the
-    project (git-ignored), else pooch's user cache."""
+    project checkout (git-ignored), else (an installed package) pooch's user cache."""
     env = os.environ.get("BEARING_LAB_DATA")
     if env:
         return Path(env)
-    proj = REGISTRY_FILE.parent
-    if proj.is_dir() and os.access(proj, os.W_OK):
+    proj = _CHECKOUT_DATA
+    if (proj / "README.md").is_file() and os.access(proj, os.W_OK):
         return proj / "cache"
     import pooch
     return Path(pooch.os_cache("bearing_lab"))

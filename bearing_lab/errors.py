@@ -29,3 +29,33 @@ class SolverError(BearingLabError, RuntimeError):
 
 class ValidationCaseError(BearingLabError, ValueError):
     """A validation case file is invalid or names a missing recording."""
+
+
+def check_choice(value, allowed, where: str, error: type = BearingLabError):
+    """Return ``value`` if it is one of ``allowed``, else raise ``error`` with the one wording used
+    for every option that takes one of a few values::
+
+        <where>: invalid value 'x'; allowed values are 'a', 'b' and 'c'
+
+    ``where`` names the input (a scene key, a parameter, a command-line option); ``error`` is
+    an exception type, or any callable taking the message and returning the exception.
+
+    Examples
+    --------
+    >>> check_choice("hann", ("hann", "boxcar"), "window")
+    'hann'
+    >>> check_choice("flat", ("hann", "boxcar"), "window", AnalysisError)
+    Traceback (most recent call last):
+    ...
+    bearing_lab.errors.AnalysisError: window: invalid value 'flat'; allowed values are 'hann' and 'boxcar'
+    """
+    allowed = tuple(allowed)
+    try:
+        ok = value in allowed
+    except TypeError:          # an unhashable value against a set or dict
+        ok = False
+    if ok:
+        return value
+    names = [repr(a) for a in allowed]
+    listed = names[0] if len(names) == 1 else ", ".join(names[:-1]) + " and " + names[-1]
+    raise error(f"{where}: invalid value {value!r}; allowed values are {listed}")

@@ -47,6 +47,7 @@ import numpy as np
 import xarray as xr
 
 from ._files import savefig, write_text
+from .figures import new_figure
 
 G0 = 9.80665
 STUDY_FS = 100_000.0
@@ -182,7 +183,6 @@ def run_paper_studies(out_dir="reports/studies", *, progress=True, studies=None)
     minimum load, minimum carried share and intact fraction, the contact model and the
     compute time (SI units).
     """
-    import matplotlib.pyplot as plt
     from tqdm.auto import tqdm
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -203,14 +203,12 @@ def run_paper_studies(out_dir="reports/studies", *, progress=True, studies=None)
     from .io_netcdf import write_netcdf
     write_netcdf(table, out / "studies.nc")
     _write_html(out, names, rows, figs)
-    for f in figs.values():
-        plt.close(f)
     return table
 
 
 def _pulse_figure(s, results):
-    import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(2, 1, figsize=(7.5, 6), sharex=True)
+    fig = new_figure(figsize=(7.5, 6))
+    ax = fig.subplots(2, 1, sharex=True)
     for lab, _ in STUDIES[s][1]:
         r = results[(s, lab)]
         ax[0].plot(r["t"] * 1e3, r["pulse"] * 1e6, label=lab)
@@ -230,8 +228,8 @@ def _mechanism_figure(names, results):
     """Through the passage: the defected ball's outer-race load, the share of the intact
     load its contact carries (elastic half-space) and the intact fraction of its Hertz
     ellipse (geometry), both at the static approach."""
-    import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(3, len(names), figsize=(4 * len(names), 8), squeeze=False, sharex="col")
+    fig = new_figure(figsize=(4 * len(names), 8))
+    ax = fig.subplots(3, len(names), squeeze=False, sharex="col")
     for i, s in enumerate(names):
         for lab, _ in STUDIES[s][1]:
             r = results[(s, lab)]

@@ -65,8 +65,9 @@ import uuid
 import numpy as np
 
 from . import __version__
-from .schema import DEFAULT_CHANNEL
 from .errors import BearingLabError, SceneError
+from ._sweep_store import (CacheWarning, _checksum_path, _from_cache, _METRIC_SIGNAL, _METRICS,  # noqa: F401
+                           _Stack, _write_cache)
 
 __all__ = ["sweep", "scene_hash", "code_fingerprint", "default_cache_dir", "dim_name", "key_units",
            "CacheWarning"]
@@ -80,17 +81,8 @@ _UNIT_STRINGS = {
 # simulate()'s keywords and the scene keys they set (the same mapping simulate applies)
 _SIM_KW = {"duration": "output.duration_s", "fs": "output.sample_rate_hz", "rtol": "solver.rtol",
            "method": "solver.method", "step": "solver.step_s", "fidelity": "fidelity"}
-_METRICS = ("rms", "peak", "crest_factor", "kurtosis")
-_METRIC_SIGNAL = DEFAULT_CHANNEL  # the simulator's accelerometer signal
-_REQUIRED = ("outer_ring_acc_y", "outer_ring_acc_x", "outer_ring_disp_y", "outer_ring_disp_x",
-             "inner_ring_disp_y", "inner_ring_disp_x")
 
 
-class CacheWarning(UserWarning):
-    """A sweep-cache entry was damaged or incomplete and its scene was computed again."""
-
-
-# ---------------------------------------------------------------- helpers
 def default_cache_dir() -> Path:
     """``$BEARING_LAB_CACHE`` or ``~/.cache/bearing_lab/sweeps``."""
     env = os.environ.get("BEARING_LAB_CACHE")
@@ -194,105 +186,7 @@ def _coord(key, values):
     return arr, attrs
 
 
-def _metrics(x: np.ndarray) -> dict:
-    """RMS, peak, crest factor, Pearson kurtosis (NaN where undefined)."""
-    try:
-        from .analysis import crest_factor, kurtosis, peak, rms
-        fns = {"rms": rms, "peak": peak, "crest_factor": crest_factor, "kurtosis": kurtosis}
-    except ImportError:  # pragma: no cover - analysis is part of the package
-        fns = None
-    out = {}
-    for name in _METRICS:
-        try:
-            if fns is not None:
-                out[name] = float(fns[name](x))
-                continue
-            r = float(np.sqrt(np.mean(x * x)))
-            p = float(np.max(np.abs(x)))
-            d = x - x.mean()
-            m2 = float(np.mean(d * d))
-            out[name] = {"rms": r, "peak": p, "crest_factor": p / r if r else math.nan,
-                         "kurtosis": float(np.mean(d ** 4)) / m2 ** 2 if m2 else math.nan}[name]
-        except BearingLabError:
-            out[name] = math.nan
-    return out
-
-
 # ---------------------------------------------------------------- one scene (runs on workers)
-def _checksum_path(path: Path) -> Path:
-    return path.with_name(path.name + ".sha256")
-
-
-def _write_cache(ds, path: Path) -> None:
-    """Write one scene to the cache: netCDF4, float64 as is, *uncompressed* (zlib costs
-    ~0.12 s per 1 s scene, a third of its simulation, to save a third of 3.5 MB), then its
-    checksum file ``<hash>.nc.sha256`` (``sha256sum -c`` format).  Both are written
-    atomically; an entry without its checksum is incomplete and is never read."""
-    from ._files import atomic_open, atomic_path, sha256_file
-    path.parent.mkdir(parents=True, exist_ok=True)
-    out = ds.copy(deep=False)
-    out.attrs = {k: (int(v) if isinstance(v, (bool, np.bool_)) else "" if v is None else v)
-                 for k, v in ds.attrs.items()}
-    try:
-        with atomic_path(path) as tmp:
-            out.to_netcdf(tmp, engine="netcdf4", format="NETCDF4")
-            digest = sha256_file(tmp)
-        with atomic_open(_checksum_path(path), "w") as fh:
-            fh.write(f"{digest}  {path.name}\n")
-    except (OSError, ValueError, RuntimeError) as exc:
-        raise BearingLabError(f"sweep: cannot write the cache file {path}: {exc}") from None
-
-
-def _cache_problem(ds, digest: str, expect: dict) -> str | None:
-    """What is wrong with a cache entry's content, or None (shape, names, finite values)."""
-    if ds.attrs.get("sweep_scene_hash") != digest:
-        return "it belongs to another scene"
-    for name in _REQUIRED:
-        if name not in ds.data_vars:
-            return f"variable {name} is missing"
-    for dim, n in expect.items():
-        if ds.sizes.get(dim) != n:
-            return f"dimension {dim} has {ds.sizes.get(dim)} entries, the scene needs {n}"
-    for name, var in ds.data_vars.items():
-        if var.dtype.kind in "fc" and not np.all(np.isfinite(var.values)):
-            return f"variable {name} holds NaN/Inf"
-    return None
-
-
-def _read_cache(path: Path, digest: str, expect: dict):
-    """Return (Dataset or None, problem or None): None/None when there is no entry.
-
-    The file's bytes are checked against its checksum file before netCDF reads them
-    (a damaged file never reaches the C library), then the content is validated.
-    """
-    import xarray as xr
-    from ._files import sha256_file
-    if not path.is_file():
-        return None, None
-    sums = _checksum_path(path)
-    try:
-        recorded = sums.read_text().split()[0] if sums.is_file() else None
-    except (OSError, IndexError, UnicodeDecodeError):
-        recorded = None
-    if recorded is None:
-        return None, "no checksum file (an interrupted write)"
-    try:
-        if sha256_file(path) != recorded:
-            return None, "its sha256 does not match the checksum file"
-        ds = xr.load_dataset(path, engine="netcdf4")
-    except (OSError, ValueError, RuntimeError, KeyError) as exc:
-        return None, f"unreadable ({type(exc).__name__}: {exc})"
-    return (None, problem) if (problem := _cache_problem(ds, digest, expect)) else (ds, None)
-
-
-def _drop_entry(path: Path) -> None:
-    for p in (path, _checksum_path(path)):
-        try:
-            p.unlink()
-        except OSError:
-            pass
-
-
 def _simulate_scene(scene_toml: str, digest: str, cache_path: str | None):
     """Simulate one resolved scene (given as TOML); write the cache file if asked.
 
@@ -414,6 +308,109 @@ def _client_for(scheduler, n_workers):
                           "a 'tcp://host:port' address or a dask.distributed.Client")
 
 
+def _open_cache_dir(cache_dir) -> Path | None:
+    if cache_dir is False:
+        return None
+    cdir = Path(cache_dir).expanduser() if cache_dir not in (None, True) else default_cache_dir()
+    try:
+        cdir.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise BearingLabError(f"sweep: cannot create the cache directory {cdir}: {exc}") from None
+    return cdir
+
+
+def _compute(todo, tomls, digests, cdir, acc, scheduler, n_workers, bar, failed) -> str:
+    """Simulate the scenes ``todo`` (serially or on Dask) into ``acc``; return the scheduler used."""
+    if not todo:
+        return "serial (in process)"
+    if scheduler == "serial":
+        for i in todo:
+            path = str(cdir / f"{digests[i]}.nc") if cdir is not None else None
+            try:
+                ds = _simulate_scene(tomls[i], digests[i], path)
+            except Exception as exc:  # noqa: BLE001 - re-raised with the scene's values
+                raise failed(i, exc) from exc
+            acc.put(i, ds, cached=False)
+            if bar is not None:
+                bar.update(1)
+        return "serial (in process)"
+    client, cluster, own, desc = _client_for(scheduler, n_workers)
+    remote = cluster is None  # an existing cluster's workers may not share our disk
+    try:
+        from dask.distributed import as_completed
+        futures = {}
+        for i in todo:
+            # workers of a local cluster share our disk and write the cache themselves
+            path = str(cdir / f"{digests[i]}.nc") if (cdir is not None and not remote) else None
+            fut = client.submit(_simulate_scene, tomls[i], digests[i], path,
+                                key=f"bearing_lab-scene-{digests[i][:16]}-{uuid.uuid4().hex[:8]}",
+                                pure=False)
+            futures[fut] = i
+        for fut in as_completed(list(futures)):
+            i = futures.pop(fut)
+            try:
+                ds = fut.result()
+            except Exception as exc:  # noqa: BLE001
+                for other in futures:
+                    other.cancel()
+                raise failed(i, exc) from exc
+            del fut
+            if remote and cdir is not None:
+                _write_cache(ds, cdir / f"{digests[i]}.nc")
+            acc.put(i, ds, cached=False)
+            if bar is not None:
+                bar.update(1)
+    finally:
+        if own:
+            client.close()
+        if cluster is not None:
+            cluster.close()
+    return desc
+
+
+def _assemble(acc, keys, values, shape, digests, metrics):
+    """The sweep Dataset: the stacked scenes on the swept dimensions, per-scene metrics,
+    times, cache flags and the attributes that differ between scenes."""
+    coords = {}
+    for key, vals in zip(keys, values):
+        arr, attrs = _coord(key, vals)
+        coords[dim_name(key)] = (dim_name(key), arr, attrs)
+    sdims = tuple(dim_name(k) for k in keys)
+    out = acc.dataset(sdims, coords)
+    if metrics:
+        units = out[_METRIC_SIGNAL].attrs.get("units", "") if _METRIC_SIGNAL in out else ""
+        from .analysis._metrics import METRICS, metric_units
+        for name in _METRICS:
+            out[name] = (sdims, acc.metrics[name].reshape(shape),
+                         {"units": metric_units(name, units),
+                          "long_name": f"{METRICS[name].long_name} of {_METRIC_SIGNAL}", "signal": _METRIC_SIGNAL})
+    out["wall_time_s"] = (sdims, acc.wall.reshape(shape),
+                          {"units": "s", "long_name": "compute time of the scene (simulate's wall_time_s, "
+                                                      "without compilation; from the run that filled the cache)"})
+    out["solver_steps"] = (sdims, acc.steps.reshape(shape), {"units": "1",
+                                                             "long_name": "accepted solver steps"})
+    out["cached"] = (sdims, acc.cached.reshape(shape).astype(np.int8),
+                     {"units": "1", "long_name": "1: the scene was read from the sweep cache",
+                      "flag_values": "0 1"})
+    out["scene_hash"] = (sdims, np.asarray(digests, dtype=object).reshape(shape),
+                         {"units": "1", "long_name": "sha256 of the resolved scene TOML, version and "
+                                                     "simulate options (the cache file name)"})
+    out.attrs.update(acc.common_attrs)
+    # attributes that differ between scenes (e.g. the fidelity "auto" picked) become variables
+    for name, vals in acc.scene_attrs.items():
+        if name in acc.common_attrs or any(v is None for v in vals):
+            continue
+        var = name if name not in out.variables else f"scene_{name}"
+        kinds = {type(v) for v in vals}
+        arr = (np.asarray(vals, dtype=float) if kinds <= {int, float} and kinds != {int}
+               else np.asarray(vals, dtype=np.int64) if kinds == {int}
+               else np.asarray([str(v) for v in vals], dtype=object))
+        out[var] = (sdims, arr.reshape(shape), {"units": key_units(name) or "1",
+                                                "long_name": f"simulation attribute {name!r} of each "
+                                                             "scene (it differs across the sweep)"})
+    return out
+
+
 def sweep(scene, params: dict, *, scheduler=None, n_workers: int | None = None, cache_dir=None,
           progress: bool = True, metrics: bool = True, **simulate_kwargs):
     """Simulate every combination of swept scene keys; return one labelled Dataset.
@@ -449,14 +446,7 @@ def sweep(scene, params: dict, *, scheduler=None, n_workers: int | None = None, 
     kw_for_hash = {k: v for k, v in simulate_kwargs.items() if v is not None}
     tomls = [s.to_toml() for s in scenes]
     digests = [scene_hash(t, kw_for_hash) for t in tomls]
-    if cache_dir is False:
-        cdir = None
-    else:
-        cdir = Path(cache_dir).expanduser() if cache_dir not in (None, True) else default_cache_dir()
-        try:
-            cdir.mkdir(parents=True, exist_ok=True)
-        except OSError as exc:
-            raise BearingLabError(f"sweep: cannot create the cache directory {cdir}: {exc}") from None
+    cdir = _open_cache_dir(cache_dir)
     shape = tuple(len(v) for v in values)
     n = len(scenes)
 
@@ -477,100 +467,20 @@ def sweep(scene, params: dict, *, scheduler=None, n_workers: int | None = None, 
             return type(exc)(f"sweep scene {label(i)}: {exc}")
         return BearingLabError(f"sweep scene {label(i)}: {type(exc).__name__}: {exc}")
 
-    desc = "serial (in process)"
     try:
-        if todo and scheduler == "serial":
-            for i in todo:
-                path = str(cdir / f"{digests[i]}.nc") if cdir is not None else None
-                try:
-                    ds = _simulate_scene(tomls[i], digests[i], path)
-                except Exception as exc:  # noqa: BLE001 - re-raised with the scene's values
-                    raise failed(i, exc) from exc
-                acc.put(i, ds, cached=False)
-                if bar is not None:
-                    bar.update(1)
-        elif todo:
-            client, cluster, own, desc = _client_for(scheduler, n_workers)
-            remote = cluster is None  # an existing cluster's workers may not share our disk
-            try:
-                from dask.distributed import as_completed
-                futures = {}
-                for i in todo:
-                    # workers of a local cluster share our disk and write the cache themselves
-                    path = str(cdir / f"{digests[i]}.nc") if (cdir is not None and not remote) else None
-                    fut = client.submit(_simulate_scene, tomls[i], digests[i], path,
-                                        key=f"bearing_lab-scene-{digests[i][:16]}-{uuid.uuid4().hex[:8]}",
-                                        pure=False)
-                    futures[fut] = i
-                for fut in as_completed(list(futures)):
-                    i = futures.pop(fut)
-                    try:
-                        ds = fut.result()
-                    except Exception as exc:  # noqa: BLE001
-                        for other in futures:
-                            other.cancel()
-                        raise failed(i, exc) from exc
-                    del fut
-                    if remote and cdir is not None:
-                        _write_cache(ds, cdir / f"{digests[i]}.nc")
-                    acc.put(i, ds, cached=False)
-                    if bar is not None:
-                        bar.update(1)
-            finally:
-                if own:
-                    client.close()
-                if cluster is not None:
-                    cluster.close()
+        desc = _compute(todo, tomls, digests, cdir, acc, scheduler, n_workers, bar, failed)
     finally:
         if bar is not None:
             bar.close()
 
-    # ---- assemble
-    coords = {}
-    for key, vals in zip(keys, values):
-        arr, attrs = _coord(key, vals)
-        coords[dim_name(key)] = (dim_name(key), arr, attrs)
-    sdims = tuple(dim_name(k) for k in keys)
-    out = acc.dataset(sdims, coords)
-    if metrics:
-        units = out[_METRIC_SIGNAL].attrs.get("units", "") if _METRIC_SIGNAL in out else ""
-        long = {"rms": "RMS", "peak": "peak (largest |x|)", "crest_factor": "crest factor (peak / RMS)",
-                "kurtosis": "Pearson kurtosis (Gaussian = 3)"}
-        for name in _METRICS:
-            out[name] = (sdims, acc.metrics[name].reshape(shape),
-                         {"units": units if name in ("rms", "peak") else "1",
-                          "long_name": f"{long[name]} of {_METRIC_SIGNAL}", "signal": _METRIC_SIGNAL})
-    out["wall_time_s"] = (sdims, acc.wall.reshape(shape),
-                          {"units": "s", "long_name": "compute time of the scene (simulate's wall_time_s, "
-                                                      "without compilation; from the run that filled the cache)"})
-    out["solver_steps"] = (sdims, acc.steps.reshape(shape), {"units": "1",
-                                                             "long_name": "accepted solver steps"})
-    out["cached"] = (sdims, acc.cached.reshape(shape).astype(np.int8),
-                     {"units": "1", "long_name": "1: the scene was read from the sweep cache",
-                      "flag_values": "0 1"})
-    out["scene_hash"] = (sdims, np.asarray(digests, dtype=object).reshape(shape),
-                         {"units": "1", "long_name": "sha256 of the resolved scene TOML, version and "
-                                                     "simulate options (the cache file name)"})
-    out.attrs.update(acc.common_attrs)
-    # attributes that differ between scenes (e.g. the fidelity "auto" picked) become variables
-    for name, vals in acc.scene_attrs.items():
-        if name in acc.common_attrs or any(v is None for v in vals):
-            continue
-        var = name if name not in out.variables else f"scene_{name}"
-        kinds = {type(v) for v in vals}
-        arr = (np.asarray(vals, dtype=float) if kinds <= {int, float} and kinds != {int}
-               else np.asarray(vals, dtype=np.int64) if kinds == {int}
-               else np.asarray([str(v) for v in vals], dtype=object))
-        out[var] = (sdims, arr.reshape(shape), {"units": key_units(name) or "1",
-                                                "long_name": f"simulation attribute {name!r} of each "
-                                                             "scene (it differs across the sweep)"})
+    out = _assemble(acc, keys, values, shape, digests, metrics)
     out.attrs.update({
         "title": f"bearing_lab sweep of scene {base.name!r}",
         "scene_name": base.name,
         "scene_toml": base.to_toml(),
         "bearing_lab_version": __version__,
         "sweep_params": json.dumps({k: v for k, v in zip(keys, values)}),
-        "sweep_dims": " ".join(sdims),
+        "sweep_dims": " ".join(dim_name(k) for k in keys),
         "sweep_n_scenes": int(n),
         "sweep_cache_hits": int(hits),
         "sweep_cache_rejected": int(len(rejected)),
@@ -583,104 +493,3 @@ def sweep(scene, params: dict, *, scheduler=None, n_workers: int | None = None, 
     })
     out.attrs.setdefault("Conventions", "CF-1.8")
     return out
-
-
-def _from_cache(cdir, scenes, digests, acc):
-    """Put every valid cached scene into ``acc``; return (hits, indices to compute, rejected).
-
-    A damaged or incomplete entry is deleted, listed in ``rejected`` and warned about
-    (:class:`CacheWarning`): its scene is computed again.
-    """
-    hits, todo, rejected = 0, [], []
-    for i, dg in enumerate(digests):
-        ds, problem = (None, None)
-        if cdir is not None:
-            expect = {"time": int(round(scenes[i].duration * scenes[i].fs_out)),
-                      "ball": scenes[i].bearing.n_balls}
-            ds, problem = _read_cache(cdir / f"{dg}.nc", dg, expect)
-        if problem is not None:
-            rejected.append(f"{dg[:12]} ({problem})")
-            _drop_entry(cdir / f"{dg}.nc")
-        if ds is None:
-            todo.append(i)
-        else:
-            acc.put(i, ds, cached=True)
-            hits += 1
-    if rejected:
-        import warnings
-        warnings.warn(f"sweep: {len(rejected)} damaged cache entr{'y' if len(rejected) == 1 else 'ies'} "
-                      f"in {cdir} computed again: {'; '.join(rejected)}", CacheWarning, stacklevel=3)
-    return hits, todo, rejected
-
-
-# attributes that differ per scene or are replaced by the sweep's own
-_PER_SCENE_ATTRS = {"title", "scene_toml", "wall_time_s", "table_time_s", "compile_time_s", "solver_steps",
-                    "solver_rejected_steps", "sweep_scene_hash", "scene_name"}
-
-
-class _Stack:
-    """Places each scene's variables at its grid index as results arrive (any order)."""
-
-    def __init__(self, shape, n):
-        self.shape, self.n = shape, n
-        self.arrays = None
-        self.template = None
-        self.metrics = {m: np.full(n, np.nan) for m in _METRICS}
-        self.wall = np.full(n, np.nan)
-        self.steps = np.zeros(n, dtype=np.int64)
-        self.cached = np.zeros(n, dtype=bool)
-        self.common_attrs = None
-        self.scene_attrs = {}  # scalar per-scene attributes, name -> values by scene index
-
-    def put(self, i, ds, *, cached):
-        if self.arrays is None:
-            self.template = ds
-            self.arrays = {name: np.empty((self.n, *var.shape), dtype=var.dtype)
-                           for name, var in ds.data_vars.items()}
-            self.common_attrs = {k: v for k, v in ds.attrs.items() if k not in _PER_SCENE_ATTRS}
-        else:
-            t0 = self.template
-            if set(ds.data_vars) != set(self.arrays):
-                raise BearingLabError("sweep: scenes returned different variables "
-                                      f"({sorted(ds.data_vars)} vs {sorted(self.arrays)})")
-            if not np.array_equal(ds["time"].values, t0["time"].values):
-                raise SceneError("sweep: scenes have different time axes; all scenes of a sweep "
-                                 "must share output.duration_s and output.sample_rate_hz")
-            for k in list(self.common_attrs):
-                if not _same(ds.attrs.get(k), self.common_attrs[k]):
-                    del self.common_attrs[k]
-        for name, arr in self.arrays.items():
-            v = ds[name].transpose(*self.template[name].dims).values
-            if v.shape != arr.shape[1:]:
-                raise BearingLabError(f"sweep: variable {name} has shape {v.shape} in one scene "
-                                      f"and {arr.shape[1:]} in another")
-            arr[i] = v
-        if _METRIC_SIGNAL in ds:
-            for k, val in _metrics(np.asarray(ds[_METRIC_SIGNAL].values)).items():
-                self.metrics[k][i] = val
-        for k, v in ds.attrs.items():
-            if k not in _PER_SCENE_ATTRS and isinstance(v, (str, int, float, np.number)):
-                self.scene_attrs.setdefault(k, [None] * self.n)[i] = v.item() if isinstance(v, np.generic) else v
-        self.wall[i] = float(ds.attrs.get("wall_time_s", np.nan))
-        self.steps[i] = int(ds.attrs.get("solver_steps", 0))
-        self.cached[i] = cached
-
-    def dataset(self, sdims, coords):
-        import xarray as xr
-        t = self.template
-        data_vars = {}
-        for name, arr in self.arrays.items():
-            var = t[name]
-            data_vars[name] = ((*sdims, *var.dims), arr.reshape(*self.shape, *var.shape), dict(var.attrs))
-        all_coords = dict(coords)
-        for cname, c in t.coords.items():
-            all_coords[cname] = (c.dims, c.values, dict(c.attrs))
-        self.arrays = None  # hand the memory to the Dataset
-        return xr.Dataset(data_vars, coords=all_coords)
-
-
-def _same(a, b) -> bool:
-    try:
-        return bool(np.array_equal(np.asarray(a), np.asarray(b)))
-    except Exception:  # noqa: BLE001 - incomparable attributes are simply not common
-        return False

@@ -31,7 +31,7 @@ from collections import namedtuple
 
 import numpy as np
 
-from ..errors import AnalysisError
+from ..errors import AnalysisError, check_choice
 from ._spectral import envelope_band, fast_kurtogram, squared_envelope
 from ._speed import _harmonic_family
 from ._util import check_fs, check_signal
@@ -357,9 +357,7 @@ def excitation_period(x, fs, *, frequency_range, band=None, method="ses", n_harm
     if lo < 4 * df:
         raise AnalysisError(f"excitation_period: x lasts {x.size / fs:.3g} s, too short to resolve "
                             f"an impact rate of {lo:g} Hz (need at least {4 / lo:.3g} s)")
-    if method not in ("ses", "times"):
-        raise AnalysisError(f"Invalid value for the 'method' parameter. Allowed values are 'ses' and "
-                            f"'times', but got {method!r} instead.")
+    check_choice(method, ("ses", "times"), "excitation_period: method", AnalysisError)
     # a demodulation band must hold several harmonics of the impact rate
     band = _band_arg(x, fs, band, "excitation_period", min_bandwidth=4 * hi, frequency_range=(lo, hi))
     se = squared_envelope(x, fs, band=band)

@@ -17,17 +17,17 @@ continuous one, so compare peaks of signals sampled the same way.
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
+from typing import Callable
+
 import numpy as np
 
 from ..errors import AnalysisError
 from ._util import check_signal
 
 __all__ = ["rms", "peak", "peak_to_peak", "crest_factor", "kurtosis", "impulse_factor",
-           "clearance_factor", "shape_factor", "metrics", "METRIC_NAMES"]
-
-METRIC_NAMES = ("rms", "peak", "peak_to_peak", "crest_factor", "kurtosis", "impulse_factor",
-                "clearance_factor", "shape_factor")
-_DIMENSIONLESS = {"crest_factor", "kurtosis", "impulse_factor", "clearance_factor", "shape_factor"}
+           "clearance_factor", "shape_factor", "metrics", "METRICS", "METRIC_NAMES", "Metric"]
+# METRICS, the table of metrics (one entry each), follows the functions below.
 
 
 def _x(x, func, axis):
@@ -157,7 +157,7 @@ def shape_factor(x, *, axis=-1):
 
 
 def metrics(x, *, axis=-1, units="1"):
-    """All eight metrics at once (one pass over the data).
+    """All the metrics of :data:`METRICS` at once (one pass over the data).
 
     Parameters
     ----------
@@ -185,21 +185,51 @@ def metrics(x, *, axis=-1, units="1"):
     """
     x = _x(x, "metrics", axis)
     a = np.abs(x)
-    ms = np.mean(x * x, axis=axis)
-    r = np.sqrt(ms)
-    pk = np.max(a, axis=axis)
-    mabs = np.mean(a, axis=axis)
-    msq = np.mean(np.sqrt(a), axis=axis)
     d = x - x.mean(axis=axis, keepdims=True)
-    m2 = np.mean(d * d, axis=axis)
-    for v, what in ((r, "rms"), (mabs, "mean |x|"), (m2, "the variance")):
-        _nonzero(v, "metrics", what)
-    out = {
-        "rms": r, "peak": pk, "peak_to_peak": np.ptp(x, axis=axis), "crest_factor": pk / r,
-        "kurtosis": np.mean(d ** 4, axis=axis) / m2 ** 2, "impulse_factor": pk / mabs,
-        "clearance_factor": pk / msq ** 2, "shape_factor": r / mabs,
-    }
+    mom = {"rms": np.sqrt(np.mean(x * x, axis=axis)), "peak": np.max(a, axis=axis),
+           "ptp": np.ptp(x, axis=axis), "mean_abs": np.mean(a, axis=axis),
+           "mean_sqrt_abs": np.mean(np.sqrt(a), axis=axis), "var": np.mean(d * d, axis=axis),
+           "m4": np.mean(d ** 4, axis=axis)}
+    for k, what in (("rms", "rms"), ("mean_abs", "mean |x|"), ("var", "the variance")):
+        _nonzero(mom[k], "metrics", what)
+    out = {name: m.from_moments(mom) for name, m in METRICS.items()}
     if x.ndim == 1:
         out = {k: float(v) for k, v in out.items()}
-    out["units"] = {k: ("1" if k in _DIMENSIONLESS else units) for k in METRIC_NAMES}
+    out["units"] = {k: metric_units(k, units) for k in METRICS}
     return out
+
+
+def metric_units(name: str, signal_units: str) -> str:
+    """The unit of metric ``name`` of a signal in ``signal_units`` ("1" for the ratios)."""
+    return "1" if METRICS[name].dimensionless else signal_units
+
+
+@dataclass(frozen=True)
+class Metric:
+    """One metric: its function, its value from the one-pass moments of :func:`metrics`
+    (keys ``rms``, ``peak``, ``ptp``, ``mean_abs``, ``mean_sqrt_abs``, ``var``, ``m4``: the
+    central moments along the time axis), whether it is a ratio (unit 1) and its long name."""
+
+    name: str
+    func: Callable
+    from_moments: Callable[[dict], np.ndarray]
+    dimensionless: bool
+    long_name: str
+
+
+#: name -> Metric, in report order.  Adding a metric: its function above, one entry here, its
+#: test in tests/analysis/test_analysis_metrics.py; ``metrics()``, the xarray wrapper, the
+#: accessor, ``analyze``'s JSON and sweeps read this table.
+METRICS: dict[str, Metric] = {m.name: m for m in [
+    Metric("rms", rms, lambda m: m["rms"], False, "RMS"),
+    Metric("peak", peak, lambda m: m["peak"], False, "peak (largest |x|)"),
+    Metric("peak_to_peak", peak_to_peak, lambda m: m["ptp"], False, "peak to peak"),
+    Metric("crest_factor", crest_factor, lambda m: m["peak"] / m["rms"], True, "crest factor (peak / RMS)"),
+    Metric("kurtosis", kurtosis, lambda m: m["m4"] / m["var"] ** 2, True, "Pearson kurtosis (Gaussian = 3)"),
+    Metric("impulse_factor", impulse_factor, lambda m: m["peak"] / m["mean_abs"], True,
+           "impulse factor (peak / mean |x|)"),
+    Metric("clearance_factor", clearance_factor, lambda m: m["peak"] / m["mean_sqrt_abs"] ** 2, True,
+           "clearance factor (peak / mean(sqrt|x|)^2)"),
+    Metric("shape_factor", shape_factor, lambda m: m["rms"] / m["mean_abs"], True, "shape factor (RMS / mean |x|)"),
+]}
+METRIC_NAMES = tuple(METRICS)

@@ -37,7 +37,7 @@ import warnings
 import numpy as np
 
 from ..bearings import BearingGeometry, get_bearing
-from ..errors import AnalysisError, BearingLabError
+from ..errors import AnalysisError, BearingLabError, check_choice
 from ._diagnosis import (coincidences, combine, deciding_route, interpretations, route_summary, run_routes,
                          runner_up, spectrum_top)
 from ._families import LABELS, CyclicSpectrum
@@ -105,9 +105,7 @@ def _speed(x, fs, geom, *, rpm, rpm_source, shaft_hz, tacho, pulses_per_rev, tol
         return xa, sp, None
     if rpm is not None and not (math.isfinite(rpm) and rpm > 0):
         raise AnalysisError(f"analyze: rpm={rpm!r} must be a positive speed in r/min")
-    if rpm_source not in ("given", "file"):
-        raise AnalysisError(f"Invalid value for the 'rpm_source' parameter. Allowed values are 'given' "
-                            f"and 'file', but got {rpm_source!r} instead.")
+    check_choice(rpm_source, ("given", "file"), "analyze: rpm_source", AnalysisError)
     xw = cepstral_prewhitening(x)
     cache = {}
 
@@ -459,9 +457,8 @@ def plot_analysis(x, fs, *, bearing, rpm=None, shaft_hz=None, channel="", units=
     3
     """
     if fig is None:
-        # a bare Figure (no pyplot): no backend switch, no global state; savefig works headless
-        from matplotlib.figure import Figure
-        fig = Figure(figsize=(10, 9), layout="constrained")
+        from ..figures import new_figure   # detached from pyplot, shown inline as a cell's value
+        fig = new_figure(figsize=(10, 9), layout="constrained")
     result, ex = _run(x, fs, bearing=bearing, rpm=rpm, shaft_hz=shaft_hz, units=units, **kwargs)
     result["channel"], result["units"] = str(channel), str(units)
     x = np.asarray(x, float)

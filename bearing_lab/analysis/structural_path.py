@@ -51,7 +51,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import AnalysisError
+from ..errors import AnalysisError, check_choice
 from .impacts import impact_peaks, impact_times, mean_envelope, segment_spectrum
 
 __all__ = ["transmissibility", "Resonance", "StructuralPath", "fit_structural_path", "MIN_IMPACTS"]
@@ -423,8 +423,7 @@ def fit_structural_path(recording, simulation, fs, period, *, band=None, n_reson
         raise AnalysisError(f"structural path: recording at {fs_r:g} Hz and simulation at {fs_s:g} Hz; "
                             "simulate at the recording's rate")
     fs = fs_r
-    if n_resonances not in (1, 2):
-        raise AnalysisError(f"structural path: n_resonances={n_resonances!r}; allowed values are 1 and 2")
+    check_choice(n_resonances, (1, 2), "structural path: n_resonances", AnalysisError)
     bounds, notes = _check_bounds(frequency_bounds, damping_bounds, gain_bounds, fs)
     f_hi = bounds["frequency_hz"][1]
     post = 0.6 * period if post is None else post

@@ -179,15 +179,13 @@ def excitation_duration(da, *, level=0.1, baseline="median", dim="time", fs=None
 
 
 def metrics(da, *, dim="time"):
-    """The eight :func:`bearing_lab.analysis.metrics` as a Dataset (units in attrs)."""
-    names = _metrics.METRIC_NAMES
-    res = xr.apply_ufunc(lambda x: tuple(np.asarray(v) for k, v in _metrics.metrics(x).items()
-                                         if k != "units"), da,
+    """The :func:`bearing_lab.analysis.metrics` as a Dataset (units and long names in attrs)."""
+    names = tuple(_metrics.METRICS)
+    res = xr.apply_ufunc(lambda x: (lambda m: tuple(np.asarray(m[k]) for k in names))(_metrics.metrics(x)), da,
                          input_core_dims=[[dim]], output_core_dims=[[] for _ in names],
                          dask="parallelized", output_dtypes=[float] * len(names),
                          dask_gufunc_kwargs=_kw())
     ds = xr.Dataset(dict(zip(names, res)))
     for k in names:
-        ds[k].attrs["units"] = "1" if k in _metrics._DIMENSIONLESS else _units(da)
-    ds["kurtosis"].attrs["long_name"] = "Pearson kurtosis (Gaussian = 3)"
+        ds[k].attrs.update(units=_metrics.metric_units(k, _units(da)), long_name=_metrics.METRICS[k].long_name)
     return ds

@@ -6,10 +6,9 @@ def _bench(args) -> int:
     from ..bench import SCENES, run_bench, summary_table
     names = [s[0] for s in SCENES]
     if args.scene:
-        bad = [s for s in args.scene if s not in names]
-        if bad:
-            from ..errors import BearingLabError
-            raise BearingLabError(f"--scene {bad[0]!r}: allowed values are " + ", ".join(names))
+        from ..errors import check_choice
+        for s in args.scene:
+            check_choice(s, names, "--scene")
     ds = run_bench(args.output, duration=args.duration, scenes=args.scene, progress=not args.quiet,
                    scipy=not args.no_scipy,
                    scipy_duration=args.scipy_duration)

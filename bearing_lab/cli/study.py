@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import sys
 
-from ..errors import BearingLabError
+from ..errors import BearingLabError, check_choice
 
 
 def _study(args) -> int:
@@ -11,9 +11,8 @@ def _study(args) -> int:
         raise BearingLabError(f"study {args.which!r}: the only study set is 'paper'")
     from ..studies import STUDIES, run_paper_studies
     names = args.only or list(STUDIES)
-    bad = [n for n in names if n not in STUDIES]
-    if bad:
-        raise BearingLabError(f"--only {bad[0]!r}: allowed values are " + ", ".join(STUDIES))
+    for n in names:
+        check_choice(n, STUDIES, "--only")
     table = run_paper_studies(args.output, progress=not args.quiet, studies=names)
     for r in table.to_dataframe().itertuples():
         print(f"{r.study:7s} {r.label:12s} peak disp {r.peak_displacement*1e6:7.4f} µm  "

@@ -1,4 +1,4 @@
-"""Recording import: a rig's file -> the recording Dataset of contract.md.
+"""Recording import: a rig's file -> the recording Dataset of :mod:`bearing_lab.schema`.
 
 Public API
 ----------
@@ -7,7 +7,9 @@ list_engines()                                -- {name: description} of the read
 to_netcdf(ds, path)                           -- compressed, lossless netCDF4
 to_uff58b(ds, path, channels=None, ...)       -- UFF 58b (binary) for Testlab and other tools
 get_warnings(ds)                              -- the recording's warnings as a list
-ENGINES                                       -- name -> reader class (one module per format)
+ENGINES                                       -- name -> reader class, in sniffing order (SNIFF_ORDER,
+                                                 then the entry-point group "bearing_lab.readers",
+                                                 then FALLBACK_READERS)
 RecordingReader                               -- base class of the readers
 RecordingWarning                              -- category of the non-fatal warnings
 
@@ -20,21 +22,56 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..errors import BearingLabError, RecordingError
+from ..errors import BearingLabError, RecordingError, check_choice
 from ._base import ENGINES, RecordingReader, RecordingWarning, get_warnings  # noqa: F401
 
-# one import line per format: the order is the sniffing order
-from . import uff58  # noqa: F401,E402
-from . import testlab_mat  # noqa: F401,E402
-from . import cwru  # noqa: F401,E402
-from . import mfpt  # noqa: F401,E402
-from . import ims  # noqa: F401,E402
-from . import testlab_text  # noqa: F401,E402
-from . import wav  # noqa: F401,E402
-from . import tdms  # noqa: F401,E402
-from . import mdf  # noqa: F401,E402
-from . import netcdf  # noqa: F401,E402
-from . import csv  # noqa: F401,E402  (last: it accepts any delimited text)
+#: The built-in readers (one module each, named like the format), in sniffing order: the first
+#: reader whose ``guess_can_open`` says yes reads the file.
+SNIFF_ORDER = ("uff58", "testlab_mat", "cwru", "mfpt", "ims", "testlab_text", "wav", "tdms", "mdf",
+               "netcdf")
+#: Readers that accept almost anything (any delimited text): sniffed last.
+FALLBACK_READERS = ("csv",)
+#: Entry-point group of readers installed by other packages (a lab's private format): each entry
+#: names a RecordingReader subclass; they are sniffed after SNIFF_ORDER, before FALLBACK_READERS.
+ENTRY_POINT_GROUP = "bearing_lab.readers"
+
+
+def _load_plugin_readers() -> list[str]:
+    """Register the readers of :data:`ENTRY_POINT_GROUP`; a broken one is skipped with a warning."""
+    import warnings
+    from importlib.metadata import entry_points
+    added = []
+    for ep in entry_points(group=ENTRY_POINT_GROUP):
+        why = None
+        if ep.name in ENGINES or ep.name in FALLBACK_READERS:
+            why = "the name is taken by a built-in reader"
+        else:
+            try:
+                cls = ep.load()
+            except Exception as exc:  # noqa: BLE001 - another package's import error must not stop ours
+                why = f"it cannot be imported ({type(exc).__name__}: {exc})"
+            else:
+                if not (isinstance(cls, type) and issubclass(cls, RecordingReader)):
+                    why = f"{ep.value} is not a bearing_lab.io.RecordingReader subclass"
+        if why:
+            warnings.warn(f"reader {ep.name!r} of the {ENTRY_POINT_GROUP!r} entry points ({ep.value}) "
+                          f"is not used: {why}", RecordingWarning, stacklevel=2)
+            continue
+        ENGINES[ep.name] = cls
+        added.append(ep.name)
+    return added
+
+
+def _register_readers():
+    import importlib
+    for name in SNIFF_ORDER:
+        importlib.import_module(f".{name}", __name__)
+    _load_plugin_readers()
+    for name in FALLBACK_READERS:
+        importlib.import_module(f".{name}", __name__)
+
+
+_register_readers()
 from .export import to_netcdf, to_uff58b  # noqa: E402
 
 __all__ = ["open_recording", "list_engines", "to_netcdf", "to_uff58b", "get_warnings",
@@ -154,10 +191,8 @@ def open_recording(path, format=None, **options):
             format = guess_format(path)
         except OSError as exc:
             raise RecordingError(f"{path}: cannot read the file ({exc.strerror or exc})") from None
-    if format not in ENGINES:
-        msg = (f"{path}: invalid value for the 'format' parameter. Allowed values are "
-               f"{', '.join(repr(n) for n in ENGINES)}, but got {format!r} instead")
-        raise RecordingError(msg)
+    check_choice(format, ENGINES, f"{path}: format", RecordingError)
+    from .. import _accessor  # noqa: F401  (registers da.bearing on the recordings; imports xarray)
     reader = ENGINES[format]()
     missing = reader.available()
     if missing:

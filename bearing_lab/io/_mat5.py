@@ -3,7 +3,7 @@
 Why our own reader: scipy.io's compiled v5 reader trusts the element tags it
 finds.  One flipped byte in a data type or a size (a CWRU file with byte 192 set
 to 0x19, say) makes it index outside its tables or buffers and the whole process
-dies with a segmentation fault (scipy issue 6072 is one of that family); other
+dies with a segmentation fault (scipy/scipy#6072 is one of that family); other
 corrupt sizes make it allocate gigabytes before failing.  A reader of users'
 files must never take the process down, so here every tag, size and offset is
 checked against the bytes that are really there *before* numpy looks at them:

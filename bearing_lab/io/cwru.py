@@ -1,7 +1,7 @@
 """Case Western Reserve University bearing data (``.mat`` with ``X###_DE_time`` ...).
 
 Why the registry: CWRU files store neither the sampling rate nor units.  The
-rate comes from ``data/recordings.csv`` through :mod:`bearing_lab.datasets`
+rate comes from ``bearing_lab/data/recordings.csv`` through :mod:`bearing_lab.datasets`
 (record 97 is 48 kHz, the drive-end 12k set 12 kHz); an unregistered record is
 refused with a request for ``fs=``.  Values are in g (the Bearing Data Center's
 description), converted to m s-2.
@@ -134,12 +134,12 @@ class CwruReader(RecordingReader):
             if len(rates) == 1:
                 fs = rates.pop()
             elif not rates:
-                b.fail(f"CWRU record {rec} is not in the registry (data/recordings.csv), and CWRU "
+                b.fail(f"CWRU record {rec} is not in the registry (bearing_lab/data/recordings.csv), and CWRU "
                        "files do not store their sampling rate; pass fs=12000 or fs=48000 (CLI "
                        "--fs) as the data centre lists it")
             else:
                 b.fail(f"records {cands} have different registered rates {sorted(rates)}; pass fs=")
-            b.attrs["sampling_rate_source"] = "registry data/recordings.csv" + (
+            b.attrs["sampling_rate_source"] = "registry bearing_lab/data/recordings.csv" + (
                 f" (file content, sha256, of {by_sha.name})" if reg is by_sha else "")
         else:
             b.attrs["sampling_rate_source"] = "user"
@@ -155,7 +155,7 @@ class CwruReader(RecordingReader):
             b.attrs["shaft_speed_source"] = f"file variable {rpm_var}"
         elif reg is not None and reg.rpm:
             rpm = reg.rpm
-            b.attrs["shaft_speed_source"] = "registry data/recordings.csv"
+            b.attrs["shaft_speed_source"] = "registry bearing_lab/data/recordings.csv"
         b.attrs["cwru_record"] = rec
         if file_no is not None and file_no != rec:
             b.attrs["cwru_file_number"] = file_no

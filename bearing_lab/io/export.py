@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import RecordingError
+from ..errors import RecordingError, check_choice
 from .. import units as _units
 
 # quantity -> (UFF specific data type, length exponent, force exponent)
@@ -105,9 +105,7 @@ def to_uff58b(ds, path, *, channels=None, units: str = "si", id1=None, id2=None,
                              f"{', '.join(ds.data_vars)}")
     if not channels:
         raise RecordingError(f"{path}: no time-series variables to export")
-    if units not in ("si", "original"):
-        raise RecordingError(f"Invalid value for the 'units' parameter. Allowed values are 'si' "
-                             f"and 'original', but got {units!r} instead")
+    check_choice(units, ("si", "original"), f"{path}: units", RecordingError)
     bo_code, bo_char = (1, "<") if byte_order == "little" else (2, ">")
     date = datetime.now().strftime("%d-%b-%y %H:%M:%S")
     src = Path(str(ds.attrs.get("source_file", ""))).name or "bearing_lab"

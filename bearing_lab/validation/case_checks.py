@@ -6,11 +6,13 @@ placeholder speed, so an invalid scene key fails at load time, before anything r
 """
 from __future__ import annotations
 
+from functools import partial
+
 import math
 import tomllib
 from pathlib import Path
 
-from ..errors import ValidationCaseError
+from ..errors import ValidationCaseError, check_choice
 from .case import CASE_KEYS, _err, _keys, _number, _recording, _tolerances, check_speed
 
 __all__ = ["check_recording", "check_paper", "PAPER_QUANTITIES", "HEALTHY_QUANTITIES"]
@@ -36,8 +38,7 @@ def _load_and_defects(case):
     _keys(case.name, "load", load, CASE_KEYS["load"])
     if "radial_n" in load:
         _number(case.name, "load.radial_n", load["radial_n"], lo=0.0, hi=1e7)
-    if load.get("on", "inner") not in ("inner", "outer"):
-        raise _err(case.name, f"load.on = {load['on']!r}; allowed values are 'inner' and 'outer'")
+    check_choice(load.get("on", "inner"), ("inner", "outer"), "load.on", partial(_err, case.name))
     defects = case.data.get("defect", [])
     if not isinstance(defects, list):
         raise _err(case.name, "defects are [[defect]] tables (an array of tables)")
@@ -74,11 +75,8 @@ def _structural_path(case):
     sp = case.data.get("structural_path", {})
     _keys(case.name, "structural_path", sp, CASE_KEYS["structural_path"])
     method = sp.get("method", "fit")
-    if method not in ("fit", "fixed", "none"):
-        raise _err(case.name, f"structural_path.method = {method!r}; allowed values are 'fit', 'fixed' and 'none'")
-    n = sp.get("resonances", 1)
-    if n not in (1, 2):
-        raise _err(case.name, f"structural_path.resonances = {n!r}; allowed values are 1 and 2")
+    check_choice(method, ("fit", "fixed", "none"), "structural_path.method", partial(_err, case.name))
+    n = check_choice(sp.get("resonances", 1), (1, 2), "structural_path.resonances", partial(_err, case.name))
     if sp.get("from_case") and sp.get("file"):
         raise _err(case.name, "structural_path: give from_case or file, not both")
     if (sp.get("from_case") or sp.get("file")) and method != "fit":
@@ -100,8 +98,7 @@ def _background(case):
     if not isinstance(bg.get("enabled", True), bool):
         raise _err(case.name, f"background.enabled = {bg['enabled']!r} must be true or false")
     src = bg.get("source", "auto")
-    if src not in ("auto", "reference", "recording"):
-        raise _err(case.name, f"background.source = {src!r}; allowed values are 'auto', 'reference' and 'recording'")
+    check_choice(src, ("auto", "reference", "recording"), "background.source", partial(_err, case.name))
     if src == "reference" and "reference" not in case.data:
         raise _err(case.name, "background.source = \"reference\" needs a [reference] recording")
     for key, lo, hi in (("max_tones", 0, 200), ("tone_snr_db", 3, 60), ("seed", 0, 2 ** 32)):

@@ -12,8 +12,8 @@ __all__ = ["waveforms", "spectra", "envelope_spectra", "structural_path", "psd_o
 
 
 def _fig(h=3.2, n=1, w=10):
-    from matplotlib.figure import Figure
-    fig = Figure(figsize=(w, h * n), layout="constrained")
+    from ..figures import new_figure
+    fig = new_figure(figsize=(w, h * n), layout="constrained")
     return fig, fig.subplots(n, 1, squeeze=False)[:, 0]
 
 

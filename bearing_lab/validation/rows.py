@@ -19,7 +19,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from ..errors import ValidationCaseError
+from ..errors import ValidationCaseError, check_choice
 
 __all__ = ["Tolerance", "make_row", "row_status", "ROW_KEYS", "TOLERANCE_KINDS"]
 
@@ -45,10 +45,7 @@ class Tolerance:
     known_limitation: str = ""
 
     def __post_init__(self):
-        if self.kind not in TOLERANCE_KINDS:
-            msg = (f"Invalid value for the tolerance kind. Allowed values are 'pct' and 'factor', but got "
-                   f"{self.kind!r} instead")
-            raise ValidationCaseError(msg)
+        check_choice(self.kind, TOLERANCE_KINDS, "tolerance kind", ValidationCaseError)
         if not (self.reason or "").strip():
             raise ValidationCaseError("every tolerance needs a reason (key 'reason')")
         try:

@@ -49,3 +49,25 @@ def test_constant_signal_is_refused():
         kurtosis(np.ones(100))
     with pytest.raises(AnalysisError, match="NaN"):
         metrics(np.r_[1.0, np.nan, 2.0])
+
+
+def test_metrics_table_is_read_by_every_consumer(monkeypatch):
+    """A metric added to the one table appears in metrics() and the xarray wrapper with its unit
+    and long name, and each entry's one-pass value equals its own function."""
+    import xarray as xr
+
+    from bearing_lab.analysis import _metrics
+    from bearing_lab.analysis import xr as bxr
+    x = np.random.default_rng(3).normal(0.5, 2.0, 20_000)
+    m = _metrics.metrics(x, units="m s-2")
+    for name, spec in _metrics.METRICS.items():
+        assert m[name] == pytest.approx(float(spec.func(x)), rel=1e-12), name
+    mean_abs = _metrics.Metric("mean_abs", lambda v, axis=-1: np.mean(np.abs(v), axis=axis),
+                               lambda mom: mom["mean_abs"], False, "mean |x|")
+    monkeypatch.setattr(_metrics, "METRICS", {**_metrics.METRICS, "mean_abs": mean_abs})
+    m = _metrics.metrics(x, units="m s-2")
+    assert m["mean_abs"] == pytest.approx(np.mean(np.abs(x))) and m["units"]["mean_abs"] == "m s-2"
+    ds = bxr.metrics(xr.DataArray(x, dims="time", attrs={"units": "m s-2"}))
+    assert float(ds["mean_abs"]) == pytest.approx(np.mean(np.abs(x)))
+    assert ds["mean_abs"].attrs == {"units": "m s-2", "long_name": "mean |x|"}
+    assert ds["kurtosis"].attrs["units"] == "1"

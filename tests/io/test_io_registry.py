@@ -16,7 +16,7 @@ def test_registry_covers_mirror_and_cwru_12k(mirror):
     if mirror is not None:
         files = sorted(str(p.relative_to(mirror)) for p in Path(mirror).glob("*/*") if p.is_file())
         for f in files:
-            assert f in reg, f"{f} missing from data/recordings.csv"
+            assert f in reg, f"{f} missing from bearing_lab/data/recordings.csv"
             assert len(reg[f].sha256) == 64
     r = datasets.get("130_OR007@6_0.mat")
     assert (r.rpm, r.load_hp, r.defect, r.defect_size_in, r.defect_position) == \
@@ -175,3 +175,16 @@ def test_cwru_files_open_with_their_registered_rate_by_content(datafile, tmp_pat
             ds2 = open_recording(renamed, checksum=False)
         assert ds2.attrs["sampling_rate_hz"] == 48000.0 and "sha256" in ds2.attrs["sampling_rate_source"]
         assert ds2.attrs["registry_name"] == f"cwru/48k_DE/{name}.mat"
+
+
+def test_registry_documentation_lists_its_columns():
+    """data/README.md documents the package's registry: every CSV column, and no other."""
+    import csv
+    import re
+    from pathlib import Path
+    with datasets.REGISTRY_FILE.open(newline="", encoding="utf-8") as fh:
+        header = next(csv.reader(fh))
+    readme = (Path(__file__).resolve().parents[2] / "data" / "README.md").read_text()
+    rows = [line.split("|")[1] for line in readme.splitlines() if line.startswith("| `")]
+    documented = {c for cell in rows for c in re.findall(r"`([a-z_0-9]+)`", cell)}
+    assert documented == set(header), (documented ^ set(header))

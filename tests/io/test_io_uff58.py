@@ -1,4 +1,5 @@
-"""UFF 58 / 58b: the real exports, and every pitfall of formats.md on synthetic sets."""
+"""UFF 58 / 58b: the real exports, and the known pitfalls of UFF 58/58b (header fields, binary byte
+counts, padding, the closing -1) on synthetic sets."""
 import numpy as np
 import pytest
 

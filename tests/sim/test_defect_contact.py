@@ -278,3 +278,26 @@ def test_area_table_against_direct_sum():
         direct = np.where(ins, np.sqrt(np.maximum(delta - hf, 0)), w0).sum() / w0.sum()
         table = float(T.lookup(sb / T.track_radius, delta)) / delta ** 1.5
         assert table == pytest.approx(direct, abs=0.01)
+
+
+def test_registry_is_the_one_list_of_contact_models(monkeypatch):
+    """Scenes, contact_table and the time loop read CONTACT_MODELS: a model registered there
+    (here a copy of "drop" under another name) is accepted at scene load and simulated,
+    identically to the original."""
+    import dataclasses
+
+    from bearing_lab import simulate
+    from bearing_lab.sim.defects import contact
+    from bearing_lab.sim.scene import load_scene
+    with pytest.raises(SceneError, match="contact_model: invalid value 'rigid2d'"):
+        load_scene("paper-O1", **{"defect.contact_model": "rigid2d"})
+    extra = dict(contact.CONTACT_MODELS,
+                 rigid2d=dataclasses.replace(contact.CONTACT_MODELS["drop"], name="rigid2d"))
+    monkeypatch.setattr(contact, "CONTACT_MODELS", extra)
+    kw = dict(duration=0.03, progress=False)
+    a = simulate("paper-O1", **{"defect.contact_model": "rigid2d"}, **kw)
+    b = simulate("paper-O1", **{"defect.contact_model": "drop"}, **kw)
+    assert a.attrs["defect_contact_models"] == "rigid2d"
+    ch = a.attrs["default_channel"]
+    np.testing.assert_array_equal(a[ch].values, b[ch].values)
+

@@ -12,7 +12,9 @@ from bearing_lab.sim.defects.geometry import drop_profile_1d, drop_profile_2d
 B6308 = get_bearing("6308")
 
 
-# reference.md, "How far a rigid ball can move into an outer-race defect": 6308, r_o = 0.53 D_b,
+# How far a rigid ball can move into an outer-race defect, from two computations independent of
+# this code (a brute-force grid over the raceway; an exact reduction along lines of constant axial
+# position), which agree: 6308, r_o = 0.53 D_b,
 # rectangle removed to 0.5 mm depth, ball centred over the defect.  (L, B, H/B, theta_deg, µm)
 REFERENCE_DROPS = [
     (1, 1, 0, 0, 0.9413),
@@ -35,7 +37,7 @@ def test_rigid_drop_matches_reference(L, B, h_frac, theta, expected_um):
 
 
 def test_rigid_drop_closed_form_bounds():
-    """Along the track (L^2/8)(1/r_b - 1/R_o); across (B^2/8)(1/r_b - 1/r_o) (reference.md)."""
+    """Along the track (L^2/8)(1/r_b - 1/R_o); across (B^2/8)(1/r_b - 1/r_o) (circle sagitta)."""
     g = RaceGeometry.from_bearing(B6308, "outer")
     slot = Defect(length=1e-3, width=23e-3)
     assert rigid_drop(slot, B6308) == pytest.approx(1e-6 / 8 / g.rx, rel=0.005)
@@ -151,7 +153,7 @@ def test_polygon_and_ellipse_outlines():
     ("outer", 50, 3.27e10, 0.49, 0.09), ("outer", 300, 3.27e10, 0.90, 0.16),
     ("outer", 600, 3.27e10, 1.13, 0.20), ("inner", 300, 3.50e10, 1.09, 0.11)])
 def test_hertz_semi_axes_reference(race, load, k, a_mm, b_mm):
-    """reference.md: semi-axes (a across, b along) and kappa = a/b (5.639 outer, 9.550 inner)."""
+    """Hand values (Harris & Kotzalas's Hertz solution): semi-axes (a across, b along) and kappa = a/b (5.639 outer, 9.550 inner)."""
     from bearing_lab.sim.defects.geometry import hertz_semi_axes
     g = RaceGeometry.from_bearing(B6308, race)
     a, b = hertz_semi_axes(g, (load / k) ** (2 / 3))

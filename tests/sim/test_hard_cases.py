@@ -1,4 +1,4 @@
-"""Numerically hard scenes (issue 6).  Each case must finish with finite output, non-negative
+"""Numerically hard scenes.  Each case must finish with finite output, non-negative
 contact loads and bounded displacements, and converge when the tolerance is tightened
 (the differences are printed), or be refused with a clear message when unphysical.
 

@@ -1,4 +1,5 @@
-"""Hertz point-contact constants against reference.md (Harris & Kotzalas, 1 %)."""
+"""Hertz point-contact constants against values computed by hand with Harris & Kotzalas's
+method (*Rolling Bearing Analysis*: F(rho), kappa, delta*, K_c) for the 6308 of Liu et al., 1 %."""
 import pytest
 
 from bearing_lab.sim.hertz import race_contact, series_stiffness
@@ -41,7 +42,7 @@ def test_series_and_other_conformities():
 ])
 def test_contact_ellipse(race, f, force, a_mm, b_mm):
     a, b = race_contact(DB, DM, f, race).semi_axes(force)
-    # reference.md prints two significant figures: half a unit of the last digit
+    # the hand values carry two significant figures: half a unit of the last digit
     assert a * 1e3 == pytest.approx(a_mm, abs=0.005 + 0.01 * a_mm)
     assert b * 1e3 == pytest.approx(b_mm, abs=0.005 + 0.01 * b_mm)
 

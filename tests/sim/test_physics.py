@@ -1,4 +1,5 @@
-"""Simulator physics against independent numbers (reference.md, textbook formulas).
+"""Simulator physics against independent numbers (closed-form kinematics and Hertz theory after
+Harris & Kotzalas, *Rolling Bearing Analysis*; the 6308 of Liu et al., Table 1).
 
 Each test states what fixes the expected value; none compares with numbers the
 simulator printed before.
@@ -15,8 +16,8 @@ from bearing_lab.schema import check_dataset
 from bearing_lab.sim.hertz import race_contact, series_stiffness
 from tests.naive import impulse_times, interpolated_peak_frequency, static_ball_loads
 
-BPFO_1800 = 92.158          # reference.md, 6308 at 1800 r/min
-PERIOD_1800 = 0.0108509     # reference.md
+BPFO_1800 = 92.158          # BPFO = Z f_r/2 (1 - D_b/d_m), 6308 at 1800 r/min, by hand
+PERIOD_1800 = 0.0108509     # 1 / BPFO_1800
 
 
 @pytest.fixture(scope="module")

@@ -40,6 +40,9 @@ def test_toml_round_trip(tmp_path):
     ({"mass.ball_kg": -0.01}, "mass.ball_kg: -0.01 must be positive"),
     ({"load.on": "cage"}, "load.on: invalid value 'cage'"),
     ({"fidelity": "exact"}, "fidelity: invalid value 'exact'"),
+    ({"defect.contact_model": "hertz"},
+     "defect.contact_model: invalid value 'hertz'; allowed values are 'auto', 'profile', 'drop', "
+     "'area' and 'halfspace'"),
     ({"bearing_geometry.ball_diameter_mm": 30.0}, "does not fit in the ring gap"),
     ({"bearing_geometry.ball_diameter_mm": 70.0}, "is not smaller than pitch_diameter"),
     ({"defect.length_mm": -1}, "defect.length_mm"),

@@ -7,7 +7,7 @@ rigid_drop        -- how far a rigid ball centred over a defect moves before it 
 contact_table     -- tabulated ball-race contact G(psi, delta) with F = K_hertz * G.
 ContactTable      -- the table: psi, delta, G, drop, intact_fraction, model, race.
 RaceGeometry      -- exact torus groove of one race and the ball-race gap function.
-CONTACT_MODELS    -- ("profile", "drop", "area", "halfspace").
+CONTACT_MODELS    -- name -> ContactModel: "profile", "drop", "area", "halfspace".
 
 Modules: model (Defect), geometry (exact sphere-torus gap, rigid drop), contact (tables
 and the models), halfspace (elastic half-space contact solver behind the default

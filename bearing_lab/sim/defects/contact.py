@@ -72,17 +72,18 @@ delta = 0).
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+from typing import Callable
 import math
 import time
 
 import numpy as np
 
-from bearing_lab.errors import SceneError
+from bearing_lab.errors import SceneError, check_choice
 
 from .geometry import RaceGeometry, drop_profile_1d, drop_profile_2d, hertz_semi_axes
 from .model import Defect
 
-CONTACT_MODELS = ("profile", "drop", "area", "halfspace")
+# CONTACT_MODELS, the registry of models (one entry each), closes this module.
 #: approach nodes of the "halfspace" model, as fractions of delta_max
 HALFSPACE_NODES = (0.05, 0.1, 0.16, 0.25, 0.35, 0.5, 0.7, 1.0)
 #: Young's modulus and Poisson ratio the tables assume unless told (52100 steel)
@@ -184,10 +185,11 @@ class ContactTable:
         """Plot G / delta^1.5 (carried share of the intact load) and the intact fraction of
         the Hertz ellipse against the ball's track position, at the approaches ``deltas``
         (m).  Returns the figure."""
-        import matplotlib.pyplot as plt
+        from ...figures import new_figure
         scale = {"mm": 1e3, "m": 1.0, "um": 1e6}[s_units]
         if ax is None:
-            fig, ax = plt.subplots(figsize=(6, 3.5))
+            fig = new_figure(figsize=(6, 3.5))
+            ax = fig.subplots()
         else:
             fig = ax.figure
         s = np.asarray(self.psi) * self.track_radius * scale
@@ -336,9 +338,7 @@ _MEMORY_SIZE = 64
 
 
 def _check_arguments(defect, *, model, clearance, delta_max, n_psi, n_delta, against, material):
-    if model not in CONTACT_MODELS:
-        raise SceneError(f"Invalid value for the 'model' parameter. Allowed values are "
-                         f"{', '.join(map(repr, CONTACT_MODELS))}, but got {model!r} instead.")
+    check_choice(model, CONTACT_MODELS, "contact model", SceneError)
     if not (math.isfinite(delta_max) and delta_max > 0):
         raise SceneError(f"{delta_max=} m must be positive and finite")
     if n_delta < 3:
@@ -384,20 +384,15 @@ def _build(defect, bearing, *, model, clearance, delta_max, n_psi, n_delta, agai
     psi = np.linspace(s_lo / R, s_hi / R, n_psi)
     delta = np.linspace(0.0, delta_max, n_delta)
     drop2 = drop_profile_2d(defect, geom, psi, psi_radius=R)
-    drop = drop_profile_1d(defect, geom, psi, psi_radius=R) if model == "profile" else drop2
-    cells = (_CELLS_ALONG, _CELLS_ACROSS) if model == "area" else (_FRACTION_CELLS,) * 2
-    lat = _lattice(defect, geom, psi, R, delta, cells=cells, area_law=model == "area")
+    spec = CONTACT_MODELS[model]
+    drop = drop_profile_1d(defect, geom, psi, psi_radius=R) if spec.along_track_drop else drop2
+    cells = (_CELLS_ALONG, _CELLS_ACROSS) if spec.area_law else (_FRACTION_CELLS,) * 2
+    lat = _lattice(defect, geom, psi, R, delta, cells=cells, area_law=spec.area_law)
     info = {"reach_along_m": b_reach, "reach_across_m": a_reach, "misses_track": misses,
             "drop_2d": drop2, **lat["info"]}
-    if model == "halfspace":
-        E, nu = material
-        G, info_hs = _halfspace_G(defect, geom, psi * R, delta, drop2, e_star=E / (2 * (1 - nu * nu)),
-                                  misses=misses, settings=halfspace_settings)
-        info.update(info_hs)
-    elif model == "area":
-        G = lat["G"]
-    else:
-        G = np.maximum(delta[None, :] - drop[:, None], 0.0) ** 1.5
+    G = spec.g(dict(defect=defect, geom=geom, psi=psi, R=R, delta=delta, drop=drop, drop2=drop2,
+                    lattice=lat, material=material, misses=misses, info=info,
+                    halfspace_settings=halfspace_settings))
     G[:, 0] = 0.0
     info["build_time_s"] = time.perf_counter() - t0
     info["build_cpu_s"] = time.process_time() - c0
@@ -524,3 +519,53 @@ def _halfspace_G(defect, geom, s_tab, delta, drop, *, e_star, misses, settings=N
                  "halfspace_semi_axes_m": np.array(axes), "halfspace_richardson": richardson,
                  "halfspace_solves": solves})
     return G, info
+
+
+# ---------------------------------------------------------------- the registry
+@dataclass(frozen=True)
+class ContactModel:
+    """One defect-contact model: how its table's G is built and how the time loop reads it.
+
+    ``g(c)`` returns G (n_psi x n_delta, m^1.5) from the build context ``c`` (keys ``defect``,
+    ``geom``, ``psi``, ``R``, ``delta``, ``drop``, ``drop2``, ``lattice``, ``material``,
+    ``misses``, ``info`` (add diagnostics here), ``halfspace_settings``).  ``tabulated``: the
+    time loop interpolates the table's G; otherwise it applies ``max(delta - drop, 0)^1.5`` to
+    the table's drop (and G must be that law).  ``along_track_drop``: the table's drop is the
+    1-D along-track reduction, not the exact 2-D drop.  ``area_law``: the lattice evaluates the
+    local (Winkler-type) law on the fine "area" cells.
+    """
+
+    name: str
+    g: Callable[[dict], np.ndarray]
+    tabulated: bool
+    along_track_drop: bool = False
+    area_law: bool = False
+    summary: str = ""
+
+
+def _g_halfspace(c):
+    E, nu = c["material"]
+    G, info = _halfspace_G(c["defect"], c["geom"], c["psi"] * c["R"], c["delta"], c["drop2"],
+                           e_star=E / (2 * (1 - nu * nu)), misses=c["misses"],
+                           settings=c["halfspace_settings"])
+    c["info"].update(info)
+    return G
+
+
+def _g_rigid(c):
+    return np.maximum(c["delta"][None, :] - c["drop"][:, None], 0.0) ** 1.5
+
+
+#: name -> ContactModel, in the order they are listed to users.  Adding a model: one entry here
+#: (its ``g``), a section in the module docstring, and its test in tests/sim/test_defect_contact.py;
+#: scenes (``defect.contact_model``), ``contact_table`` and the time loop read this table.
+CONTACT_MODELS: dict[str, ContactModel] = {m.name: m for m in [
+    ContactModel("profile", _g_rigid, tabulated=False, along_track_drop=True,
+                 summary="along-track 1-D drop, full-width slot"),
+    ContactModel("drop", _g_rigid, tabulated=False, summary="rigid 2-D drop, intact stiffness"),
+    ContactModel("area", lambda c: c["lattice"]["G"], tabulated=True, area_law=True,
+                 summary="local (Winkler-type) law over the remaining surface"),
+    ContactModel("halfspace", _g_halfspace, tabulated=True,
+                 summary="elastic half-space share of the intact load (the default)"),
+]}
+

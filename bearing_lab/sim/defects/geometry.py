@@ -54,7 +54,7 @@ import math
 
 import numpy as np
 
-from bearing_lab.errors import SceneError
+from bearing_lab.errors import SceneError, check_choice
 
 from .model import Defect
 
@@ -70,8 +70,7 @@ class RaceGeometry:
 
     @classmethod
     def from_bearing(cls, bearing, race: str, *, clearance: float = 0.0) -> "RaceGeometry":
-        if race not in ("outer", "inner"):
-            raise SceneError(f"race={race!r}: allowed values are 'outer' and 'inner'")
+        check_choice(race, ("outer", "inner"), "race", SceneError)
         if not (math.isfinite(clearance) and clearance >= 0):
             raise SceneError(f"clearance={clearance!r} m must be finite and not negative")
         db, dm = bearing.ball_diameter, bearing.pitch_diameter

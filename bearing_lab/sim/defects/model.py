@@ -34,7 +34,7 @@ import math
 
 import numpy as np
 
-from bearing_lab.errors import SceneError
+from bearing_lab.errors import SceneError, check_choice
 
 RACES = ("outer", "inner", "ball")
 SHAPES = ("rectangle", "ellipse", "polygon")
@@ -104,12 +104,8 @@ class Defect:
 
     def __post_init__(self):
         where = "defect"
-        if self.race not in RACES:
-            raise SceneError(f"Invalid value for {where}.race: allowed values are "
-                             f"{', '.join(map(repr, RACES))}, but got {self.race!r} instead.")
-        if self.shape not in SHAPES:
-            raise SceneError(f"Invalid value for {where}.shape: allowed values are "
-                             f"{', '.join(map(repr, SHAPES))}, but got {self.shape!r} instead.")
+        check_choice(self.race, RACES, f"{where}.race", SceneError)
+        check_choice(self.shape, SHAPES, f"{where}.shape", SceneError)
         for key, unit in (("length", "m"), ("width", "m"), ("depth", "m")):
             x = getattr(self, key)
             if not (isinstance(x, (int, float)) and math.isfinite(x) and x > 0):
@@ -160,12 +156,8 @@ class Defect:
                              f"{', '.join(_KEYS)}")
         race = m.get("race", "outer")
         shape = m.get("shape", "rectangle")
-        if race not in RACES:
-            raise SceneError(f"Invalid value for {where}.race: allowed values are "
-                             f"{', '.join(map(repr, RACES))}, but got {race!r} instead.")
-        if shape not in SHAPES:
-            raise SceneError(f"Invalid value for {where}.shape: allowed values are "
-                             f"{', '.join(map(repr, SHAPES))}, but got {shape!r} instead.")
+        check_choice(race, RACES, f"{where}.race", SceneError)
+        check_choice(shape, SHAPES, f"{where}.shape", SceneError)
         vertices = None
         if "diameter_mm" in m:
             if shape != "ellipse" or "length_mm" in m or "width_mm" in m:

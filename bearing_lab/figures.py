@@ -1,0 +1,31 @@
+"""Figures for the plotting API: created through pyplot, then detached from it.
+
+:func:`new_figure` returns a ``matplotlib.figure.Figure`` that pyplot no longer tracks
+(``plt.close`` right after creation).  So
+
+- a script or the command line never accumulates open figures, and library code never
+  switches the backend (``savefig`` works headless, whatever backend the user chose);
+- in Jupyter the figure keeps the session's canvas, so returning it as a cell's value shows
+  it inline (a bare ``Figure()`` built without pyplot shows only its text form there), and it
+  is not shown a second time when the cell ends.
+"""
+from __future__ import annotations
+
+__all__ = ["new_figure"]
+
+
+def new_figure(figsize=None, *, layout=None, **kwargs):
+    """A new detached ``matplotlib.figure.Figure`` (``figsize`` in inches).
+
+    Examples
+    --------
+    >>> fig = new_figure(figsize=(4, 3), layout="constrained")
+    >>> ax = fig.subplots()
+    >>> import matplotlib.pyplot as plt
+    >>> fig in map(plt.figure, plt.get_fignums())   # not tracked by pyplot
+    False
+    """
+    import matplotlib.pyplot as plt
+    fig = plt.figure(figsize=figsize, layout=layout, **kwargs)
+    plt.close(fig)
+    return fig

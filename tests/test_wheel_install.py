@@ -1,0 +1,115 @@
+"""A wheel, installed outside the checkout, works: the recordings registry, the shipped validation
+cases, scenes and report templates travel as package data.
+
+The wheel is built from a copy of the checkout's files (``pip wheel --no-deps``) and installed with ``--no-deps
+--no-index`` into a fresh venv in a temporary folder.  The dependencies are not downloaded again:
+a ``.pth`` line puts the test environment's site-packages *behind* the new venv's own, so the
+installed wheel is what ``import bearing_lab`` finds (checked), while numpy, scipy, numba ... come
+from the environment already installed.  The commands run from a folder outside the checkout.
+
+Marked ``wheel`` (deselect locally with ``-m "not wheel"``); about 30-40 s on 2 cores.
+"""
+import json
+import os
+import shutil
+import site
+import subprocess
+import sys
+import venv
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+IN_CI = os.environ.get("CI", "").lower() in ("1", "true", "yes")
+CWRU = "cwru/130_OR007@6_0.mat"
+
+pytestmark = [pytest.mark.wheel, pytest.mark.xdist_group("wheel")]
+
+
+def _run(cmd, cwd, env, timeout=300):
+    p = subprocess.run([str(c) for c in cmd], cwd=cwd, env=env, capture_output=True, text=True,
+                       timeout=timeout)
+    assert p.returncode == 0, f"{' '.join(map(str, cmd))} -> {p.returncode}\n{p.stdout[-2000:]}\n{p.stderr[-3000:]}"
+    return p
+
+
+def _clean_source(dest: Path) -> Path:
+    """The checkout's files that git knows or would add (no build/, *.egg-info, .venv): a stale
+    egg-info's file list would otherwise smuggle files into the wheel that the package-data
+    declaration misses."""
+    try:
+        files = subprocess.run(["git", "-C", str(ROOT), "ls-files", "-z", "--cached", "--others",
+                                "--exclude-standard"], capture_output=True, text=True, check=True).stdout
+        rels = list(filter(None, files.split("\0")))
+    except (OSError, subprocess.CalledProcessError):   # a source archive without git
+        skip = {".git", ".venv", "build", "dist", "reports", "__pycache__", ".pytest_cache", ".hypothesis"}
+        rels = [str(f.relative_to(ROOT)) for f in ROOT.rglob("*")
+                if f.is_file() and not skip & set(f.relative_to(ROOT).parts)
+                and not any(part.endswith(".egg-info") for part in f.parts)]
+    for rel in rels:
+        f = ROOT / rel
+        if f.is_file():
+            (dest / rel).parent.mkdir(parents=True, exist_ok=True)
+            shutil.copy2(f, dest / rel)
+    return dest
+
+
+@pytest.fixture(scope="module")
+def installed(tmp_path_factory):
+    """(venv bin folder, environment, work folder) of a fresh venv holding the built wheel."""
+    tmp = tmp_path_factory.mktemp("wheel")
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "VIRTUAL_ENV", "MPLBACKEND")}
+    env["PIP_DISABLE_PIP_VERSION_CHECK"] = "1"
+    src = _clean_source(tmp / "src")
+    _run([sys.executable, "-m", "pip", "wheel", "--no-deps", "-q", "-w", tmp / "dist", src], tmp, env)
+    wheels = list((tmp / "dist").glob("bearing_lab-*.whl"))
+    assert len(wheels) == 1, wheels
+    venv.EnvBuilder(with_pip=False).create(tmp / "venv")
+    vpy = tmp / "venv" / "bin" / "python"
+    _run([sys.executable, "-m", "pip", "--python", vpy, "install", "--no-deps", "--no-index", "-q",
+          wheels[0]], tmp, env)
+    purelib = Path(_run([vpy, "-c", "import sysconfig; print(sysconfig.get_paths()['purelib'])"],
+                        tmp, env).stdout.strip())
+    (purelib / "_test_env_deps.pth").write_text("\n".join(site.getsitepackages()) + "\n")
+    work = tmp / "work"
+    work.mkdir()
+    return vpy.parent, env, work
+
+
+def test_wheel_holds_the_installed_package(installed):
+    bin_dir, env, work = installed
+    out = _run([bin_dir / "python", "-c",
+                "import bearing_lab, bearing_lab.datasets as d; print(bearing_lab.__file__); "
+                "print(len(d.load_registry()))"], work, env).stdout.split()
+    assert Path(out[0]).is_relative_to(bin_dir.parent), f"imported {out[0]}, not the wheel"
+    assert not Path(out[0]).is_relative_to(ROOT)
+    assert int(out[1]) > 100        # the CWRU drive-end table alone has more rows
+
+
+def test_validate_default_case_from_the_wheel(installed):
+    bin_dir, env, work = installed
+    env = {k: v for k, v in env.items() if k != "BEARING_LAB_MIRROR"}   # the default set: paper
+    _run([bin_dir / "bearing-lab", "validate", "-o", work / "reports", "--no-progress"], work, env)
+    summary = json.loads((work / "reports" / "paper" / "summary.json").read_text())
+    assert summary["case"] == "paper" and summary["status"] in ("pass", "fail"), summary["status"]
+    assert summary["rows"], "no compared quantity"
+    assert (work / "reports" / "index.html").stat().st_size > 1000
+
+
+def test_cwru_import_from_the_wheel(installed, mirror):
+    bin_dir, env, work = installed
+    if mirror is None or not (Path(mirror) / CWRU).is_file():
+        if IN_CI:
+            pytest.fail(f"BEARING_LAB_MIRROR with {CWRU} is required in CI")
+        pytest.skip(f"no BEARING_LAB_MIRROR with {CWRU}")
+    env = dict(env, BEARING_LAB_MIRROR=str(mirror))
+    out = work / "130.nc"
+    _run([bin_dir / "bearing-lab", "import", Path(mirror) / CWRU, "-o", out], work, env)
+    info = _run([bin_dir / "bearing-lab", "info", "--json", out], work, env).stdout
+    got = json.loads(info)
+    # CWRU files store no sampling rate: without the registry the reader refuses the file
+    assert got["reader"] == "cwru" and got["sampling_rate_hz"] == 12000.0, info[:500]
+    src = _run([bin_dir / "python", "-c", "import sys, xarray as xr; "
+                "print(xr.open_dataset(sys.argv[1]).attrs['sampling_rate_source'])", out], work, env).stdout
+    assert "registry" in src, src
