@@ -289,7 +289,7 @@ def intact_contact(geom: RaceGeometry, delta: float, *, cells=TABLE_CELLS,
 
 def _symmetry(defect: Defect) -> bool:
     """True if the contact over the defect is even in the ball position."""
-    if defect.shape == "polygon":
+    if not defect.outline.symmetric:
         return False
     return defect.offset == 0.0 or defect.skew == 0.0
 

@@ -36,8 +36,11 @@ import numpy as np
 
 from bearing_lab.errors import SceneError, check_choice
 
+from .outlines import OUTLINES
+
 RACES = ("outer", "inner", "ball")
-SHAPES = ("rectangle", "ellipse", "polygon")
+#: the outline names a scene accepts (``defect.shape``): the registry in :mod:`.outlines`
+SHAPES = tuple(OUTLINES)
 #: Default defect depth (m): 0.5 mm.  The reference paper (Liu et al.) does not state one; any depth much larger than the ball's drop (micrometres) gives the
 #: same response.
 DEFAULT_DEPTH = 0.5e-3
@@ -58,19 +61,6 @@ def _finite(where, key, value, *, positive=False, nonneg=False):
     if nonneg and x < 0:
         raise SceneError(f"{where}.{key}={value!r} must not be negative")
     return x
-
-
-def _polygon_area(v: np.ndarray) -> float:
-    x, y = v[:, 0], v[:, 1]
-    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))
-
-
-def _segments_cross(p1, p2, p3, p4) -> bool:
-    def orient(a, b, c):
-        return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
-    d1, d2 = orient(p3, p4, p1), orient(p3, p4, p2)
-    d3, d4 = orient(p1, p2, p3), orient(p1, p2, p4)
-    return (d1 * d2 < 0) and (d3 * d4 < 0)
 
 
 @dataclass(frozen=True)
@@ -105,7 +95,7 @@ class Defect:
     def __post_init__(self):
         where = "defect"
         check_choice(self.race, RACES, f"{where}.race", SceneError)
-        check_choice(self.shape, SHAPES, f"{where}.shape", SceneError)
+        check_choice(self.shape, tuple(OUTLINES), f"{where}.shape", SceneError)
         for key, unit in (("length", "m"), ("width", "m"), ("depth", "m")):
             x = getattr(self, key)
             if not (isinstance(x, (int, float)) and math.isfinite(x) and x > 0):
@@ -114,29 +104,14 @@ class Defect:
             x = getattr(self, key)
             if not (isinstance(x, (int, float)) and math.isfinite(x)):
                 raise SceneError(f"{where}.{key}={x!r} must be finite")
-        if self.shape == "polygon":
-            if self.vertices is None:
-                raise SceneError(f"{where}.vertices: a polygon defect needs at least 3 vertices")
-            v = np.asarray(self.vertices, dtype=float)
-            if v.ndim != 2 or v.shape[1] != 2 or v.shape[0] < 3:
-                raise SceneError(f"{where}.vertices must be a list of at least 3 [along, across] "
-                                 f"pairs, got shape {v.shape}")
-            if not np.all(np.isfinite(v)):
-                raise SceneError(f"{where}.vertices must be finite")
-            if abs(_polygon_area(v)) <= 0:
-                raise SceneError(f"{where}.vertices enclose no area")
-            n = len(v)
-            for i in range(n):
-                for j in range(i + 2, n):
-                    if i == 0 and j == n - 1:
-                        continue
-                    if _segments_cross(v[i], v[(i + 1) % n], v[j], v[(j + 1) % n]):
-                        raise SceneError(f"{where}.vertices: the polygon intersects itself "
-                                         f"(edges {i} and {j})")
-            object.__setattr__(self, "vertices", tuple(map(tuple, v.tolist())))
-        elif self.vertices is not None:
-            raise SceneError(f"{where}.vertices is only used with shape='polygon', "
-                             f"not with shape={self.shape!r}")
+        vertices = self.outline.check(self, where)
+        if vertices is not None:
+            object.__setattr__(self, "vertices", vertices)
+
+    @property
+    def outline(self):
+        """The outline class of this defect's shape (:mod:`.outlines`)."""
+        return OUTLINES[self.shape]
 
     # ------------------------------------------------------------------ construction
     @classmethod
@@ -157,45 +132,8 @@ class Defect:
         race = m.get("race", "outer")
         shape = m.get("shape", "rectangle")
         check_choice(race, RACES, f"{where}.race", SceneError)
-        check_choice(shape, SHAPES, f"{where}.shape", SceneError)
-        vertices = None
-        if "diameter_mm" in m:
-            if shape != "ellipse" or "length_mm" in m or "width_mm" in m:
-                raise SceneError(f"{where}.diameter_mm is only for shape='ellipse' (a circle) "
-                                 "and replaces length_mm and width_mm")
-            d = _finite(where, "diameter_mm", m["diameter_mm"], positive=True) * 1e-3
-            length = width = d
-        elif shape == "polygon":
-            if "vertices_mm" not in m:
-                raise SceneError(f"{where}.vertices_mm is required for shape='polygon'")
-            raw = m["vertices_mm"]
-            try:
-                v = np.asarray(raw, dtype=float) * 1e-3
-            except (TypeError, ValueError):
-                raise SceneError(f"{where}.vertices_mm must be a list of [along, across] "
-                                 "pairs of numbers") from None
-            if v.ndim != 2 or v.shape[1] != 2 or v.shape[0] < 3:
-                raise SceneError(f"{where}.vertices_mm must be a list of at least 3 "
-                                 f"[along, across] pairs, got {raw!r}")
-            if not np.all(np.isfinite(v)):
-                raise SceneError(f"{where}.vertices_mm must be finite, got {raw!r}")
-            for key in ("length_mm", "width_mm"):
-                if key in m:
-                    raise SceneError(f"{where}.{key} is not used with shape='polygon' "
-                                     "(the vertices give the size)")
-            vertices = v
-            length = float(np.ptp(v[:, 0]))
-            width = float(np.ptp(v[:, 1]))
-            if not (length > 0 and width > 0):
-                raise SceneError(f"{where}.vertices_mm enclose no area")
-        else:
-            if "vertices_mm" in m:
-                raise SceneError(f"{where}.vertices_mm is only used with shape='polygon'")
-            for key in ("length_mm", "width_mm"):
-                if key not in m:
-                    raise SceneError(f"{where}.{key} is required for shape={shape!r}")
-            length = _finite(where, "length_mm", m["length_mm"], positive=True) * 1e-3
-            width = _finite(where, "width_mm", m["width_mm"], positive=True) * 1e-3
+        check_choice(shape, tuple(OUTLINES), f"{where}.shape", SceneError)
+        length, width, vertices = OUTLINES[shape].size_from_mapping(m, where)
         depth = _finite(where, "depth_mm", m.get("depth_mm", DEFAULT_DEPTH * 1e3), positive=True) * 1e-3
         offset = _finite(where, "offset_mm", m.get("offset_mm", 0.0)) * 1e-3
         skew = math.radians(_finite(where, "skew_deg", m.get("skew_deg", 0.0)))
@@ -214,29 +152,11 @@ class Defect:
     # ------------------------------------------------------------------ outline
     def _local_boundary(self, spacing: float, max_points: int = 20000) -> np.ndarray:
         """Boundary points (n, 2) in local (u, v) coordinates, about ``spacing`` apart."""
-        if self.shape == "ellipse":
-            a, b = self.length / 2, self.width / 2
-            perim = math.pi * (3 * (a + b) - math.sqrt((3 * a + b) * (a + 3 * b)))
-            n = int(min(max(perim / spacing, 256), 4 * max_points))
-            t = np.linspace(0, 2 * math.pi, n, endpoint=False)
-            return np.column_stack([a * np.cos(t), b * np.sin(t)])
-        verts = self.local_vertices()
-        pts = []
-        for i in range(len(verts)):
-            p, q = verts[i], verts[(i + 1) % len(verts)]
-            n = int(min(max(math.hypot(*(q - p)) / spacing, 16), max_points))
-            t = np.linspace(0, 1, n, endpoint=False)[:, None]
-            pts.append(p + t * (q - p))
-        return np.concatenate(pts)
+        return self.outline.boundary(self, spacing, max_points)
 
     def local_vertices(self) -> np.ndarray:
         """Corners in local (u, v) coordinates (rectangle and polygon), shape (n, 2)."""
-        if self.shape == "rectangle":
-            a, b = self.length / 2, self.width / 2
-            return np.array([[-a, -b], [a, -b], [a, b], [-a, b]])
-        if self.shape == "polygon":
-            return np.asarray(self.vertices, dtype=float)
-        raise ValueError("an ellipse has no vertices")
+        return self.outline.vertices(self)
 
     def to_track(self, u, v):
         """Local (u, v) -> track (s, z), m."""
@@ -260,33 +180,11 @@ class Defect:
     def contains(self, s, z) -> np.ndarray:
         """True where the track point (s, z) lies inside the outline (boundary: either)."""
         u, v = self.to_local(s, z)
-        if self.shape == "rectangle":
-            return (np.abs(u) <= self.length / 2) & (np.abs(v) <= self.width / 2)
-        if self.shape == "ellipse":
-            return (u / (self.length / 2)) ** 2 + (v / (self.width / 2)) ** 2 <= 1.0
-        verts = self.local_vertices()
-        inside = np.zeros(np.broadcast(u, v).shape, dtype=bool)
-        n = len(verts)
-        for i in range(n):
-            x1, y1 = verts[i]
-            x2, y2 = verts[(i + 1) % n]
-            if y1 == y2:
-                continue
-            crosses = (y1 > v) != (y2 > v)
-            xint = x1 + (v - y1) * (x2 - x1) / (y2 - y1)
-            inside ^= crosses & (u < xint)
-        return inside
+        return self.outline.contains(self, u, v)
 
     def track_extent(self) -> tuple[float, float, float, float]:
         """(s_min, s_max, z_min, z_max) of the outline in track coordinates, m."""
-        if self.shape == "ellipse":
-            a, b = self.length / 2, self.width / 2
-            c, s_ = math.cos(self.skew), math.sin(self.skew)
-            hs = math.hypot(a * c, b * s_)
-            hz = math.hypot(a * s_, b * c)
-            return -hs, hs, self.offset - hz, self.offset + hz
-        s, z = self.to_track(*self.local_vertices().T)
-        return float(s.min()), float(s.max()), float(z.min()), float(z.max())
+        return self.outline.track_extent(self)
 
     def min_abs_axial(self) -> float:
         """Smallest |z| over the outline (0 when it covers the track centre line), m."""
@@ -357,7 +255,7 @@ class Defect:
         else:
             if bearing.width is not None:
                 zmax = max(abs(z0), abs(z1))
-                if self.shape != "rectangle" and self.shape != "ellipse":
+                if not self.outline.exact_extent:
                     _, zb = self.boundary_track(spacing=max(self.length, self.width) / 2000)
                     zmax = float(np.max(np.abs(zb)))
                 if zmax > bearing.width / 2 * (1 + 1e-9):
