@@ -183,8 +183,8 @@ def identify(case, *, grid=None, refine=True, scheduler="serial", n_workers=None
         Interval threshold (default: max(3 × the recording's split-half misfit, 0.3 dB)).
     """
     from . import load_case, simulation
-    from .candidates import setting_for
-    from .recording_case import _scene_overrides, prepare
+    from .candidates import comparison_overrides, setting_for
+    from .recording_case import prepare
     from .rig import background_for, path_for
     from .recording import open_spec
     t_cpu, t_wall = time.process_time(), time.perf_counter()
@@ -203,7 +203,7 @@ def identify(case, *, grid=None, refine=True, scheduler="serial", n_workers=None
     st = setting_for(prep, path, bg, level_weight=level_weight)
     thr = float(threshold_db) if threshold_db is not None else max(3 * st.noise_db, MIN_THRESHOLD_DB)
     base = simulation.build_scene(case, rpm=prep.speed.rpm, fs=prep.fs, duration=prep.n / prep.fs,
-                                  overrides=_scene_overrides(case))
+                                  overrides=comparison_overrides(case))
     n_coarse = int(np.prod([len(v) for v in grid.values()]))
     n_total = n_coarse + (2 * len(grid) if refine else 0)
     client, close = _client(scheduler, n_workers)
