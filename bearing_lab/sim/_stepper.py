@@ -224,6 +224,20 @@ def integrate(y, t, t_stop, h, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, met
     err = np.empty(n)
     fi = np.empty(int(p[K.P_Z]))
     fo = np.empty(int(p[K.P_Z]))
+    return _steps(y, t, t_stop, h, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, method, rtol, atol, hmax,
+                  nsteps_def, vel_idx, vel_sign, fine_t, fine_out, fine_pos, out_t, out_state, out_pos, stats,
+                  ctrl, k, ytmp, ynew, err, fi, fo)
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _steps(y, t, t_stop, h, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, method, rtol, atol, hmax,
+           nsteps_def, vel_idx, vel_sign, fine_t, fine_out, fine_pos, out_t, out_state, out_pos, stats,
+           ctrl, k, ytmp, ynew, err, fi, fo):
+    """The time loop of :func:`integrate`, on work arrays allocated there (``k``: the stages'
+    derivatives, 7 × n).  Compiled without reference counting: it allocates nothing, and with
+    it each stage's row view ``k[st]`` took and dropped a reference to ``k`` (two atomic
+    operations per right-hand side)."""
+    n = y.shape[0]
     ns = N_STAGES[method]
     fsal = method != 2
     adaptive = method != 2
@@ -302,6 +316,14 @@ def loads_at(out_t, out_state, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, fi_
     z = int(p[K.P_Z])
     fi = np.empty(z)
     fo = np.empty(z)
+    _loads(out_t, out_state, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, fi_all, fo_all, dy, fi, fo)
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _loads(out_t, out_state, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, fi_all, fo_all, dy, fi, fo):
+    """The loop of :func:`loads_at` on its work arrays, without reference counting (as
+    :func:`_steps`)."""
+    z = fi.shape[0]
     for i in range(out_t.shape[0]):
         K.rhs(out_t[i], out_state[i], p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, dy, fi, fo)
         for j in range(z):
@@ -331,7 +353,7 @@ def _drop_stale_cache():
     import hashlib
     from pathlib import Path
     stamp = hashlib.sha256(Path(K.__file__).read_bytes() + Path(__file__).read_bytes()).hexdigest()
-    for fn in (integrate, loads_at, step_limit):
+    for fn in (integrate, _steps, loads_at, _loads, step_limit):
         cache = getattr(fn, "_cache", None)
         path = getattr(cache, "cache_path", None)
         if not path:
