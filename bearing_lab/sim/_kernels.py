@@ -71,6 +71,19 @@ TWO_PI = 2.0 * math.pi
 # (``_nrt=False``): they allocate nothing, and with it the right-hand side took a reference to
 # each of its 13 array arguments on entry and dropped it on exit (26 atomic operations, about
 # half the cost of an evaluation: 275 -> 135 ns per call for 8 balls, CPU time of 10^6 calls).
+# The option is numba's own (a jit flag since its runtime appeared); should a numba version not
+# have it, the kernels compile with reference counting: slower, same results.
+
+
+def _no_refcount() -> dict:
+    try:
+        from numba.core.cpu import CPUTargetOptions
+    except ImportError:
+        return {}
+    return {"_nrt": False} if hasattr(CPUTargetOptions, "_nrt") else {}
+
+
+NO_REFCOUNT = _no_refcount()
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -143,7 +156,7 @@ def _interp_h(k, psi, dint, dflt, hbuf):
     return h0 + fr * (h1 - h0), (h1 - h0) / dflt[k, F_DPSI]
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@njit(cache=True, error_model="numpy", **NO_REFCOUNT)
 def _interp_g23(k, psi, delta, dint, dflt, gbuf):
     """Equivalent penetration g = G^(2/3) (m) of defect k at (psi, delta), and its partial
     derivatives dg/ddelta and dg/dpsi.
@@ -189,14 +202,14 @@ def _interp_g(k, psi, delta, dint, dflt, gbuf):
     return g * math.sqrt(g) if g > 0.0 else 0.0
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@njit(cache=True, error_model="numpy", **NO_REFCOUNT)
 def defect_force(kk, rel, reld, delta, delta_rate, k, p, dint, dflt, hbuf, gbuf):
     """Normal force of a ball at relative angle ``rel`` inside the zone of defect kk (the
     contact's own damping coefficient); see :func:`contact_force`."""
     return contact_force(kk, rel, reld, delta, delta_rate, k, p[P_CMAX], p, dint, dflt, hbuf, gbuf)
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@njit(cache=True, error_model="numpy", **NO_REFCOUNT)
 def contact_force(kk, rel, reld, delta, delta_rate, k, cmax, p, dint, dflt, hbuf, gbuf):
     """Normal force of a contact at relative angle ``rel`` inside the zone of defect kk, with
     stiffness ``k`` and damping coefficient ``cmax`` (one ball-race contact, or for a drop
@@ -255,7 +268,7 @@ def find_zone(contact, j, phi, phidot, theta_s, omega_s, spin, ndef, dint, dflt)
     return -1, 0.0, 0.0
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@njit(cache=True, error_model="numpy", **NO_REFCOUNT)
 def _qs_ball(kk, rel, reld, dtot, dtot_rate, p, dint, dflt, hbuf, gbuf):
     """Quasi-static (massless) ball whose contact kk has a defect: load through the two
     contacts in series."""
@@ -568,7 +581,7 @@ def _balls_dynamic(y, p, z, phic, theta_s, omega_s, dint, dflt, hbuf, gbuf, dy, 
     return fix, fiy, fox, foy, pocket_torque
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@njit(cache=True, error_model="numpy", **NO_REFCOUNT)
 def rhs(t, y, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, dy, fi_out, fo_out):
     """dy/dt of the bearing model; also writes the ball loads into fi_out/fo_out."""
     z = int(p[P_Z])

@@ -229,7 +229,7 @@ def integrate(y, t, t_stop, h, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, met
                   ctrl, k, ytmp, ynew, err, fi, fo)
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@njit(cache=True, error_model="numpy", **K.NO_REFCOUNT)
 def _steps(y, t, t_stop, h, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, method, rtol, atol, hmax,
            nsteps_def, vel_idx, vel_sign, fine_t, fine_out, fine_pos, out_t, out_state, out_pos, stats,
            ctrl, k, ytmp, ynew, err, fi, fo):
@@ -319,7 +319,7 @@ def loads_at(out_t, out_state, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, fi_
     _loads(out_t, out_state, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, fi_all, fo_all, dy, fi, fo)
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@njit(cache=True, error_model="numpy", **K.NO_REFCOUNT)
 def _loads(out_t, out_state, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, fi_all, fo_all, dy, fi, fo):
     """The loop of :func:`loads_at` on its work arrays, without reference counting (as
     :func:`_steps`)."""
