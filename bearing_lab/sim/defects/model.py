@@ -36,7 +36,7 @@ import numpy as np
 
 from bearing_lab.errors import SceneError, check_choice
 
-from .outlines import OUTLINES
+from .outlines import OUTLINES, finite as _finite
 
 RACES = ("outer", "inner", "ball")
 #: the outline names a scene accepts (``defect.shape``): the registry in :mod:`.outlines`
@@ -47,20 +47,6 @@ DEFAULT_DEPTH = 0.5e-3
 
 _KEYS = ("race", "shape", "length_mm", "width_mm", "depth_mm", "offset_mm", "skew_deg",
          "angle_deg", "vertices_mm", "diameter_mm")
-
-
-def _finite(where, key, value, *, positive=False, nonneg=False):
-    try:
-        x = float(value)
-    except (TypeError, ValueError):
-        raise SceneError(f"{where}.{key}={value!r} is not a number") from None
-    if not math.isfinite(x):
-        raise SceneError(f"{where}.{key}={value!r} must be finite")
-    if positive and not x > 0:
-        raise SceneError(f"{where}.{key}={value!r} must be positive")
-    if nonneg and x < 0:
-        raise SceneError(f"{where}.{key}={value!r} must not be negative")
-    return x
 
 
 @dataclass(frozen=True)

@@ -27,7 +27,8 @@ from bearing_lab.errors import SceneError
 __all__ = ["Outline", "Rectangle", "Ellipse", "Polygon", "OUTLINES"]
 
 
-def _finite(where, key, value, *, positive=False):
+def finite(where, key, value, *, positive=False):
+    """``value`` as a finite float (positive if asked), else a SceneError naming ``where.key``."""
     try:
         x = float(value)
     except (TypeError, ValueError):
@@ -86,8 +87,8 @@ class Outline:
         for key in ("length_mm", "width_mm"):
             if key not in m:
                 raise SceneError(f"{where}.{key} is required for shape={cls.name!r}")
-        return (_finite(where, "length_mm", m["length_mm"], positive=True) * 1e-3,
-                _finite(where, "width_mm", m["width_mm"], positive=True) * 1e-3, None)
+        return (finite(where, "length_mm", m["length_mm"], positive=True) * 1e-3,
+                finite(where, "width_mm", m["width_mm"], positive=True) * 1e-3, None)
 
     @classmethod
     def check(cls, defect, where: str):
@@ -144,7 +145,7 @@ class Ellipse(Outline):
                                  "and replaces length_mm and width_mm")
             if "vertices_mm" in m:
                 raise SceneError(f"{where}.vertices_mm is only used with shape='polygon'")
-            d = _finite(where, "diameter_mm", m["diameter_mm"], positive=True) * 1e-3
+            d = finite(where, "diameter_mm", m["diameter_mm"], positive=True) * 1e-3
             return d, d, None
         return super().size_from_mapping(m, where)
 
