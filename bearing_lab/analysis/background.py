@@ -20,7 +20,7 @@ Measurement:
   (Grandke 1983), amplitude and phase by joint least squares over the record; at most
   ``max_tones``, the strongest kept;
 - *broadband*: the power spectral density of the record with the tones removed,
-  from the quiet part of every period (from 0.45 to 0.95 of a period after each
+  from the quiet part of every period (from 0.45 to 0.85 of a period after each
   impact, where the impact ringing has died out) when impact times are given, else
   from the whole record (Welch, Hann, 50 % overlap).
 

@@ -57,11 +57,16 @@ def _fit(case, rec, measured, sim_x) -> StructuralPath:
                             f"({measured['extras']['notes'].get('excitation_period', '')}); use method = "
                             "\"fixed\", from_case or \"none\"")
     bounds = {k: tuple(sp.get(k, v)) for k, v in PATH_DEFAULT_BOUNDS.items()}
-    return fit_structural_path(rec.x, sim_x, rec.fs, period, band=measured["extras"]["band"],
+    # the recording's own background (between its impacts), added to the path's output in the fit
+    # so that its noise enters both sides alike instead of biasing the gain
+    seed = int(case.section("background").get("seed", 0))
+    bg = _measured_background(case, rec, measured, None).synthesize(np.asarray(sim_x).size, seed=seed)
+    return fit_structural_path(rec.x, sim_x, rec.fs, period, band=measured["extras"]["band"], background=bg,
                                n_resonances=int(sp.get("resonances", 1)), frequency_bounds=bounds["frequency_hz"],
                                damping_bounds=bounds["damping_ratio"], gain_bounds=bounds["gain"],
                                source=f"fitted on {rec.path.name} ({rec.channel}) against the scene of case "
-                                      f"{case.name!r}, pooled over all impacts")
+                                      f"{case.name!r}, pooled over all impacts, with the recording's background "
+                                      "added to the simulation")
 
 
 def _fit_or_fail(case, rec, measured, sim_x) -> StructuralPath:
@@ -113,10 +118,14 @@ def path_for(case, rec, measured, sim_x, *, mirror=None) -> StructuralPath:
 
 def background_for(case, rec, measured, reference=None):
     """The rig's background (tones and broadband), or None when ``[background] enabled = false``."""
+    if not case.section("background").get("enabled", True):
+        return None
+    return _measured_background(case, rec, measured, reference)
+
+
+def _measured_background(case, rec, measured, reference):
     from ..analysis.background import estimate_background
     cfg = case.section("background")
-    if not cfg.get("enabled", True):
-        return None
     src = cfg.get("source", "auto")
     opts = {"max_tones": int(cfg.get("max_tones", 20)), "tone_snr_db": float(cfg.get("tone_snr_db", 15.0))}
     fr = measured["extras"]["shaft_hz_used"]
