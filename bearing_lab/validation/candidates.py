@@ -35,6 +35,10 @@ DEFAULT_BAND_HZ = (1000.0, None)
 #: 2 us ceiling) by 0.16 dB, half the 0.3 dB interval threshold; at 1e-6 by < 0.01 dB
 COMPARISON_RTOL = 1e-6
 
+#: a level within LEVEL_K standard uncertainties of the path's gain (its ``fit["gain_sigma_db"]``) costs
+#: nothing in the score: two standard uncertainties cover about 95 % of a normal error
+LEVEL_K = 2.0
+
 
 def comparison_overrides(case) -> dict:
     """Scene keys every simulated candidate of ``case`` gets: sensor off (a path is applied), the
@@ -58,6 +62,7 @@ class Setting:
     measured: object                    # Signature of the recording
     level_weight: float
     level_reason: str
+    level_tolerance_db: float           # level the path's gain cannot vouch for (LEVEL_K x its uncertainty)
     noise_db: float                     # misfit of the recording's two halves of impacts
     seed: int = 0
     notes: list = field(default_factory=list)
@@ -125,10 +130,14 @@ def setting_for(prep, path, background, *, level_weight=None, band_hz=None, seed
     except AnalysisError as exc:
         raise ValidationCaseError(f"validation case {prep.case.name!r}: {exc}") from None
     w, why = _level_weight(prep, path, level_weight)
+    tol = LEVEL_K * float(path.fit.get("gain_sigma_db") or 0.0) if w else 0.0
     seed = int(prep.case.section("background").get("seed", 0)) if seed is None else int(seed)
     notes = [] if path.status == "ok" else [f"the structural path is {path.status}: " + "; ".join(path.problems)]
     notes += [period_note] if period_note else []
-    return Setting(prep, path, background, period, band, meas, w, why,
+    if tol > 0:
+        notes.append(f"a level within ±{tol:.3f} dB costs nothing: {LEVEL_K:g} × the standard uncertainty of the "
+                     "path's gain")
+    return Setting(prep, path, background, period, band, meas, w, why, tol,
                    _halves_noise(x, prep.fs, times, band), seed, notes)
 
 
@@ -156,5 +165,5 @@ def score_candidates(prep, path, background, candidates: dict, *, level_weight=N
         scene = simulation.build_scene(prep.case, rpm=prep.speed.rpm, fs=prep.fs, duration=prep.n / prep.fs,
                                        overrides={**comparison_overrides(prep.case), **ov})
         sig = candidate_signature(st, simulation.signal(simulation.run(scene)))
-        out[label] = misfit(sig, st.measured, level_weight=st.level_weight)
+        out[label] = misfit(sig, st.measured, level_weight=st.level_weight, level_tolerance_db=st.level_tolerance_db)
     return dict(sorted(out.items(), key=lambda kv: kv[1]["score_db"]))

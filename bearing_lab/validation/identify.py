@@ -121,7 +121,8 @@ def _run_grid(setting, base, grid, *, scheduler, cache_dir, bar, out, keep):
             sel = {ds_dim(first): v, **{ds_dim(k): x for k, x in zip(rest, c)}}
             x = np.asarray(ds[ch].sel(sel, method="nearest").values, float)
             sig = candidate_signature(setting, x)
-            m = misfit(sig, setting.measured, level_weight=setting.level_weight)
+            m = misfit(sig, setting.measured, level_weight=setting.level_weight,
+                       level_tolerance_db=setting.level_tolerance_db)
             out.append({first: v, **dict(zip(rest, c)), **m})
             if m["score_db"] < keep.get("score_db", np.inf):
                 keep.update(score_db=m["score_db"], signature=sig)

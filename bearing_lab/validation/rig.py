@@ -21,6 +21,7 @@ background_for(case, rec, measured, reference=None) -> Background | None
 """
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -86,19 +87,33 @@ def _gain_on_signature(path, rec, sim_x, bg, period):
     fs = rec.fs
     band = (DEFAULT_BAND_HZ[0], DEFAULT_BAND_HZ[1] or 0.45 * fs)
     try:
-        meas = impact_signature(rec.x, fs, impact_times(rec.x, fs, period, band=band), band=band).peak
+        t_rec = impact_times(rec.x, fs, period, band=band)
+        meas = impact_signature(rec.x, fs, t_rec, band=band).peak
         gain0, x = path.gain, np.asarray(sim_x, float)
         for _ in range(_GAIN_PASSES):
             y = path.apply(x, fs) + bg
-            sim = impact_signature(y, fs, impact_times(y, fs, period, band=band), band=band).peak
-            path.gain *= meas / sim
+            t_sim = impact_times(y, fs, period, band=band)
+            path.gain *= meas / impact_signature(y, fs, t_sim, band=band).peak
+        sigma = math.hypot(_subsets_db(rec.x, fs, t_rec, band), _subsets_db(y, fs, t_sim, band))
     except AnalysisError as exc:
         path.fit.setdefault("notes", []).append(f"gain kept from the fit: no impact signature ({exc})")
         return
     path.fit["gain_views"] = gain0
+    path.fit["gain_sigma_db"] = sigma
     path.fit.setdefault("notes", []).append(
         f"gain set on the impact signature ({band[0]:g}-{band[1]:g} Hz, path + background): {path.gain:.4g} "
-        f"(the three views gave {gain0:.4g})")
+        f"(the three views gave {gain0:.4g}); its standard uncertainty from 4 interleaved subsets of the "
+        f"impacts: {sigma:.3f} dB")
+
+
+def _subsets_db(x, fs, times, band, groups=4):
+    """Standard uncertainty (dB) of a signature's peak from ``groups`` interleaved subsets of its impacts:
+    the subsets' standard deviation over sqrt(groups) (each subset holds 1/groups of the impacts)."""
+    from .signature import impact_signature
+    if times.size < 3 * groups:
+        raise AnalysisError(f"{times.size} impacts: at least {3 * groups} are needed to split them in {groups}")
+    db = [20.0 * math.log10(impact_signature(x, fs, times[k::groups], band=band).peak) for k in range(groups)]
+    return float(np.std(db, ddof=1) / math.sqrt(groups))
 
 
 def _fit_or_fail(case, rec, measured, sim_x) -> StructuralPath:

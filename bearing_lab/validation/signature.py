@@ -17,8 +17,10 @@ Score (documented in docs/identification.md):
   after the fixed path);
 - ``shape_db``: the RMS difference, in dB, of the two signatures each normalised to its
   peak, over the window, at the lag that minimises it (entry/exit timing, rise, decay);
-- ``score_db = shape_db + level_weight · |level_db|``; ``level_weight = 1`` by default;
-  0 drops the amplitude when the path's gain is not independent of the geometry.  A sum,
+- ``score_db = shape_db + level_weight · max(|level_db| - level_tolerance_db, 0)``;
+  ``level_weight = 1`` by default; 0 drops the amplitude when the path's gain is not
+  independent of the geometry.  ``level_tolerance_db`` is the level the path's gain cannot
+  vouch for (a multiple of its standard uncertainty): a level inside it costs nothing.  A sum,
   not a sum of squares: every candidate carries about the same systematic shape residual
   (the model's path is not the rig's), and in quadrature that common part would swamp the
   amplitude differences that tell offsets apart.
@@ -30,7 +32,7 @@ Public API
 ----------
 Signature                                       -- time (s, relative to the impact), envelope (m s-2), n_impacts
 impact_signature(x, fs, times, *, band, window_s=(-0.002, 0.006)) -> Signature
-misfit(sim, meas, *, level_weight=1.0, floor=0.05, max_lag_s=0.001) -> dict
+misfit(sim, meas, *, level_weight=1.0, level_tolerance_db=0.0, floor=0.05, max_lag_s=0.001) -> dict
 """
 from __future__ import annotations
 
@@ -109,7 +111,8 @@ def impact_signature(x, fs, times, *, band, window_s=WINDOW_S) -> Signature:
     return Signature(t, mean, int(rows.shape[0]), (float(band[0]), float(band[1])))
 
 
-def misfit(sim: Signature, meas: Signature, *, level_weight=1.0, floor=0.05, max_lag_s=0.001) -> dict:
+def misfit(sim: Signature, meas: Signature, *, level_weight=1.0, level_tolerance_db=0.0, floor=0.05,
+           max_lag_s=0.001) -> dict:
     """Misfit of a simulated signature against the measured one (see the module docstring), dB."""
     if sim.time.size != meas.time.size:
         raise AnalysisError("impact signature misfit: the two signatures have different windows")
@@ -128,5 +131,5 @@ def misfit(sim: Signature, meas: Signature, *, level_weight=1.0, floor=0.05, max
         v = float(np.sqrt(np.mean(d * d)))
         if v < best:
             best, lag = v, s
-    score = float(best + level_weight * abs(level))
+    score = float(best + level_weight * max(abs(level) - level_tolerance_db, 0.0))
     return {"score_db": score, "shape_db": best, "level_db": float(level), "lag_s": lag / fs}
