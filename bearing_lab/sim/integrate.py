@@ -130,6 +130,7 @@ def _run(asm, method, rtol, *, progress, t_end_override=None, step=None, max_ste
     v_buf = np.zeros((0, 2))        # fine velocities [v_start, m_next)
     v_start = 0
     args = (asm.p, asm.sp_t, asm.sp_w, asm.sp_th, asm.dint, asm.dflt, asm.hbuf, asm.gbuf)
+    work = S.work_arrays(n, z)
     bar = None
     if progress:
         from tqdm.auto import tqdm
@@ -151,7 +152,7 @@ def _run(asm, method, rtol, *, progress, t_end_override=None, step=None, max_ste
             out_state = np.zeros((out_t.size, n))
             t_new, h, fpos, opos, status = S.integrate(
                 y, t, t_stop, h, *args, method, rtol, atol, hmax,
-                defect_steps, vel_idx, vel_sign, fine_t, fine_out, 0, out_t, out_state, 0, stats, ctrl)
+                defect_steps, vel_idx, vel_sign, fine_t, fine_out, 0, out_t, out_state, 0, stats, ctrl, *work)
             if status != 0:
                 what = "the state became NaN/Inf" if status == 1 else "the step size underflowed"
                 raise SolverError(f"scene {scene.name!r}: integration failed at t = {t_new:.6g} s: {what} "
@@ -163,7 +164,7 @@ def _run(asm, method, rtol, *, progress, t_end_override=None, step=None, max_ste
                 if dyn:
                     cage_speed[o_next:o_hi] = out_state[:, cage_idx]
                 if loads:
-                    S.loads_at(out_t, out_state, *args, fi_all[:, o_next:o_hi], fo_all[:, o_next:o_hi])
+                    S.loads_at(out_t, out_state, *args, fi_all[:, o_next:o_hi], fo_all[:, o_next:o_hi], *work[1:2], *work[4:])
                 o_next = o_hi
             # accelerometer: fine-interval mean acceleration, FIR, decimate; keep the tail
             m_next += fine_t.size

@@ -89,3 +89,37 @@ def test_background_healthy_reference_and_report(cwru):
         assert part in html, part
     index = (out / "index.html").read_text()
     assert 'href="cwru-144/index.html"' in index
+
+
+def _impact_peaks_by_shaft_angle(path, rpm, bins=8):
+    """Mean impact peak (2.5-4 kHz band envelope, one per BPFO period) in ``bins`` shaft-angle bins of a record."""
+    import scipy.io
+    import scipy.signal as ss
+    m = scipy.io.loadmat(str(path))
+    x = m[next(k for k in m if k.endswith("_DE_time"))].ravel() * 9.80665
+    fs, fr = 12000.0, rpm / 60.0
+    env = np.abs(ss.hilbert(ss.sosfiltfilt(ss.butter(4, [2500, 4000], "bandpass", fs=fs, output="sos"), x)))
+    per = fs / (3.5848 * fr)                                   # BPFO period in samples (6205 drive end)
+    starts = (np.arange(int(x.size // per) - 1) * per).astype(int)
+    idx = np.array([s + np.argmax(env[s:s + int(per)]) for s in starts])
+    b = np.floor((idx / fs * fr) % 1.0 * bins).astype(int)
+    return np.array([env[idx][b == k].mean() for k in range(bins)])
+
+
+def test_the_021_pit_amplitudes_fail_as_a_known_limitation_whose_evidence_holds(cwru, datafile):
+    _, _, _, sums = cwru
+    s234, s130 = sums["cwru-234"], sums["cwru-130"]
+    rows, rows130 = _rows(s234), _rows(s130)
+    for q in ("rms", "peak", "impulse_strength"):
+        assert not rows[q]["pass"] and rows[q]["status"] == "known limitation", rows[q]
+        assert q in s234["known_limitations"]
+    assert not s234["unexplained_failures"]
+    # the stated reason, model side: through the same fixed path the model's 0.021 in pit gives several times
+    # the 0.007 in pit's RMS and peak, while the rig's two records are within a factor 2 of each other
+    for q in ("rms", "peak"):
+        assert rows[q]["simulation"] / rows130[q]["simulation"] > 4
+        assert 0.5 < rows[q]["experiment"] / rows130[q]["experiment"] < 2
+    # rig side, straight from the recordings: the 234 impacts change strongly with the shaft angle, 130's much less
+    mod234 = _impact_peaks_by_shaft_angle(datafile("cwru/234_OR021@6_0.mat"), 1796.0)
+    mod130 = _impact_peaks_by_shaft_angle(datafile("cwru/130_OR007@6_0.mat"), 1796.0)
+    assert mod234.max() / mod234.min() > 4 and mod130.max() / mod130.min() < 3, (mod234, mod130)
