@@ -35,7 +35,7 @@ DEFAULT_BAND_HZ = (1000.0, None)
 #: 2 us ceiling) by 0.16 dB, half the 0.3 dB interval threshold; at 1e-6 by < 0.01 dB
 COMPARISON_RTOL = 1e-6
 
-#: a level within LEVEL_K standard uncertainties of the path's gain (its ``fit["gain_sigma_db"]``) costs
+#: a level within LEVEL_K standard uncertainties of the path's signature gain (``fit["signature_gain_sigma_db"]``) costs
 #: nothing in the score: two standard uncertainties cover about 95 % of a normal error
 LEVEL_K = 2.0
 
@@ -110,6 +110,18 @@ def _period(prep) -> tuple:
     return float("nan"), ""
 
 
+def _signature_path(path):
+    """The path as signatures are compared through it: with its signature gain when it has one (see
+    :func:`bearing_lab.validation.rig.identify_path`)."""
+    g = path.fit.get("signature_gain")
+    if not g or abs(g - path.gain) <= 1e-12 * path.gain:
+        return path, ""
+    from ..analysis.structural_path import StructuralPath
+    note = (f"the path's gain for the impact signature is {g:.4g} (fitted {path.gain:.4g}, matched to the impact "
+            "peaks): the declared scene's signature on the path's own recording peaks where that recording's does")
+    return StructuralPath(path.resonances, g, path.source, dict(path.fit)), note
+
+
 def setting_for(prep, path, background, *, level_weight=None, band_hz=None, seed=None) -> Setting:
     """The measured signature, period, band and level weight every candidate is scored with."""
     m = prep.measured["record"]
@@ -130,10 +142,12 @@ def setting_for(prep, path, background, *, level_weight=None, band_hz=None, seed
     except AnalysisError as exc:
         raise ValidationCaseError(f"validation case {prep.case.name!r}: {exc}") from None
     w, why = _level_weight(prep, path, level_weight)
-    tol = LEVEL_K * float(path.fit.get("gain_sigma_db") or 0.0) if w else 0.0
+    path, gain_note = _signature_path(path)
+    tol = LEVEL_K * float(path.fit.get("signature_gain_sigma_db") or 0.0) if w else 0.0
     seed = int(prep.case.section("background").get("seed", 0)) if seed is None else int(seed)
     notes = [] if path.status == "ok" else [f"the structural path is {path.status}: " + "; ".join(path.problems)]
     notes += [period_note] if period_note else []
+    notes += [gain_note] if gain_note and w else []
     if tol > 0:
         notes.append(f"a level within ±{tol:.3f} dB costs nothing: {LEVEL_K:g} × the standard uncertainty of the "
                      "path's gain")
