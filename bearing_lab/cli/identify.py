@@ -17,7 +17,7 @@ def register(subparsers):
         description=("Search simulated scenes around the case's declared defect (length 0.5-2x, offset 0-B/2, "
                      "skew -60..60 deg by default) for the one whose impact signature after the fixed structural "
                      "path and background matches the recording; report an interval per parameter, or that it "
-                     "is not identifiable.  The default grid is 140 scenes plus up to 6 refinements (about 0.8 s CPU "
+                     "is not identifiable.  The default grid is 140 scenes plus up to 6 refinements and 6 roughness probes (about 0.8 s CPU "
                      "each for a 1 s record at 20 kHz, 0.2 s once the contact tables are cached)."))
     p.add_argument("case", metavar="CASE", help="case TOML file (docs/case-format.md) with one [[defect]]")
     p.add_argument("-o", "--output", default="reports", metavar="DIR", help="output directory (default: reports)")
@@ -26,7 +26,7 @@ def register(subparsers):
     p.add_argument("--skew-deg", type=float, nargs="+", default=None, help="skews θ to search, degrees")
     p.add_argument("--depth-mm", type=float, nargs="+", default=None,
                    help="depths to search, mm (default: not searched)")
-    p.add_argument("--no-refine", action="store_true", help="no refinement around the best coarse scene")
+    p.add_argument("--no-refine", action="store_true", help="no refinement and no roughness probe around the best coarse scene")
     p.add_argument("--workers", type=int, default=1,
                    help="Dask worker processes (default 1: in this process, no Dask; measured faster on a "
                         "shared 2-core machine, see docs/identification.md)")
@@ -59,10 +59,10 @@ def run(args) -> int:
     for v in grid.values():
         n *= len(v)
     if not args.json:
-        total = n + (0 if args.no_refine else 2 * len(grid))
+        total = n + (0 if args.no_refine else 4 * len(grid))
         sec = float(case.recording.duration_s)
         print(f"identify {case.name}: {n} scenes on the coarse grid"
-              + ("" if args.no_refine else f" + up to {2 * len(grid)} refinements")
+              + ("" if args.no_refine else f" + up to {2 * len(grid)} refinements and {2 * len(grid)} roughness probes")
               + f" of {sec:g} s each: about {0.2 * total * sec:.0f}-{0.8 * total * sec:.0f} s of CPU (cached / "
                 "new contact tables; measured at 20 kHz)", file=sys.stderr)
     res = identify(case, grid=grid, refine=not args.no_refine, scheduler="serial" if args.workers <= 1 else "local",

@@ -52,13 +52,14 @@ class Identification:
     notes: list = field(default_factory=list)
     signatures: dict = field(default_factory=dict)   # "recording", "best" -> Signature
     declared: dict = field(default_factory=dict)
+    roughness_db: float | None = None    # score change for 1 % of a grid step at the best scene
 
     def to_dict(self) -> dict:
         return {"case": self.case, "best": self.best, "parameters": self.parameters,
                 "threshold_db": self.threshold_db, "noise_db": self.noise_db, "level_weight": self.level_weight,
                 "level_reason": self.level_reason, "grid": self.grid, "n_scenes": self.n_scenes,
                 "cpu_time_s": self.cpu_time_s, "wall_time_s": self.wall_time_s, "notes": self.notes,
-                "declared": self.declared}
+                "declared": self.declared, "roughness_db": self.roughness_db}
 
 
 def _declared(case) -> dict:
@@ -95,6 +96,28 @@ def _refined(grid, best) -> list:
         for j in (i - 1, i + 1):
             if 0 <= j < len(v):
                 out.append({**{q: [best[q]] for q in grid}, k: [round((v[i] + v[j]) / 2, 4)]})
+    return out
+
+
+#: the roughness probe moves each parameter by this fraction of its coarse grid step
+ROUGHNESS_STEP = 0.01
+
+
+def _probes(grid, best) -> list:
+    """Scenes a hundredth of a coarse step from the best one, each parameter alone, both ways:
+    geometries no recording can tell apart.  How much their scores differ from the best's is the
+    score's roughness at this scale (the contact tables' discretisation of the outline, the
+    impact signature's sampling): differences below it carry no information."""
+    out = []
+    for k, vals in grid.items():
+        v = sorted(vals)
+        if len(v) < 2:
+            continue
+        step = ROUGHNESS_STEP * (v[-1] - v[0]) / (len(v) - 1)
+        for sign in (-1, 1):
+            x = round(best[k] + sign * step, 5)
+            if v[0] <= x <= v[-1]:          # inside the searched range (an offset beyond B/2 is another defect)
+                out.append({**{q: [best[q]] for q in grid}, k: [x]})
     return out
 
 
@@ -173,7 +196,9 @@ def identify(case, *, grid=None, refine=True, scheduler="serial", n_workers=None
         Coarse grid (default :func:`default_grid`); keys among ``defect.length_mm``, ``defect.offset_mm``,
         ``defect.skew_deg``, ``defect.depth_mm``.
     refine : bool
-        Simulate a grid of half the coarse steps around the best coarse scene.
+        Simulate a grid of half the coarse steps around the best coarse scene, then probe the score's
+        roughness there (each parameter moved by 1 % of its grid step); the interval threshold is at
+        least twice that roughness.
     scheduler, n_workers, cache_dir : as :func:`bearing_lab.sweeps.sweep` (default serial, in process; no sweep
         cache: it keeps every simulated variable, about 3.6 MB per scene of 1 s at 20 kHz; the contact tables
         are cached regardless).
@@ -181,7 +206,8 @@ def identify(case, *, grid=None, refine=True, scheduler="serial", n_workers=None
         Weight of the amplitude in the score (default: 1 when the structural path is independent of this
         recording, else 0; see :func:`bearing_lab.validation.candidates.setting_for`).
     threshold_db : float, optional
-        Interval threshold (default: max(3 × the recording's split-half misfit, 0.3 dB)).
+        Interval threshold (default: max(3 × the recording's split-half misfit, 0.3 dB, twice the
+        score's roughness at the best scene)).
     """
     from . import load_case, simulation
     from .candidates import comparison_overrides, setting_for
@@ -206,7 +232,7 @@ def identify(case, *, grid=None, refine=True, scheduler="serial", n_workers=None
     base = simulation.build_scene(case, rpm=prep.speed.rpm, fs=prep.fs, duration=prep.n / prep.fs,
                                   overrides=comparison_overrides(case))
     n_coarse = int(np.prod([len(v) for v in grid.values()]))
-    n_total = n_coarse + (2 * len(grid) if refine else 0)
+    n_total = n_coarse + (4 * len(grid) if refine else 0)
     client, close = _client(scheduler, n_workers)
     bar = None
     if progress:
@@ -217,15 +243,24 @@ def identify(case, *, grid=None, refine=True, scheduler="serial", n_workers=None
     try:
         _run_grid(st, base, grid, scheduler=client, cache_dir=cache_dir, bar=bar, out=points, keep=keep)
         best = min(points, key=lambda p: p["score_db"])
+        roughness = None
         if refine:
             for fine in _refined(grid, best):
                 _run_grid(st, base, fine, scheduler="serial", cache_dir=cache_dir, bar=bar, out=points, keep=keep)
+            best = min(points, key=lambda p: p["score_db"])
+            n_before = len(points)
+            for probe in _probes(grid, best):
+                _run_grid(st, base, probe, scheduler="serial", cache_dir=cache_dir, bar=bar, out=points, keep=keep)
+            if len(points) > n_before:
+                roughness = max(abs(p["score_db"] - best["score_db"]) for p in points[n_before:])
+                if threshold_db is None:     # the best and any other scene each move by up to it
+                    thr = max(thr, 2 * roughness)
     finally:
         if bar is not None:
             bar.close()
         if close:
             client.close()
-    return _result(case, st, points, grid, thr, declared, t_cpu, t_wall, keep["signature"])
+    return _result(case, st, points, grid, thr, declared, t_cpu, t_wall, keep["signature"], roughness)
 
 
 def _client(scheduler, n_workers):
@@ -237,13 +272,18 @@ def _client(scheduler, n_workers):
     return scheduler, False
 
 
-def _result(case, st, points, grid, thr, declared, t_cpu, t_wall, best_signature):
+def _result(case, st, points, grid, thr, declared, t_cpu, t_wall, best_signature, roughness=None):
     best = min(points, key=lambda p: p["score_db"])
     params = {k: _profile(points, k, thr) for k in grid}
     notes = list(st.notes) + [f"amplitude weight {st.level_weight:g}: {st.level_reason}"]
+    if roughness is not None:
+        notes.append(f"score roughness {roughness:.2f} dB: moving one parameter of the best scene by "
+                     f"{100 * ROUGHNESS_STEP:g} % of its grid step changes the score by up to this much"
+                     + ("; the interval threshold is raised to twice it (the best scene and any other each move "
+                        "by up to it)" if 2 * roughness >= thr - 1e-12 and roughness > 0 else ""))
     if not any(p["identifiable"] for p in params.values()):
         notes.append("no parameter is identifiable: the recording's impact signature does not change with the "
                      "searched geometry more than with its own noise")
     return Identification(case.name, points, best, params, thr, st.noise_db, st.level_weight, st.level_reason,
                           grid, len(points), time.process_time() - t_cpu, time.perf_counter() - t_wall, notes,
-                          {"recording": st.measured, "best": best_signature}, declared)
+                          {"recording": st.measured, "best": best_signature}, declared, roughness)

@@ -52,6 +52,8 @@ def landscape(result):
                      "best": json.dumps({k: result.best[k] for k in keys}), "n_scenes": result.n_scenes,
                      "bearing_lab_version": __version__,
                      "statements": " | ".join(p["statement"] for p in result.parameters.values())})
+    if result.roughness_db is not None:
+        ds.attrs["roughness_db"] = result.roughness_db
     return ds
 
 
@@ -95,7 +97,9 @@ def _sections(result) -> list:
     notes = "".join(f"<p class=\"note\">{esc(n)}</p>" for n in result.notes)
     text = (f"<p>{result.n_scenes} simulated scenes, {result.cpu_time_s:.0f} s CPU in this process "
             f"({result.wall_time_s:.0f} s wall). Interval threshold {result.threshold_db:.2f} dB (the recording's "
-            f"split-half misfit {result.noise_db:.2f} dB).</p><ul>{items}</ul>{notes}")
+            f"split-half misfit {result.noise_db:.2f} dB"
+            + (f"; the score's roughness at the best scene {result.roughness_db:.2f} dB" if result.roughness_db is not None
+               else "") + f").</p><ul>{items}</ul>{notes}")
     return [("Defect identification", text, None)] + [("Defect identification: figures", None, figures(result))]
 
 

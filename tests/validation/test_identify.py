@@ -28,17 +28,9 @@ def found(tmp_path_factory):
     return d, case, identify(case, grid=GRID, progress=False)
 
 
-# measured with the signature gain recovered (1.003): the truth (3 mm, 0.3 mm, 30°) scores 0.31 dB, best of all, but it
-# is not on the grid, and 0.05 mm of H moves the score by 0.7-0.9 dB ((3, 0.25) 1.19 dB, (3, 0.35) 1.04 dB): the
-# score's valley runs diagonally through (length, H), narrower than the 0.25 mm H step, so the grid's best is
-# (3.6 mm, 0.5 mm) at 0.47 dB and the axis-wise refinement around it cannot reach the valley floor near the truth
-@pytest.mark.xfail(strict=True, reason="the score's (length, H) valley is narrower (0.7-0.9 dB per 0.05 mm of H) than "
-                                      "the grid's 0.25 mm H step: the grid's best is L 3.6 mm, H 0.5 mm (0.47 dB) "
-                                      "while the unsampled truth scores 0.31 dB")
-def test_identify_recovers_the_length_and_brackets_offset_and_skew(found):
+def test_identify_brackets_offset_and_skew_or_says_not_identifiable(found):
+    """The true offset and skew lie inside their intervals (a confident wrong interval is the failure)."""
     _, _, r = found
-    length = r.parameters["defect.length_mm"]
-    assert length["identifiable"] and abs(length["best"] - 3.0) / 3.0 <= 0.15, length
     for k in ("defect.offset_mm", "defect.skew_deg"):
         p = r.parameters[k]
         if p["identifiable"]:
@@ -46,9 +38,38 @@ def test_identify_recovers_the_length_and_brackets_offset_and_skew(found):
             assert lo <= TRUE[k] <= hi, p["statement"]
         else:
             assert "not identifiable" in p["statement"]
+    length = r.parameters["defect.length_mm"]
+    assert not length["identifiable"] or length["interval"][0] <= TRUE["defect.length_mm"] <= length["interval"][1]
     # the amplitude took part: the path came from another recording of the rig
     assert r.level_weight == 1.0 and "calib" in r.level_reason
-    assert r.n_scenes == 27 + 6
+    assert r.n_scenes >= 27 + 6
+
+
+def test_the_score_roughness_is_measured_and_widens_the_threshold(found):
+    """Geometries 1 % of a grid step apart are probed at the best scene; the threshold is at least twice
+    the score change they show.  Break it: at the 0.3 dB floor alone the offset interval of this recording
+    excludes the true 0.3 mm (the profile at 0.25 mm is 0.87 dB above the best), a confident wrong answer."""
+    from bearing_lab.validation.identify import _profile
+    _, _, r = found
+    assert r.roughness_db is not None and r.roughness_db > 0.0
+    assert r.threshold_db >= 2 * r.roughness_db - 1e-12
+    assert any("roughness" in n for n in r.notes)
+    narrow = _profile(r.points, "defect.offset_mm", 0.3)
+    assert not narrow["interval"][0] <= TRUE["defect.offset_mm"] <= narrow["interval"][1], narrow["statement"]
+
+
+# measured: the score is rough for a skewed outline -- moving one parameter of the best scene by 1 % of its grid
+# step (0.0025 mm of H, 0.3 degrees of skew) changes it by up to 0.82 dB (0.09 dB for an unskewed outline; the
+# contact table resolves a skewed edge to its cells), which is more than what separates the truth (3 mm, 0.3 mm,
+# 30 degrees: 0.31 dB) from (3.6 mm, 0.5 mm, 30 degrees: 0.33-0.47 dB) along the valley where length and offset
+# trade against each other; so the best scene's length is 20 % long, inside an interval of 2.5-3.6 mm
+@pytest.mark.xfail(strict=True, reason="the score's roughness for a skewed outline (0.82 dB for 1 % of a grid step) "
+                                      "exceeds the length-offset trade-off: (3.6 mm, 0.5 mm) scores 0.33 dB against "
+                                      "the truth's 0.31 dB, so the best length is 20 % long")
+def test_identify_recovers_the_length_within_15_percent(found):
+    _, _, r = found
+    length = r.parameters["defect.length_mm"]
+    assert length["identifiable"] and abs(length["best"] - 3.0) / 3.0 <= 0.15, length
 
 
 def test_a_flat_profile_is_called_not_identifiable(found):
