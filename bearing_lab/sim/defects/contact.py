@@ -465,12 +465,13 @@ def _halfspace_G(defect, geom, s_tab, delta, drop, *, e_star, misses, settings=N
     ``settings`` (for convergence studies) overrides ``nodes`` (fractions of delta_max),
     ``cells``, ``richardson`` and the keywords of :func:`.halfspace.ratio_curve`
     (``tol``, ``refine_tol``, ``coarse_step``)."""
-    from .halfspace import TABLE_CELLS, aligned_sides, ratio_curve
+    from .halfspace import TABLE_CELLS, ratio_curve
     settings = dict(settings or {})
     n_psi, n_delta = s_tab.size, delta.size
     nodes_d = np.array(settings.pop("nodes", HALFSPACE_NODES)) * delta[-1]
     cells = tuple(settings.pop("cells", TABLE_CELLS))
-    richardson = settings.pop("richardson", True) and aligned_sides(defect) is not None
+    # rectangles: sides on cell boundaries (aligned, or on a grid rotated with the defect)
+    richardson = settings.pop("richardson", True) and defect.shape == "rectangle"
     info = {"halfspace_delta_nodes": nodes_d, "halfspace_cells": cells}
     if misses:
         info["halfspace_ratio"] = np.ones((n_psi, nodes_d.size))

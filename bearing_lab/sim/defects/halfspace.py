@@ -308,6 +308,10 @@ def ratio_curve(defect: Defect, geom: RaceGeometry, delta: float, *, cells=TABLE
     with ratio = F(defect) / F(intact) at the same approach (1 where the grid does not
     meet the outline), and info (intact force N, semi-axes m, cells, solves, iterations).
     """
+    if defect.shape == "rectangle" and aligned_sides(defect) is None:
+        from .halfspace_skewed import ratio_curve_skewed
+        return ratio_curve_skewed(defect, geom, delta, cells=cells, e_star=e_star, tol=tol,
+                                  refine_tol=refine_tol, coarse_step=coarse_step)
     base = intact_contact(geom, delta, cells=cells, e_star=e_star, tol=min(tol, 1e-6),
                           defect=defect)
     grid, hs = base["grid"], base["solver"]
