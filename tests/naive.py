@@ -189,3 +189,37 @@ def resample_at_angle(x, fs, pulse_times, pulses_per_rev=1):
         out.append(np.interp(t * fs, np.arange(x.size), x))
         a += shaft / fs
     return np.array(out), float(shaft)
+
+
+def halfspace_share_rotated(geom_radii, approach, *, length, width, offset, skew, s_ball,
+                            cell_u, cell_v, half_u, half_v, e_star=114.3e9):
+    """F(pit) / F(intact) at the same approach for an L x W rectangular pit (floor never
+    reached) centred at axial offset ``offset`` and inclined by ``skew`` (rad) to the track,
+    the ball centred at track position ``s_ball`` (m from the pit centre), brute force.
+
+    The cells are cell_u x cell_v along the pit's own axes with boundaries on its sides
+    (the influence of a loaded cell depends only on the cells' relative position, so a
+    rotated grid serves as well as one along the track); they cover |u - u_ball| < half_u,
+    |v - v_ball| < half_v around the ball's position in the pit's axes."""
+    c, sn = math.cos(skew), math.sin(skew)
+    u_b, v_b = s_ball * c - offset * sn, -s_ball * sn - offset * c
+    i = np.arange(math.floor((u_b - half_u + length / 2) / cell_u),
+                  math.ceil((u_b + half_u + length / 2) / cell_u))
+    j = np.arange(math.floor((v_b - half_v + width / 2) / cell_v),
+                  math.ceil((v_b + half_v + width / 2) / cell_v))
+    I, J = np.meshgrid(i, j, indexing="ij")
+    U, V = -length / 2 + (I + 0.5) * cell_u, -width / 2 + (J + 0.5) * cell_v
+    S, Z = U * c - V * sn - s_ball, offset + U * sn + V * c
+    with np.errstate(invalid="ignore"):
+        gap = torus_gap(S, Z, **geom_radii)
+    keep = np.isfinite(gap) & (gap < approach)
+    if keep[0].any() or keep[-1].any() or keep[:, 0].any() or keep[:, -1].any():
+        raise ValueError("the contact reaches the edge of the brute-force grid")
+    pit = (I >= 0) & (I < round(length / cell_u)) & (J >= 0) & (J < round(width / cell_v))
+    forces = []
+    for removed in (np.zeros_like(keep), pit):
+        cells = keep & ~removed
+        A = boussinesq_matrix(I[cells], J[cells], cell_u, cell_v, e_star)
+        p = contact_nnls(A, gap[cells], approach)
+        forces.append(p.sum() * cell_u * cell_v)
+    return forces[1] / forces[0], forces[0]

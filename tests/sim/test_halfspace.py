@@ -15,7 +15,7 @@ from bearing_lab.sim.defects import contact as contact_mod
 from bearing_lab.sim.defects._table_cache import TableCacheWarning, entry_path, table_key
 from bearing_lab.sim.defects.geometry import hertz_semi_axes
 from bearing_lab.sim.hertz import race_contact
-from tests.naive import halfspace_share
+from tests.naive import halfspace_share, halfspace_share_rotated
 
 B6308 = get_bearing("6308")
 DMAX = 12.11e-6          # the delta_max paper-O1 uses (3 x the most loaded ball's approach)
@@ -74,6 +74,59 @@ def test_defect_share_against_brute_force_boussinesq(offset):
     naive = 2 * shares[1] - shares[0]          # first-order error in the cell size
     assert table == pytest.approx(naive, rel=0.02)
     assert 0.3 < naive < 0.9                   # a real load loss, not an intact contact
+
+
+#: paper-O2's 1 x 3 mm defect moved off the track centre and inclined to it
+def _skewed(skew_deg, offset=0.3e-3):
+    return Defect(length=3e-3, width=1e-3, depth=0.5e-3, offset=offset, skew=math.radians(skew_deg))
+
+
+@pytest.fixture(scope="module")
+def skewed_table():
+    contact_mod._MEMORY.clear()
+    return contact_table(_skewed(30.0), B6308, model="halfspace", delta_max=DMAX, cache=False)
+
+
+@pytest.mark.parametrize("s_ball", [0.0, 0.8e-3])
+def test_skewed_share_against_brute_force_boussinesq(skewed_table, s_ball):
+    """1 x 3 mm defect at H = 0.3 mm inclined by 30 deg, ball at two track positions, 4.04 µm:
+    the table's share of the intact load against the independent dense Boussinesq solve
+    (tests/naive.py) on cells along the pit's sides, extrapolated from two grids, within
+    0.5 % (a grid that resolves the inclined sides by its cells' centres is 0.6-0.8 % low
+    here)."""
+    delta = 4.04e-6
+    T = skewed_table
+    table = float(T.lookup(s_ball / T.track_radius, delta)) / delta ** 1.5
+    radii = dict(ball_radius=B6308.ball_diameter / 2, groove_radius=0.53 * B6308.ball_diameter,
+                 track_radius=B6308.pitch_diameter / 2 + B6308.ball_diameter / 2)
+    shares = [halfspace_share_rotated(radii, delta, length=3e-3, width=1e-3, offset=0.3e-3,
+                                      skew=math.radians(30.0), s_ball=s_ball, cell_u=0.05e-3 / m,
+                                      cell_v=1e-3 / 12 / m, half_u=0.75e-3, half_v=1.25e-3)[0]
+              for m in (1, 2)]
+    naive = 2 * shares[1] - shares[0]          # first-order error in the cell size
+    assert 0.3 < naive < 0.95                  # a real load loss, not an intact contact
+    assert table == pytest.approx(naive, rel=0.005)
+
+
+def test_share_follows_a_small_skew_change_in_proportion():
+    """Turning the skewed defect by 0.1 deg moves the share curve by a tenth of what 1 deg
+    moves it (within a factor 2), and a second 0.1 deg moves it by nearly the same amount
+    again (second difference below a fifth of the first): the share is a smooth function
+    of the outline, not a staircase of cells flipping between pit and surface."""
+    from bearing_lab.sim.defects.halfspace import ratio_curve
+    geom = RaceGeometry.from_bearing(B6308, "outer")
+    s = np.linspace(-2.5e-3, 2.5e-3, 2001)
+    curves = {}
+    for th in (30.0, 30.1, 30.2, 31.0):
+        sn, r, _ = ratio_curve(_skewed(th), geom, 4.04e-6, coarse_step=1)
+        curves[th] = np.interp(s, sn, r, left=1.0, right=1.0)
+    d1 = curves[30.1] - curves[30.0]
+    d1b = curves[30.2] - curves[30.1]
+    per_tenth = np.abs(curves[31.0] - curves[30.0]).max() / 10
+    assert per_tenth > 1e-3                    # the skew matters at all
+    assert 0.5 * per_tenth < np.abs(d1).max() < 2 * per_tenth
+    assert 0.5 * per_tenth < np.abs(d1b).max() < 2 * per_tenth
+    assert np.abs(d1b - d1).max() < 0.2 * np.abs(d1).max()
 
 
 def test_cache_round_trip_and_key():
