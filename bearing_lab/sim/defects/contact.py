@@ -34,10 +34,11 @@ Models
     apart (refined where the share curves), interpolated linearly onto the table's psi;
     between approaches ``G^(2/3)`` is interpolated by a monotone cubic through (0, 0) and
     (drop, 0).
-    For rectangles with sides along and across the track the cell sizes put the sides on
-    cell boundaries, and two grids (``TABLE_CELLS`` and half as many cells) are
-    extrapolated to zero cell size (Richardson; the error is first order in the cell
-    size).  Accuracy and build time: ``docs/contact-model.md``.
+    For rectangles the sides fall on cell boundaries (cell sizes adjusted when the sides
+    run along and across the track, cells rotated with the outline otherwise), and two
+    grids (``TABLE_CELLS`` and half as many cells) are extrapolated to zero cell size
+    (Richardson; the error is first order in the cell size).  Accuracy and build time:
+    ``docs/contact-model.md``.
 ``"area"``     2-D loss of contact area by a local (Winkler-type) law over the raceway
     surface, ``dF = K c sqrt(max(delta - h(s, z), 0)) dA`` with ``h`` the exact gap of
     :mod:`.geometry` to the remaining surface, ``c = 3 / (4 pi sqrt(R_x R_y))`` so that the

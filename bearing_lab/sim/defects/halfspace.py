@@ -25,7 +25,9 @@ The grid is ball-centred and covers the rigid interpenetration region ``{h < del
 (the elastic contact lies inside it, with or without a defect: surface displacements
 are >= 0) with ``TABLE_CELLS`` cells.  For a rectangle whose sides run along and across
 the track the cell sizes are adjusted so the sides fall on cell boundaries (no
-staircase); other outlines are resolved by their cells' centres.  Ball positions are
+staircase); a rectangle inclined to the track is solved on cells rotated with it and
+anchored to its sides (:mod:`.halfspace_skewed`); ellipses and polygons are resolved by
+their cells' centres.  Ball positions are
 whole numbers of cells along the track (so the outline moves by whole cells), first
 every ``COARSE_STEP`` cells, then halved where linear interpolation misses the solved
 midpoint by more than ``REFINE_TOL``; positions whose cells see the same part of the
