@@ -96,18 +96,24 @@ def _halves_noise(x, fs, times, band):
 _FAMILY = {"outer": "bpfo", "inner": "bpfi"}
 
 
-def _period(prep) -> tuple:
-    """The impact period: the measured one, else the declared race's measured fault line."""
-    m = prep.measured["record"]
-    period = float(m["excitation_period"])
+def impact_period(case, measured) -> tuple:
+    """The impact period (s) and a note: the measured one, else the declared defect race's measured
+    fault line (``nan`` and no note when neither is there)."""
+    period = float(measured["excitation_period"])
     if np.isfinite(period):
         return period, ""
-    races = {str(d.get("race", "outer")) for d in prep.case.data.get("defect", [])}
+    races = {str(d.get("race", "outer")) for d in case.data.get("defect", [])}
     fam = _FAMILY.get(races.pop()) if len(races) == 1 else None
-    if fam and np.isfinite(m[fam]):
-        return 1.0 / float(m[fam]), (f"no fault was diagnosed on its own; the impacts are timed at the measured "
-                                     f"{fam.upper()} line ({float(m[fam]):.2f} Hz) of the declared defect's race")
+    if fam and np.isfinite(measured[fam]):
+        return 1.0 / float(measured[fam]), (f"no fault was diagnosed on its own; the impacts are timed at the measured "
+                                            f"{fam.upper()} line ({float(measured[fam]):.2f} Hz) of the declared "
+                                            "defect's race")
     return float("nan"), ""
+
+
+def _period(prep) -> tuple:
+    """The impact period: the measured one, else the declared race's measured fault line."""
+    return impact_period(prep.case, prep.measured["record"])
 
 
 def _signature_path(path):
