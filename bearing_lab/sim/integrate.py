@@ -130,7 +130,8 @@ def _run(asm, method, rtol, *, progress, t_end_override=None, step=None, max_ste
     v_buf = np.zeros((0, 2))        # fine velocities [v_start, m_next)
     v_start = 0
     args = (asm.p, asm.sp_t, asm.sp_w, asm.sp_th, asm.dint, asm.dflt, asm.hbuf, asm.gbuf)
-    work = S.work_arrays(n, z)
+    work = S.work_arrays(n, z)      # the loop's stage derivatives, state vectors and ball loads
+    loads_work = (work[1], work[4], work[5])    # a state-size scratch vector and the two ball-load vectors
     bar = None
     if progress:
         from tqdm.auto import tqdm
@@ -164,7 +165,7 @@ def _run(asm, method, rtol, *, progress, t_end_override=None, step=None, max_ste
                 if dyn:
                     cage_speed[o_next:o_hi] = out_state[:, cage_idx]
                 if loads:
-                    S.loads_at(out_t, out_state, *args, fi_all[:, o_next:o_hi], fo_all[:, o_next:o_hi], *work[1:2], *work[4:])
+                    S.loads_at(out_t, out_state, *args, fi_all[:, o_next:o_hi], fo_all[:, o_next:o_hi], *loads_work)
                 o_next = o_hi
             # accelerometer: fine-interval mean acceleration, FIR, decimate; keep the tail
             m_next += fine_t.size

@@ -29,6 +29,13 @@ __all__ = ["Setting", "setting_for", "candidate_signature", "score_candidates", 
 #: entry and exit events apart in time (a narrow band would smear them over 1/bandwidth)
 DEFAULT_BAND_HZ = (1000.0, None)
 
+
+def comparison_band(fs, band_hz=None) -> tuple:
+    """The band (Hz) impacts are timed and enveloped in: ``band_hz`` or :data:`DEFAULT_BAND_HZ`, an open
+    upper edge at 0.45 fs."""
+    lo, hi = band_hz or DEFAULT_BAND_HZ
+    return float(lo), float(hi) if hi else 0.45 * fs
+
 #: solver tolerance of every scene a comparison simulates (candidates, identification grid) unless the
 #: case's ``[scene] set`` gives ``solver.rtol``.  Measured on a stand-in of paper O1 (H = B/3): at the
 #: defect auto rule's rtol 1e-4 the true candidate's score differs from a converged one (dp54, rtol 1e-8,
@@ -139,8 +146,7 @@ def setting_for(prep, path, background, *, level_weight=None, band_hz=None, seed
     if path.status == "failed":
         raise ValidationCaseError(f"validation case {prep.case.name!r}: the structural path failed "
                                   f"({'; '.join(path.problems)}); a geometry cannot be compared through it")
-    lo, hi = band_hz or DEFAULT_BAND_HZ
-    band = (float(lo), float(hi) if hi else 0.45 * prep.fs)
+    band = comparison_band(prep.fs, band_hz)
     x = prep.recording.segment(prep.n)
     times = impact_times(x, prep.fs, period, band=band)
     try:

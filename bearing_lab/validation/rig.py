@@ -78,10 +78,10 @@ def _gain_on_signature(case, path, rec, measured, sim_x, period):
     recording's own background, then peaks where the recording's does.  The fitted ``gain`` (matched to the
     impact peaks, for the validation's waveform quantities) is left as it is."""
     from ..analysis.impacts import impact_times
-    from .candidates import DEFAULT_BAND_HZ
+    from .candidates import comparison_band
     from .signature import impact_signature
     fs = rec.fs
-    band = (DEFAULT_BAND_HZ[0], DEFAULT_BAND_HZ[1] or 0.45 * fs)
+    band = comparison_band(fs)
     seed = int(case.section("background").get("seed", 0))
     try:
         bg = _measured_background(case, rec, measured, None).synthesize(np.asarray(sim_x).size, seed=seed)
@@ -198,11 +198,10 @@ def _measured_background(case, rec, measured, reference):
         # no impact train diagnosed on its own: time the impacts at the declared defect's fault line,
         # as the comparison does; measured over the whole record the background would hold the impacts
         from ..analysis.impacts import impact_times
-        from .candidates import DEFAULT_BAND_HZ, impact_period
+        from .candidates import comparison_band, impact_period
         period, note = impact_period(case, measured)
         if np.isfinite(period):
-            lo, hi = DEFAULT_BAND_HZ
-            times = impact_times(rec.x, rec.fs, period, band=(lo, hi or 0.45 * rec.fs))
+            times = impact_times(rec.x, rec.fs, period, band=comparison_band(rec.fs))
             where = f"between impacts ({note})"
     rates = [measured[k] for k in ("bpfo", "bpfi") if np.isfinite(measured[k])]
     if times is None or len(times) < 3:
