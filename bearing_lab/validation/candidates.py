@@ -73,6 +73,12 @@ class Setting:
     noise_db: float                     # misfit of the recording's two halves of impacts
     seed: int = 0
     notes: list = field(default_factory=list)
+    residual_db: object = None          # the path's shape residual (calibration recording), or None
+
+    def score(self, sig) -> dict:
+        """Misfit of a candidate's signature against the recording's, as every comparison scores it."""
+        return misfit(sig, self.measured, level_weight=self.level_weight, level_tolerance_db=self.level_tolerance_db,
+                      residual_db=self.residual_db)
 
 
 def _level_weight(prep, path, level_weight):
@@ -163,8 +169,25 @@ def setting_for(prep, path, background, *, level_weight=None, band_hz=None, seed
     if tol > 0:
         notes.append(f"a level within ±{tol:.3f} dB costs nothing: {LEVEL_K:g} × the standard uncertainty of the "
                      "path's gain")
+    residual, note = _path_residual(prep, path, meas)
+    notes += [note] if note else []
     return Setting(prep, path, background, period, band, meas, w, why, tol,
-                   _halves_noise(x, prep.fs, times, band), seed, notes)
+                   _halves_noise(x, prep.fs, times, band), seed, notes, residual)
+
+
+def _path_residual(prep, path, meas) -> tuple:
+    """The path's shape residual to remove (see :mod:`.signature`) and a note: only for a path identified on
+    another recording (a calibration of the rig), at this recording's sampling rate and window."""
+    from .recording_parts import context
+    r = path.fit.get("signature_residual_db")
+    if r is None or context(prep.case, prep, path)["path_fitted_here"]:
+        return None, ""
+    r = np.asarray(r, float)
+    if abs(float(path.fit.get("signature_residual_fs_hz", 0.0)) - prep.fs) > 1e-6 * prep.fs or r.shape != meas.envelope.shape:
+        return None, (f"the path's shape residual was measured at {path.fit.get('signature_residual_fs_hz', 0.0):g} Hz, "
+                      f"this recording is at {prep.fs:g} Hz: not removed")
+    return r, (f"the path's shape residual ({float(np.sqrt(np.mean(r * r))):.2f} dB RMS, measured on the recording the "
+               "path was identified on, against its declared scene) is removed from every candidate's shape misfit")
 
 
 def candidate_signature(setting: Setting, x):
@@ -191,5 +214,5 @@ def score_candidates(prep, path, background, candidates: dict, *, level_weight=N
         scene = simulation.build_scene(prep.case, rpm=prep.speed.rpm, fs=prep.fs, duration=prep.n / prep.fs,
                                        overrides={**comparison_overrides(prep.case), **ov})
         sig = candidate_signature(st, simulation.signal(simulation.run(scene)))
-        out[label] = misfit(sig, st.measured, level_weight=st.level_weight, level_tolerance_db=st.level_tolerance_db)
+        out[label] = st.score(sig)
     return dict(sorted(out.items(), key=lambda kv: kv[1]["score_db"]))

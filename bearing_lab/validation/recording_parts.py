@@ -130,6 +130,10 @@ def _path_table(path) -> list:
                   "value": f"{f['n_impacts_recording']} / {f['n_impacts_simulation']}"}]
         rows += [{"parameter": f"search bounds: {k}", "value": f"{v[0]:.4g} to {v[1]:.4g}"}
                  for k, v in f["bounds"].items()]
+        if "signature_residual_rms_db" in f:
+            rows.append({"parameter": "shape residual of the impact signature, RMS (dB; removed when another "
+                                      "recording is compared through this path)",
+                         "value": f["signature_residual_rms_db"]})
     return rows
 
 

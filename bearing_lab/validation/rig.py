@@ -99,11 +99,28 @@ def _gain_on_signature(case, path, rec, measured, sim_x, period):
         return
     path.fit["signature_gain"] = trial.gain
     path.fit["signature_gain_sigma_db"] = sigma
+    _shape_residual(path, trial, x, bg, rec, fs, period, band)
     path.fit.setdefault("notes", []).append(
         f"impact-signature comparisons read the path with gain {trial.gain:.4g} ({20 * math.log10(trial.gain / path.gain):+.2f} dB "
         f"from the fitted {path.gain:.4g}): the declared scene's signature ({band[0]:g}-{band[1]:g} Hz, path + "
         f"background) then peaks where the recording's does; standard uncertainty {sigma:.3f} dB (4 interleaved "
         "subsets of the impacts)")
+
+
+def _shape_residual(path, trial, x, bg, rec, fs, period, band):
+    """The path's shape residual (``fit["signature_residual_db"]``, on the recording signature's time axis,
+    and its RMS ``fit["signature_residual_rms_db"]``): how the declared scene's impact signature through the
+    path differs in shape from the recording's.  Comparisons of *other* recordings through this path add it
+    to their recording's log-envelope (see :mod:`bearing_lab.validation.signature`)."""
+    from ..analysis.impacts import impact_times
+    from .signature import impact_signature, shape_residual
+    y = trial.apply(x, fs) + bg
+    sim = impact_signature(y, fs, impact_times(y, fs, period, band=band), band=band)
+    meas = impact_signature(rec.x, fs, impact_times(rec.x, fs, period, band=band), band=band)
+    r = shape_residual(sim, meas)
+    path.fit["signature_residual_db"] = [float(v) for v in r]
+    path.fit["signature_residual_fs_hz"] = float(fs)
+    path.fit["signature_residual_rms_db"] = float(np.sqrt(np.mean(r * r)))
 
 
 def _subsets_db(x, fs, times, band, groups=4):

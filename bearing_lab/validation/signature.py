@@ -28,11 +28,22 @@ Score (documented in docs/identification.md):
 Below a floor (``floor`` × the recording signature's peak) both envelopes are clipped, so
 the noise floor between events does not dominate the log difference.
 
+The path's shape residual (``residual_db``): the model's structural path is not the rig's (one
+resonance for several, a damping that fits the pooled impacts), so even the right geometry
+leaves a shape residual, and a wrong geometry whose shape happens to lean the same way can
+score as well as the right one.  When the path was identified on a *calibration* recording of
+the rig (a known defect), the residual of that recording's known scene is the path's own: it
+is measured there once (:func:`shape_residual`), and a comparison through the same path adds
+it to the recording's log-envelope (the recording as the model's path would render it) before
+the difference is taken.  It is never measured on the compared recording itself: that would
+make its declared geometry fit by construction.
+
 Public API
 ----------
 Signature                                       -- time (s, relative to the impact), envelope (m s-2), n_impacts
 impact_signature(x, fs, times, *, band, window_s=(-0.002, 0.006)) -> Signature
-misfit(sim, meas, *, level_weight=1.0, level_tolerance_db=0.0, floor=0.05, max_lag_s=0.001) -> dict
+misfit(sim, meas, *, level_weight=1.0, level_tolerance_db=0.0, floor=0.05, max_lag_s=0.001, residual_db=None) -> dict
+shape_residual(sim, meas, *, floor=0.05, max_lag_s=0.001) -> ndarray   -- the model's log-envelope residual, meas's frame
 """
 from __future__ import annotations
 
@@ -42,7 +53,7 @@ import numpy as np
 
 from ..errors import AnalysisError
 
-__all__ = ["Signature", "impact_signature", "misfit", "WINDOW_S"]
+__all__ = ["Signature", "impact_signature", "misfit", "shape_residual", "WINDOW_S"]
 
 #: default window around an impact, s: 2 ms before (the entry may precede the strongest
 #: strike by the event's duration) and 6 ms after (the ring-down of a housing mode)
@@ -111,25 +122,60 @@ def impact_signature(x, fs, times, *, band, window_s=WINDOW_S) -> Signature:
     return Signature(t, mean, int(rows.shape[0]), (float(band[0]), float(band[1])))
 
 
-def misfit(sim: Signature, meas: Signature, *, level_weight=1.0, level_tolerance_db=0.0, floor=0.05,
-           max_lag_s=0.001) -> dict:
-    """Misfit of a simulated signature against the measured one (see the module docstring), dB."""
+def _logs(sim, meas, floor):
     if sim.time.size != meas.time.size:
         raise AnalysisError("impact signature misfit: the two signatures have different windows")
-    fs = 1.0 / float(sim.time[1] - sim.time[0])
-    level = 20.0 * np.log10(max(sim.peak, 1e-300) / max(meas.peak, 1e-300))
     a = np.maximum(sim.envelope / max(sim.peak, 1e-300), floor)
     b = np.maximum(meas.envelope / max(meas.peak, 1e-300), floor)
-    la, lb = 20 * np.log10(a), 20 * np.log10(b)
-    m = int(round(max_lag_s * fs))
+    return 20 * np.log10(a), 20 * np.log10(b)
+
+
+def _shifted(la, lb, s):
+    """``la`` moved by ``s`` samples against ``lb``: (the overlapping part of la, its index range in lb)."""
+    if s >= 0:
+        return la[s:], slice(0, lb.size - s)
+    return la[: la.size + s], slice(-s, lb.size)
+
+
+def _best_lag(la, lb, m):
     best, lag = np.inf, 0
     for s in range(-m, m + 1):
-        if s >= 0:
-            d = la[s:] - lb[: lb.size - s]
-        else:
-            d = la[: la.size + s] - lb[-s:]
+        a, sl = _shifted(la, lb, s)
+        d = a - lb[sl]
         v = float(np.sqrt(np.mean(d * d)))
         if v < best:
             best, lag = v, s
+    return best, lag
+
+
+def shape_residual(sim: Signature, meas: Signature, *, floor=0.05, max_lag_s=0.001) -> np.ndarray:
+    """The simulated signature's log-envelope (each normalised to its peak) minus the measured one's, dB,
+    at the lag that minimises it, on the measured signature's time axis (0 where the two do not overlap)."""
+    la, lb = _logs(sim, meas, floor)
+    fs = 1.0 / float(sim.time[1] - sim.time[0])
+    _, lag = _best_lag(la, lb, int(round(max_lag_s * fs)))
+    a, sl = _shifted(la, lb, lag)
+    r = np.zeros_like(lb)
+    r[sl] = a - lb[sl]
+    return r
+
+
+def misfit(sim: Signature, meas: Signature, *, level_weight=1.0, level_tolerance_db=0.0, floor=0.05,
+           max_lag_s=0.001, residual_db=None) -> dict:
+    """Misfit of a simulated signature against the measured one (see the module docstring), dB.
+
+    ``residual_db``: the path's shape residual on ``meas``'s time axis (:func:`shape_residual` of a
+    calibration recording), added to the measured log-envelope before the difference; None: none.
+    """
+    la, lb = _logs(sim, meas, floor)
+    if residual_db is not None:
+        r = np.asarray(residual_db, float)
+        if r.shape != lb.shape:
+            raise AnalysisError(f"impact signature misfit: the path's shape residual has {r.size} samples, the "
+                                f"signature {lb.size}")
+        lb = lb + r
+    fs = 1.0 / float(sim.time[1] - sim.time[0])
+    level = 20.0 * np.log10(max(sim.peak, 1e-300) / max(meas.peak, 1e-300))
+    best, lag = _best_lag(la, lb, int(round(max_lag_s * fs)))
     score = float(best + level_weight * max(abs(level) - level_tolerance_db, 0.0))
     return {"score_db": score, "shape_db": best, "level_db": float(level), "lag_s": lag / fs}
