@@ -4,11 +4,14 @@ Method (docs/identification.md): the recording is prepared once, the rig's struc
 and background are obtained once and held fixed (:mod:`.rig`); a coarse grid of scenes over
 the defect's length, offset and skew is simulated with the sweep machinery (Dask or serial,
 finished scenes and contact tables cached on disk); every scene's impact signature is scored
-against the recording's (:mod:`.candidates`, :mod:`.signature`); a finer grid is then
-simulated around the best scene.  Each parameter gets a *profile* (the best score over the
-other parameters at each of its values) and an interval: the values whose profile lies within
-``threshold_db`` of the best.  A profile that never rises more than the threshold above its
-minimum is *flat*: that parameter is not identifiable from this recording.
+against the recording's (:mod:`.candidates`, :mod:`.signature`).  From the best coarse scene a
+simplex search follows the misfit's valleys (:func:`_minimise`); the score's roughness is probed
+there; each parameter's *profile* is then walked from the best value through the coarse values
+and half steps, minimising over the other parameters at each (:func:`_walk_profiles`) until a
+value lies more than ``threshold_db`` above the best; and a polish searches again from the
+profile points that explain the recording as well but lie apart from the best (:func:`_polish`).
+The interval of a parameter spans the accepted values up to the nearest excluded walked value on
+each side.  A parameter no walked value excludes is *flat*: not identifiable from this recording.
 
 Public API
 ----------
@@ -86,17 +89,122 @@ def default_grid(case) -> dict:
             "defect.skew_deg": [-60.0, -30.0, 0.0, 30.0, 60.0]}
 
 
-def _refined(grid, best) -> list:
-    """A cross of half the coarse steps around the best scene: each parameter moved alone to the
-    midpoints towards its grid neighbours (at most 2 scenes per parameter)."""
-    out = []
+#: the refinement stops at this many scenes, or when its simplex is smaller than REFINE_XTOL of the
+#: coarse step in every parameter and its scores differ by less than REFINE_FTOL_DB
+REFINE_MAX_SCENES = 40
+REFINE_XTOL = 1.0 / 16.0
+REFINE_FTOL_DB = 0.01
+
+
+def _coarse_steps(grid, best) -> dict:
+    """Per searched parameter: the coarse grid's spacing next to the scene ``best`` (the mean of the gaps
+    to the grid values on either side of it)."""
+    out = {}
     for k, vals in grid.items():
         v = sorted(vals)
-        i = v.index(best[k])
-        for j in (i - 1, i + 1):
-            if 0 <= j < len(v):
-                out.append({**{q: [best[q]] for q in grid}, k: [round((v[i] + v[j]) / 2, 4)]})
+        if len(v) < 2:
+            continue
+        i = int(np.argmin([abs(x - best[k]) for x in v]))
+        gaps = [v[j + 1] - v[j] for j in (i - 1, i) if 0 <= j < len(v) - 1]
+        out[k] = float(np.mean(gaps))
     return out
+
+
+def _minimise(grid, start, score, keys, max_scenes, first_step=0.5):
+    """Nelder-Mead simplex search (Nelder & Mead, Computer Journal 7, 1965; scipy's bounded
+    implementation) over the parameters ``keys`` from the scene ``start`` (the others held at its
+    values), inside the coarse grid's range, in units of the coarse step.  A simplex stretches along
+    a valley of the misfit that runs diagonally through the parameters (a longer defect further off
+    the centre meets the ball over a similar chord), which a search along one parameter at a time
+    cannot follow.  ``score(point) -> dB`` simulates one scene (or reads it back)."""
+    from scipy.optimize import minimize
+    steps = _coarse_steps(grid, start)
+    keys = [k for k in keys if k in steps]
+    if not keys:
+        return
+    x0 = np.array([start[k] for k in keys], float)
+    s = np.array([steps[k] for k in keys])
+    lo = np.array([min(grid[k]) for k in keys])
+    hi = np.array([max(grid[k]) for k in keys])
+    simplex = [np.zeros(len(keys))]
+    for i in range(len(keys)):      # first_step coarse steps along each parameter, into the searched range
+        e = np.zeros(len(keys))
+        e[i] = first_step if x0[i] + first_step * s[i] <= hi[i] else -first_step
+        simplex.append(e)
+
+    def f(z):
+        x = np.clip(x0 + z * s, lo, hi)
+        return score({**start, **{k: round(float(v), 4) for k, v in zip(keys, x)}})
+    minimize(f, np.zeros(len(keys)), method="Nelder-Mead", bounds=list(zip((lo - x0) / s, (hi - x0) / s)),
+             options={"initial_simplex": np.array(simplex), "xatol": REFINE_XTOL, "fatol": REFINE_FTOL_DB,
+                      "maxfev": max_scenes})
+
+
+#: a profile value is the best score over the other parameters found in at most this many scenes
+PROFILE_MAX_SCENES = 12
+
+
+def _walk_profiles(grid, best_point, score, best_score, thr, points, max_scenes=PROFILE_MAX_SCENES) -> dict:
+    """Profiles by optimisation: for each searched parameter, step from the best scene through its coarse
+    grid values and the midpoints between them, each way; at each value minimise the score over the *other* parameters
+    (:func:`_minimise` with a first step of a quarter of the coarse step, from the better of the best
+    scene's other values and the best scene already simulated at this value) and stop at the first value
+    whose minimum lies more than ``thr`` above the best (``best_score()``, which may fall while walking).
+    Returns {key: {value: profile score}}, the best scene's value included."""
+    prof = {}
+    for k, vals in grid.items():
+        v = sorted(vals)
+        if len(v) < 2:
+            continue
+        others = [q for q in grid if q != k]
+        prof[k] = {best_point[k]: best_point["score_db"]}
+        v = sorted(set(v) | {round((a + b) / 2, 4) for a, b in zip(v[:-1], v[1:])})   # and the half steps
+        for side in (-1, 1):
+            ahead = [x for x in v if (x - best_point[k]) * side > 1e-12]
+            for x in sorted(ahead, key=lambda x: abs(x - best_point[k])):
+                found = []
+
+                def f(point):
+                    val = score(point)
+                    found.append(val)
+                    return val
+                start = {**{q: best_point[q] for q in grid}, k: x}
+                here = [p for p in points if abs(p[k] - x) <= 1e-12]
+                if here and min(p["score_db"] for p in here) < f(start):
+                    start = {q: min(here, key=lambda p: p["score_db"])[q] for q in grid}
+                _minimise(grid, start, f, others, max_scenes - len(found), first_step=0.25)
+                prof[k][x] = min(found)
+                if prof[k][x] > best_score() + thr:
+                    break
+    return prof
+
+#: the polish: at most this many starts, each a simplex search of at most POLISH_MAX_SCENES scenes
+POLISH_STARTS = 2
+POLISH_MAX_SCENES = 30
+
+
+def _polish(grid, walked, points, score, thr):
+    """Search again, all parameters free and with a first step of an eighth of the coarse step, from the
+    best scene of every profile value within ``thr`` of the best that lies more than a quarter of a coarse
+    step (in some parameter) from the best scene and from the other starts (at most POLISH_STARTS, best
+    first): a narrow basin the first search stepped over is found from a start next to it.  Every scene a
+    polish reaches within the threshold accepts its values (see :func:`_profile`)."""
+    best = min(points, key=lambda p: p["score_db"])
+    steps = _coarse_steps(grid, best)
+
+    def apart(a, b):
+        return any(abs(a[k] - b[k]) > 0.25 * steps[k] for k in steps)
+    cands = []
+    for k, prof in walked.items():
+        for v, sc in prof.items():
+            if sc <= best["score_db"] + thr:
+                cands.append(min((p for p in points if abs(p[k] - v) <= 1e-12), key=lambda p: p["score_db"]))
+    starts = []
+    for q in sorted(cands, key=lambda p: p["score_db"]):
+        if apart(q, best) and all(apart(q, o) for o in starts):
+            starts.append(q)
+    for q in starts[:POLISH_STARTS]:
+        _minimise(grid, {j: q[j] for j in grid}, score, list(grid), POLISH_MAX_SCENES, first_step=0.125)
 
 
 #: the roughness probe moves each parameter by this fraction of its coarse grid step
@@ -127,7 +235,6 @@ def _run_grid(setting, base, grid, *, scheduler, cache_dir, bar, out, keep):
     import itertools
     from ..sweeps import sweep
     from .candidates import candidate_signature
-    from .signature import misfit
     keys = list(grid)
     first, rest = keys[0], keys[1:]
     done = {tuple(p[k] for k in keys) for p in out}
@@ -144,8 +251,7 @@ def _run_grid(setting, base, grid, *, scheduler, cache_dir, bar, out, keep):
             sel = {ds_dim(first): v, **{ds_dim(k): x for k, x in zip(rest, c)}}
             x = np.asarray(ds[ch].sel(sel, method="nearest").values, float)
             sig = candidate_signature(setting, x)
-            m = misfit(sig, setting.measured, level_weight=setting.level_weight,
-                       level_tolerance_db=setting.level_tolerance_db)
+            m = setting.score(sig)
             out.append({first: v, **dict(zip(rest, c)), **m})
             if m["score_db"] < keep.get("score_db", np.inf):
                 keep.update(score_db=m["score_db"], signature=sig)
@@ -158,30 +264,51 @@ def ds_dim(key):
     return dim_name(key)
 
 
-def _profile(points, key, threshold):
-    vals = sorted({p[key] for p in points})
-    prof = [min(p["score_db"] for p in points if p[key] == v) for v in vals]
-    best_i = int(np.argmin(prof))
-    ok = [i for i, s in enumerate(prof) if s <= prof[best_i] + threshold]
-    flat = max(prof) - min(prof) <= threshold
+def _profile(points, key, threshold, walked=None, span=None):
+    """A parameter's profile, interval and statement.
+
+    Without ``walked``: the profile is the best score among ``points`` at each searched value (the coarse
+    grid's). With ``walked`` ({value: score minimised over the other parameters}, :func:`_walk_profiles`):
+    only those values can be *excluded* (more than ``threshold`` above the best); any simulated scene within
+    the threshold *accepts* its value (a geometry that explains the recording that well is an answer,
+    whatever the others score).  The interval runs from the nearest excluded value below the accepted ones
+    to the nearest above (the profile is known at those values only), or to the end of ``span``.
+    """
+    best = min(points, key=lambda p: p["score_db"])
+    top = best["score_db"] + threshold
+    if walked:
+        known = dict(walked)
+        for p in points:
+            if p["score_db"] <= top:
+                known[p[key]] = min(known.get(p[key], np.inf), p["score_db"])
+        decisive = set(walked)
+    else:
+        known = {}
+        for p in points:
+            known[p[key]] = min(known.get(p[key], np.inf), p["score_db"])
+        decisive = set(known)
+    vals = sorted(known)
+    span = span or (vals[0], vals[-1])
+    ok = [v for v in vals if known[v] <= top]
+    out = sorted(v for v in decisive if known[v] > top)
+    below, above = [v for v in out if v < min(ok)], [v for v in out if v > max(ok)]
+    lo, hi = (below[-1] if below else span[0]), (above[0] if above else span[1])
+    flat = not out
     name, unit = PARAMS[key]
-    # the profile is known at the sampled values only: a minimum between samples cannot be excluded
-    # up to the next sampled value on each side of the accepted ones
-    lo, hi = vals[max(min(ok) - 1, 0)], vals[min(max(ok) + 1, len(vals) - 1)]
+    change = max(known[v] for v in decisive) - best["score_db"]
     if len(vals) == 1:
         text = f"{name}: held at {vals[0]:g} {unit} (one value searched)"
     elif flat:
         text = (f"{name}: not identifiable from this recording (the misfit changes by at most "
-                f"{max(prof) - min(prof):.2f} dB over {vals[0]:g}-{vals[-1]:g} {unit}, within the {threshold:.2f} dB "
-                "threshold)")
+                f"{change:.2f} dB over {span[0]:g}-{span[1]:g} {unit}, within the {threshold:.2f} dB threshold)")
     else:
-        edge = [s for s, hit in (("lower", min(ok) == 0), ("upper", max(ok) == len(vals) - 1)) if hit]
-        text = (f"{name}: {vals[best_i]:g} {unit}, interval {lo:g}-{hi:g} {unit}"
+        edge = [s for s, hit in (("lower", not below), ("upper", not above)) if hit]
+        text = (f"{name}: {best[key]:g} {unit}, interval {lo:g}-{hi:g} {unit}"
                 + (f" (reaches the {' and '.join(edge)} end of the searched range: the interval may extend beyond it)"
                    if edge else ""))
-    return {"best": vals[best_i], "interval": [lo, hi], "identifiable": not flat, "searched": len(vals) > 1,
-            "statement": text,
-            "unit": unit, "profile": [[v, s] for v, s in zip(vals, prof)]}
+    return {"best": best[key], "interval": [lo, hi], "identifiable": not flat, "searched": len(vals) > 1,
+            "statement": text, "unit": unit, "profile": [[v, known[v]] for v in vals],
+            "optimised": sorted(walked) if walked else []}
 
 
 def identify(case, *, grid=None, refine=True, scheduler="serial", n_workers=None, cache_dir=False,
@@ -196,9 +323,10 @@ def identify(case, *, grid=None, refine=True, scheduler="serial", n_workers=None
         Coarse grid (default :func:`default_grid`); keys among ``defect.length_mm``, ``defect.offset_mm``,
         ``defect.skew_deg``, ``defect.depth_mm``.
     refine : bool
-        Simulate a grid of half the coarse steps around the best coarse scene, then probe the score's
-        roughness there (each parameter moved by 1 % of its grid step); the interval threshold is at
-        least twice that roughness.
+        After the coarse grid: a simplex search from its best scene, the roughness probe there (each
+        parameter moved by 1 % of its grid step; the interval threshold is at least twice the score change),
+        profiles walked by minimisation, and the polish (see the module docstring).  False: the coarse grid's
+        scores alone (profiles are then upper bounds at the grid values).
     scheduler, n_workers, cache_dir : as :func:`bearing_lab.sweeps.sweep` (default serial, in process; no sweep
         cache: it keeps every simulated variable, about 3.6 MB per scene of 1 s at 20 kHz; the contact tables
         are cached regardless).
@@ -232,7 +360,7 @@ def identify(case, *, grid=None, refine=True, scheduler="serial", n_workers=None
     base = simulation.build_scene(case, rpm=prep.speed.rpm, fs=prep.fs, duration=prep.n / prep.fs,
                                   overrides=comparison_overrides(case))
     n_coarse = int(np.prod([len(v) for v in grid.values()]))
-    n_total = n_coarse + (4 * len(grid) if refine else 0)
+    n_total = n_coarse + ((REFINE_MAX_SCENES + 2 * len(grid)) * (1 + len(grid)) if refine else 0)   # an estimate
     client, close = _client(scheduler, n_workers)
     bar = None
     if progress:
@@ -240,13 +368,22 @@ def identify(case, *, grid=None, refine=True, scheduler="serial", n_workers=None
         bar = tqdm(total=n_total, unit="scene", desc=f"identify {case.name}", leave=False)
     points: list = []
     keep: dict = {}
+    walked = None
     try:
         _run_grid(st, base, grid, scheduler=client, cache_dir=cache_dir, bar=bar, out=points, keep=keep)
         best = min(points, key=lambda p: p["score_db"])
         roughness = None
         if refine:
-            for fine in _refined(grid, best):
-                _run_grid(st, base, fine, scheduler="serial", cache_dir=cache_dir, bar=bar, out=points, keep=keep)
+            def score(point):
+                full = {k: point[k] for k in grid}
+                key = tuple(full[k] for k in grid)
+                if key not in seen:
+                    _run_grid(st, base, {k: [full[k]] for k in grid}, scheduler="serial", cache_dir=cache_dir,
+                              bar=bar, out=points, keep=keep)
+                    seen[key] = points[-1]["score_db"]
+                return seen[key]
+            seen = {tuple(p[k] for k in grid): p["score_db"] for p in points}
+            _minimise(grid, {k: best[k] for k in grid}, score, list(grid), REFINE_MAX_SCENES)
             best = min(points, key=lambda p: p["score_db"])
             n_before = len(points)
             for probe in _probes(grid, best):
@@ -255,12 +392,15 @@ def identify(case, *, grid=None, refine=True, scheduler="serial", n_workers=None
                 roughness = max(abs(p["score_db"] - best["score_db"]) for p in points[n_before:])
                 if threshold_db is None:     # the best and any other scene each move by up to it
                     thr = max(thr, 2 * roughness)
+            seen.update({tuple(p[k] for k in grid): p["score_db"] for p in points})
+            walked = _walk_profiles(grid, best, score, lambda: min(p["score_db"] for p in points), thr, points)
+            _polish(grid, walked, points, score, thr)
     finally:
         if bar is not None:
             bar.close()
         if close:
             client.close()
-    return _result(case, st, points, grid, thr, declared, t_cpu, t_wall, keep["signature"], roughness)
+    return _result(case, st, points, grid, thr, declared, t_cpu, t_wall, keep["signature"], roughness, walked)
 
 
 def _client(scheduler, n_workers):
@@ -272,9 +412,10 @@ def _client(scheduler, n_workers):
     return scheduler, False
 
 
-def _result(case, st, points, grid, thr, declared, t_cpu, t_wall, best_signature, roughness=None):
+def _result(case, st, points, grid, thr, declared, t_cpu, t_wall, best_signature, roughness=None, walked=None):
     best = min(points, key=lambda p: p["score_db"])
-    params = {k: _profile(points, k, thr) for k in grid}
+    walked = walked or {}
+    params = {k: _profile(points, k, thr, walked.get(k), (min(grid[k]), max(grid[k]))) for k in grid}
     notes = list(st.notes) + [f"amplitude weight {st.level_weight:g}: {st.level_reason}"]
     if roughness is not None:
         notes.append(f"score roughness {roughness:.2f} dB: moving one parameter of the best scene by "

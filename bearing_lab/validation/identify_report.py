@@ -78,16 +78,20 @@ def figures(result) -> list:
     for ax, k in zip(axes, keys):
         p = result.parameters[k]
         v, s = np.array(p["profile"]).T
-        ax.plot(v, s, "o-", color="k", ms=3)
-        ax.axhline(min(s) + result.threshold_db, color="tab:red", lw=0.8, ls="--")
+        opt = np.isin(v, p.get("optimised") or v)
+        ax.plot(v[opt], s[opt], "o-", color="k", ms=3)
+        if not opt.all():
+            ax.plot(v[~opt], s[~opt], ".", color="0.55", ms=3)
+        ax.axhline(result.best["score_db"] + result.threshold_db, color="tab:red", lw=0.8, ls="--")
         ax.axvspan(*p["interval"], color="tab:red", alpha=0.12)
         from .identify import PARAMS
         ax.set_xlabel(f"{PARAMS[k][0]} ({p['unit']})")
         ax.set_title(("" if p["identifiable"] else "not identifiable: ") + f"best {p['best']:g}", fontsize=9)
     axes[0].set_ylabel("profile misfit (dB)")
-    out.append((fig2, f"Misfit profiles: the best score over the other parameters at each value (at a refinement "
-                      f"value: its single scene); dashed: best + {result.threshold_db:.2f} dB (the interval "
-                      f"threshold); shaded: the interval."))
+    out.append((fig2, f"Misfit profiles: black, the least score found by minimising over the other parameters at "
+                      f"each walked value (without the refinement: the best coarse scene at each grid value); grey, "
+                      f"other simulated scenes within the threshold; dashed: best + {result.threshold_db:.2f} dB (the "
+                      f"interval threshold); shaded: the interval."))
     return out
 
 

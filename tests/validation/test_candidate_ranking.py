@@ -14,7 +14,7 @@ from bearing_lab.validation.rig import background_for, identify_path, path_for
 
 from ._standins import SIZES, calibration, hidden
 
-pytestmark = pytest.mark.xdist_group("identification")
+pytestmark = pytest.mark.xdist_group("ranking")
 
 SCENES = [("paper-O1", 0.0, 0.0, 31), ("paper-O1", 1 / 3, 0.0, 21),
           ("paper-O2", 0.3, 30.0, 23), ("paper-O2", 1 / 6, 15.0, 34)]
@@ -111,3 +111,38 @@ def test_a_level_within_the_tolerance_costs_nothing_beyond_it_the_excess():
     assert misfit(sim, meas)["score_db"] == pytest.approx(0.5, abs=1e-9)
     assert misfit(sim, meas, level_tolerance_db=0.2)["score_db"] == pytest.approx(0.3, abs=1e-9)
     assert misfit(sim, meas, level_tolerance_db=0.6)["score_db"] == pytest.approx(0.0, abs=1e-9)
+
+
+def test_the_paths_shape_residual_separates_a_valley_geometry_from_the_truth(rig):
+    """A longer defect further off the centre (3.56 mm at H = 0.5 mm, θ = 31.3°) meets the ball over a
+    similar chord as the hidden 3 mm at 0.3 mm, 30°.  Against the recording its shape leans the way the
+    model's path departs from the rig's, so without the path's shape residual (measured on the calibration
+    recording) it scored as well as the truth (0.30 against 0.31 dB).  With the residual removed the truth
+    must win by more than the smallest identification threshold's half; break it: without it, it must not."""
+    d, calib = rig
+    case = load_case(hidden(d, "paper-O2", 0.3, 30.0, seed=23, calib=calib, name="valley", duration_s=0.5))
+    prep = prepare(case)
+    path = path_for(case, prep.recording, prep.measured["record"], prep.simulated["model"])
+    assert path.fit["signature_residual_rms_db"] > 0.1
+    bg = background_for(case, prep.recording, prep.measured["record"])
+    cands = {"valley": {"defect.length_mm": 3.56, "defect.offset_mm": 0.5, "defect.skew_deg": 31.3},
+             "true": {"defect.length_mm": 3.0, "defect.offset_mm": 0.3, "defect.skew_deg": 30.0}}
+    got = score_candidates(prep, path, bg, cands)
+    assert list(got)[0] == "true" and got["valley"]["score_db"] - got["true"]["score_db"] > 0.15, got
+    bare = path.fit.pop("signature_residual_db")
+    try:
+        without = score_candidates(prep, path, bg, cands)
+    finally:
+        path.fit["signature_residual_db"] = bare
+    assert abs(without["valley"]["score_db"] - without["true"]["score_db"]) < 0.1, without
+
+
+def test_the_shape_residual_is_never_taken_from_the_compared_recording(rig):
+    """On the recording the path was fitted on, the declared geometry would fit by construction."""
+    from bearing_lab.validation.candidates import setting_for
+    d, calib = rig
+    case = load_case(calib)
+    prep = prepare(case)
+    path = identify_path(case)
+    st = setting_for(prep, path, background_for(case, prep.recording, prep.measured["record"]))
+    assert path.fit["signature_residual_db"] and st.residual_db is None
