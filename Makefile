@@ -19,7 +19,7 @@ validate: install
 	$(VENV)/bin/bearing-lab validate -o reports
 
 test: install
-	$(PY) -m pytest -n 2 --dist loadgroup -q $(PYTEST_ARGS)
+	$(PY) -m pytest -n 2 --dist loadfile -q $(PYTEST_ARGS)
 
 bench: install
 	$(VENV)/bin/bearing-lab bench

@@ -11,14 +11,23 @@ import json
 import sys
 
 
+#: scenes the refinement typically adds, and CPU s per scene of a 1 s record (table cached, skewed table built);
+#: measured in docs/identification.md ("The search")
+REFINE_TYPICAL = (100, 250)
+SCENE_CPU_S = (0.3, 3.0)
+
+
 def register(subparsers):
     p = subparsers.add_parser(
         "identify", help="identify the defect's length, offset and skew from a case's recording",
         description=("Search simulated scenes around the case's declared defect (length 0.5-2x, offset 0-B/2, "
                      "skew -60..60 deg by default) for the one whose impact signature after the fixed structural "
                      "path and background matches the recording; report an interval per parameter, or that it "
-                     "is not identifiable.  The default grid is 140 scenes plus up to 6 refinements and 6 roughness probes (about 0.8 s CPU "
-                     "each for a 1 s record at 20 kHz, 0.2 s once the contact tables are cached)."))
+                     "is not identifiable.  The default grid is 140 scenes; the refinement (a simplex search from the best, "
+                     "a roughness probe, profiles minimised over the other parameters, a polish) adds about "
+                     f"{REFINE_TYPICAL[0]}-{REFINE_TYPICAL[1]} more.  A scene of a 1 s record at 20 kHz costs about "
+                     f"{SCENE_CPU_S[0]:g} s of CPU with its contact table cached, {SCENE_CPU_S[1]:g} s when a skewed "
+                     "outline's table has to be built."))
     p.add_argument("case", metavar="CASE", help="case TOML file (docs/case-format.md) with one [[defect]]")
     p.add_argument("-o", "--output", default="reports", metavar="DIR", help="output directory (default: reports)")
     p.add_argument("--length-mm", type=float, nargs="+", default=None, help="along-track lengths to search, mm")
@@ -26,7 +35,8 @@ def register(subparsers):
     p.add_argument("--skew-deg", type=float, nargs="+", default=None, help="skews θ to search, degrees")
     p.add_argument("--depth-mm", type=float, nargs="+", default=None,
                    help="depths to search, mm (default: not searched)")
-    p.add_argument("--no-refine", action="store_true", help="no refinement and no roughness probe around the best coarse scene")
+    p.add_argument("--no-refine", action="store_true",
+                   help="the coarse grid alone: no simplex search, roughness probe, minimised profiles or polish")
     p.add_argument("--workers", type=int, default=1,
                    help="Dask worker processes (default 1: in this process, no Dask; measured faster on a "
                         "shared 2-core machine, see docs/identification.md)")
@@ -59,12 +69,12 @@ def run(args) -> int:
     for v in grid.values():
         n *= len(v)
     if not args.json:
-        total = n + (0 if args.no_refine else 4 * len(grid))
+        lo, hi = (n, n) if args.no_refine else (n + REFINE_TYPICAL[0], n + REFINE_TYPICAL[1])
         sec = float(case.recording.duration_s)
         print(f"identify {case.name}: {n} scenes on the coarse grid"
-              + ("" if args.no_refine else f" + up to {2 * len(grid)} refinements and {2 * len(grid)} roughness probes")
-              + f" of {sec:g} s each: about {0.2 * total * sec:.0f}-{0.8 * total * sec:.0f} s of CPU (cached / "
-                "new contact tables; measured at 20 kHz)", file=sys.stderr)
+              + ("" if args.no_refine else f" + about {REFINE_TYPICAL[0]}-{REFINE_TYPICAL[1]} in the refinement")
+              + f" of {sec:g} s each: about {SCENE_CPU_S[0] * lo * sec:.0f}-{SCENE_CPU_S[1] * hi * sec:.0f} s of CPU "
+                "(cached / new contact tables; measured at 20 kHz)", file=sys.stderr)
     res = identify(case, grid=grid, refine=not args.no_refine, scheduler="serial" if args.workers <= 1 else "local",
                    n_workers=args.workers, progress=not args.no_progress, level_weight=args.amplitude_weight,
                    mirror=args.mirror, cache_dir=args.cache or False)

@@ -371,36 +371,44 @@ def identify(case, *, grid=None, refine=True, scheduler="serial", n_workers=None
     walked = None
     try:
         _run_grid(st, base, grid, scheduler=client, cache_dir=cache_dir, bar=bar, out=points, keep=keep)
-        best = min(points, key=lambda p: p["score_db"])
         roughness = None
         if refine:
-            def score(point):
-                full = {k: point[k] for k in grid}
-                key = tuple(full[k] for k in grid)
-                if key not in seen:
-                    _run_grid(st, base, {k: [full[k]] for k in grid}, scheduler="serial", cache_dir=cache_dir,
-                              bar=bar, out=points, keep=keep)
-                    seen[key] = points[-1]["score_db"]
-                return seen[key]
-            seen = {tuple(p[k] for k in grid): p["score_db"] for p in points}
-            _minimise(grid, {k: best[k] for k in grid}, score, list(grid), REFINE_MAX_SCENES)
-            best = min(points, key=lambda p: p["score_db"])
-            n_before = len(points)
-            for probe in _probes(grid, best):
-                _run_grid(st, base, probe, scheduler="serial", cache_dir=cache_dir, bar=bar, out=points, keep=keep)
-            if len(points) > n_before:
-                roughness = max(abs(p["score_db"] - best["score_db"]) for p in points[n_before:])
-                if threshold_db is None:     # the best and any other scene each move by up to it
-                    thr = max(thr, 2 * roughness)
-            seen.update({tuple(p[k] for k in grid): p["score_db"] for p in points})
-            walked = _walk_profiles(grid, best, score, lambda: min(p["score_db"] for p in points), thr, points)
-            _polish(grid, walked, points, score, thr)
+            run = dict(scheduler="serial", cache_dir=cache_dir, bar=bar, out=points, keep=keep)
+            roughness, thr, walked = _refinement(st, base, grid, points, run, thr, threshold_db is None)
     finally:
         if bar is not None:
             bar.close()
         if close:
             client.close()
     return _result(case, st, points, grid, thr, declared, t_cpu, t_wall, keep["signature"], roughness, walked)
+
+
+def _refinement(st, base, grid, points, run, thr, widen):
+    """The steps after the coarse grid (see the module docstring); returns (roughness, threshold, walked
+    profiles).  ``run``: keywords of :func:`_run_grid`; ``widen``: raise the threshold to twice the roughness."""
+    seen = {tuple(p[k] for k in grid): p["score_db"] for p in points}
+
+    def score(point):
+        key = tuple(point[k] for k in grid)
+        if key not in seen:
+            _run_grid(st, base, {k: [point[k]] for k in grid}, **run)
+            seen[key] = points[-1]["score_db"]
+        return seen[key]
+    best = min(points, key=lambda p: p["score_db"])
+    _minimise(grid, {k: best[k] for k in grid}, score, list(grid), REFINE_MAX_SCENES)
+    best = min(points, key=lambda p: p["score_db"])
+    n_before = len(points)
+    for probe in _probes(grid, best):
+        _run_grid(st, base, probe, **run)
+    roughness = None
+    if len(points) > n_before:
+        roughness = max(abs(p["score_db"] - best["score_db"]) for p in points[n_before:])
+        if widen:                   # the best and any other scene each move by up to it
+            thr = max(thr, 2 * roughness)
+    seen.update({tuple(p[k] for k in grid): p["score_db"] for p in points})
+    walked = _walk_profiles(grid, best, score, lambda: min(p["score_db"] for p in points), thr, points)
+    _polish(grid, walked, points, score, thr)
+    return roughness, thr, walked
 
 
 def _client(scheduler, n_workers):
