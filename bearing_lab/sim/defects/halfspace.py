@@ -362,15 +362,22 @@ def ratio_curve(defect: Defect, geom: RaceGeometry, delta: float, *, cells=TABLE
                 solved[k] = solved[group[0]]
 
     _refine(solve_round, solved, p_int, k_lo, k_hi, coarse_step, refine_tol)
+    s_nodes, ratio = _curve(solved, dy, defect)
+    info = {"intact_force_n": base["force"], "semi_axes_m": (base["a"], base["b"]),
+            "cells": grid.shape, "cell_m": (grid.dx, grid.dy), "aligned": grid.aligned, **stats}
+    return s_nodes, ratio, info
+
+
+def _curve(solved, step, defect):
+    """(positions m, shares) from the solved ball positions {k: (share, ...)} ``step`` apart, mirrored
+    about the defect centre when only one half was solved (:func:`_symmetry`)."""
     ks = np.array(sorted(solved))
-    s_nodes = ks * dy
+    s_nodes = ks * step
     ratio = np.array([solved[k][0] for k in ks])
     if _symmetry(defect) and ks[0] == 0:
         s_nodes = np.concatenate([-s_nodes[:0:-1], s_nodes])
         ratio = np.concatenate([ratio[:0:-1], ratio])
-    info = {"intact_force_n": base["force"], "semi_axes_m": (base["a"], base["b"]),
-            "cells": grid.shape, "cell_m": (grid.dx, grid.dy), "aligned": grid.aligned, **stats}
-    return s_nodes, ratio, info
+    return s_nodes, ratio
 
 
 def _refine(solve_round, solved, p_int, k_lo, k_hi, coarse_step, refine_tol):

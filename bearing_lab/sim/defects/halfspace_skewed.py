@@ -106,7 +106,7 @@ def ratio_curve_skewed(defect: Defect, geom: RaceGeometry, delta: float, *, cell
     """:func:`.halfspace.ratio_curve` for a rectangle inclined to the track: the same
     returns, computed on the defect-anchored rotated grid.  Ball positions are whole
     numbers of the track-aligned grid's along-track cells from the defect centre."""
-    from .halfspace import HalfSpace, _refine, _symmetry, e_star_of, intact_contact
+    from .halfspace import HalfSpace, _curve, _refine, _symmetry, e_star_of, intact_contact
     e_star = e_star_of() if e_star is None else e_star
     base = intact_contact(geom, delta, cells=cells, e_star=e_star, tol=min(tol, 1e-6))
     step = base["grid"].dy
@@ -148,12 +148,7 @@ def ratio_curve_skewed(defect: Defect, geom: RaceGeometry, delta: float, *, cell
                 solved[k] = (float(pd.sum()) / float(pi.sum()), (pd, pi))
 
     _refine(solve_round, solved, p_ref, k_lo, k_hi, coarse_step, refine_tol)
-    ks = np.array(sorted(solved))
-    s_nodes = ks * step
-    ratio = np.array([solved[k][0] for k in ks])
-    if _symmetry(defect) and ks[0] == 0:
-        s_nodes = np.concatenate([-s_nodes[:0:-1], s_nodes])
-        ratio = np.concatenate([ratio[:0:-1], ratio])
+    s_nodes, ratio = _curve(solved, step, defect)
     info = {"intact_force_n": base["force"], "semi_axes_m": (base["a"], base["b"]),
             "cells": (g.nu, g.nv), "cell_m": (g.du, g.dv), "aligned": True, "skewed": True,
             **stats}
