@@ -153,12 +153,12 @@ def _walk_profiles(grid, best_point, score, best_score, thr, points, max_scenes=
     Returns {key: {value: profile score}}, the best scene's value included."""
     prof = {}
     for k, vals in grid.items():
-        v = sorted(vals)
-        if len(v) < 2:
+        if len(vals) < 2:
             continue
+        v = sorted(vals)
+        v = sorted(set(v) | {round((a + b) / 2, 4) for a, b in zip(v[:-1], v[1:])})   # and the half steps
         others = [q for q in grid if q != k]
         prof[k] = {best_point[k]: best_point["score_db"]}
-        v = sorted(set(v) | {round((a + b) / 2, 4) for a, b in zip(v[:-1], v[1:])})   # and the half steps
         for side in (-1, 1):
             ahead = [x for x in v if (x - best_point[k]) * side > 1e-12]
             for x in sorted(ahead, key=lambda x: abs(x - best_point[k])):
@@ -177,6 +177,7 @@ def _walk_profiles(grid, best_point, score, best_score, thr, points, max_scenes=
                 if prof[k][x] > best_score() + thr:
                     break
     return prof
+
 
 #: the polish: at most this many starts, each a simplex search of at most POLISH_MAX_SCENES scenes
 POLISH_STARTS = 2
