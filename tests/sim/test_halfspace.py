@@ -108,6 +108,32 @@ def test_skewed_share_against_brute_force_boussinesq(skewed_table, s_ball):
     assert table == pytest.approx(naive, rel=0.005)
 
 
+@pytest.mark.parametrize("cells", [(32, 24), (16, 12)])
+def test_skewed_intact_force_read_from_its_offset_lattice(cells):
+    """The intact force on the rotated window, read from the 5 x 5 lattice of ball offsets,
+    against direct solves at 16 other offsets (each from scratch): within 0.3 of the force's spread over the
+    offsets (a single solve, m = 1, misses by about the spread itself), and the spread is
+    a real one (> 1e-4 of the force), so the check can tell."""
+    from bearing_lab.sim.defects import halfspace_skewed as hsk
+    from bearing_lab.sim.defects.halfspace import SOLVE_TOL, HalfSpace, e_star_of
+    geom = RaceGeometry.from_bearing(B6308, "outer")
+    d, delta = _skewed(30.0), 4.04e-6
+    g = hsk.skewed_grid(d, geom, delta, cells)
+    hs = HalfSpace(g.nu, g.nv, g.du, g.dv, e_star_of())
+    offsets = np.random.default_rng(1).random((17, 2))
+    direct = np.array([hs.solve(hsk._gap(geom, *hsk._track_coords(d.skew, g, fu, fv)), delta,
+                                tol=SOLVE_TOL)[0] for fu, fv in offsets])
+    p0, offsets, direct = direct[0], offsets[1:], direct[1:].sum(axis=(1, 2))
+    spread = np.ptp(direct) / direct.mean()
+    assert spread > 1e-4
+    err = {}
+    for m in (1, hsk.INTACT_LATTICE):
+        force = hsk.IntactForce(hs, geom, d.skew, g, delta, m, SOLVE_TOL, p0)
+        err[m] = np.abs([force(*o) for o in offsets] - direct).max() / direct.mean()
+    assert err[hsk.INTACT_LATTICE] < 0.3 * spread
+    assert err[1] > 0.5 * spread
+
+
 def test_share_follows_a_small_skew_change_in_proportion():
     """Turning the skewed defect by 0.1 deg moves the share curve by a tenth of what 1 deg
     moves it (within a factor 2), and a second 0.1 deg moves it by nearly the same amount
