@@ -10,6 +10,7 @@ Prints four tables (docs/validation.md, "Record 105: why the impulse rows fail",
 2. the impact peaks against the shaft angle (2.5-4 kHz band envelope, one peak a fault period, eight
    angle bins) of records 105 and 130 (whole records) and of the simulation after the path;
 3. the squared-envelope lines at f_r and BPFI +- f_r relative to the BPFI line (2.5-4 kHz band);
+   the kurtosis inside and outside the simulation's loaded part of the turn;
 4. how far the impulses stand above the detection threshold of the impulse duration, and the crossing
    level that leaves (the duration is measured at 10 % of the peak only where that is above the threshold).
 """
@@ -103,6 +104,11 @@ def detection_margin(x, period):
     return band, thr, float(np.median(imp.peak)), float(np.median(level)), float(np.mean(~imp.resolved))
 
 
+def _kurtosis(v):
+    v = v - v.mean()
+    return float(np.mean(v ** 4) / np.mean(v ** 2) ** 2)
+
+
 def _record(name):
     m = scipy.io.loadmat(os.path.join(MIRROR, "cwru", name))
     return m[next(k for k in m if k.endswith("_DE_time"))].ravel() * G
@@ -124,6 +130,15 @@ def signals(out: Path):
         f1, lo, hi = ses_lines(env, ORDER[fault])
         print(f"   {label}: {np.round(means, 2)} (max/min {means.max() / means.min():.1f}); "
               f"f_r {f1:.2f}, F - f_r {lo:.2f}, F + f_r {hi:.2f}")
+    print("\n   kurtosis and RMS inside the simulation's loaded shaft-angle bins (2-4 of 8) and outside, same samples "
+          "of both signals")
+    b = np.floor((np.arange(sim["path"].size) / FS * FR) % 1.0 * 8).astype(int)
+    for label in ("experiment", "path+background"):
+        x = sim[label]
+        ok = np.isfinite(x)
+        zone = ok & np.isin(b, [2, 3, 4])
+        print(f"   {label}: kurtosis all {_kurtosis(x[ok]):.1f}, inside {_kurtosis(x[zone]):.1f}; RMS inside "
+              f"{np.sqrt(np.mean(x[zone] ** 2)):.2f}, outside {np.sqrt(np.mean(x[ok & ~zone] ** 2)):.2f} m/s2")
     print("\n4. the impulse duration's detection: median impulse peak against the threshold (4 x median envelope), "
           "median crossing level, share of impulses under two samples")
     period = 1.0 / (ORDER["bpfi"] * FR)
