@@ -1,5 +1,6 @@
-"""The CWRU outer-race cases end to end on the real recordings: kinematics within 1 %, the rig's path identified
-once on record 130 and held fixed for 144 and 234, and the failures the model cannot avoid told apart."""
+"""The CWRU cases end to end on the real recordings: kinematics within 1 %, the rig's path identified once on
+record 130 and held fixed for 144, 234 and the inner-race record 105, and the failures the model cannot avoid told
+apart."""
 import json
 
 import numpy as np
@@ -10,11 +11,11 @@ pytestmark = [pytest.mark.data, pytest.mark.xdist_group("validation_cwru")]
 
 @pytest.fixture(scope="module")
 def cwru(datafile, tmp_path_factory):
-    for f in ("130_OR007@6_0.mat", "144_OR007@3_0.mat", "234_OR021@6_0.mat", "97_Normal_0.mat"):
+    for f in ("130_OR007@6_0.mat", "144_OR007@3_0.mat", "234_OR021@6_0.mat", "105_IR007_0.mat", "97_Normal_0.mat"):
         rec = datafile(f"cwru/{f}")
     from bearing_lab.validation import run_validation
     out = tmp_path_factory.mktemp("cwru")
-    outcomes, status = run_validation(["cwru-130", "cwru-144", "cwru-234"], out, progress=False,
+    outcomes, status = run_validation(["cwru-130", "cwru-144", "cwru-234", "cwru-105"], out, progress=False,
                                       mirror=str(rec.parents[1]))
     sums = {o.name: json.loads((out / o.name / "summary.json").read_text()) for o in outcomes}
     return out, outcomes, status, sums
@@ -29,9 +30,10 @@ def test_kinematics_within_1_percent_and_the_contract_files(cwru):
     assert status == 0 and {o.status for o in outcomes} <= {"pass", "fail"}
     for name, s in sums.items():
         rows = _rows(s)
-        for q in ("bpfo", "excitation_period"):
+        fault, lo, hi = ("bpfi", 161.0, 162.6) if name == "cwru-105" else ("bpfo", 107.0, 108.2)
+        for q in (fault, "excitation_period"):
             assert rows[q]["tolerance_pct"] == 1.0 and rows[q]["pass"], (name, rows[q])
-        assert 107.0 < rows["bpfo"]["experiment"] < 108.2
+        assert lo < rows[fault]["experiment"] < hi
         for r in s["rows"]:
             assert {"quantity", "simulation", "experiment", "difference_pct", "tolerance_pct", "pass"} <= set(r)
         assert "stored in the recording" in s["speed"]["source"]
@@ -44,7 +46,7 @@ def test_the_path_is_identified_once_on_130_and_held_fixed(cwru):
     p130 = sums["cwru-130"]["structural_path"]
     assert p130["status"] == "ok" and p130["fit"]["residual_db"] < p130["fit"]["initial_db"]
     assert 1000 <= p130["resonances"][0]["frequency_hz"] <= 5400
-    for name in ("cwru-144", "cwru-234"):
+    for name in ("cwru-144", "cwru-234", "cwru-105"):
         p = sums[name]["structural_path"]
         assert "cwru-130" in p["source"]
         assert p["resonances"] == p130["resonances"] and p["gain"] == p130["gain"]
@@ -91,19 +93,38 @@ def test_background_healthy_reference_and_report(cwru):
     assert 'href="cwru-144/index.html"' in index
 
 
-def _impact_peaks_by_shaft_angle(path, rpm, bins=8):
-    """Mean impact peak (2.5-4 kHz band envelope, one per BPFO period) in ``bins`` shaft-angle bins of a record."""
+BPFO_ORDER, BPFI_ORDER = 3.5848, 5.4152          # 6205 drive end: fault frequency / shaft frequency
+
+
+def _record(path):
     import scipy.io
-    import scipy.signal as ss
     m = scipy.io.loadmat(str(path))
-    x = m[next(k for k in m if k.endswith("_DE_time"))].ravel() * 9.80665
-    fs, fr = 12000.0, rpm / 60.0
+    return m[next(k for k in m if k.endswith("_DE_time"))].ravel() * 9.80665
+
+
+def _peaks_by_shaft_angle(x, rpm, order=BPFO_ORDER, bins=8, fs=12000.0):
+    """Mean impact peak (2.5-4 kHz band envelope, one per fault period) in ``bins`` shaft-angle bins, and the
+    squared-envelope line at the shaft frequency relative to the fault line."""
+    import scipy.signal as ss
+    x = np.asarray(x, float)
+    x = x[np.isfinite(x)]
+    fr = rpm / 60.0
     env = np.abs(ss.hilbert(ss.sosfiltfilt(ss.butter(4, [2500, 4000], "bandpass", fs=fs, output="sos"), x)))
-    per = fs / (3.5848 * fr)                                   # BPFO period in samples (6205 drive end)
+    per = fs / (order * fr)                                    # fault period in samples
     starts = (np.arange(int(x.size // per) - 1) * per).astype(int)
     idx = np.array([s + np.argmax(env[s:s + int(per)]) for s in starts])
     b = np.floor((idx / fs * fr) % 1.0 * bins).astype(int)
-    return np.array([env[idx][b == k].mean() for k in range(bins)])
+    e2 = env ** 2 - np.mean(env ** 2)
+    spec, f = np.abs(np.fft.rfft(e2 * np.hanning(e2.size))), np.fft.rfftfreq(e2.size, 1 / fs)
+
+    def line(f0):
+        return spec[(f > f0 - 1.0) & (f < f0 + 1.0)].max()
+    return np.array([env[idx][b == k].mean() for k in range(bins)]), line(fr) / line(order * fr)
+
+
+def _impact_peaks_by_shaft_angle(path, rpm, bins=8):
+    """Mean impact peak (2.5-4 kHz band envelope, one per BPFO period) in ``bins`` shaft-angle bins of a record."""
+    return _peaks_by_shaft_angle(_record(path), rpm, BPFO_ORDER, bins)[0]
 
 
 def test_the_021_pit_amplitudes_fail_as_a_known_limitation_whose_evidence_holds(cwru, datafile):
@@ -154,3 +175,45 @@ def test_the_130_kurtosis_fails_as_a_known_limitation_whose_evidence_holds(cwru)
     assert rms_rec > 2 * rms_sim and share_sim > share_rec + 0.05, (rms_rec, rms_sim, share_rec, share_sim)
     res = json.loads(ds.attrs["structural_path"])["resonances"]
     assert len(res) == 1 and 1.0 / (res[0]["damping_ratio"] * 2 * np.pi * res[0]["frequency_hz"]) < 0.002
+
+
+def _detection_margin(x, fs, period):
+    """Median impulse peak over the impulse detector's threshold (4 x the median envelope in the measured band)."""
+    from bearing_lab.analysis._impulse import DETECTION_FACTOR, impulses
+    from bearing_lab.analysis._spectral import bandpass, fast_kurtogram, squared_envelope
+    x = np.asarray(x, float)
+    x = x[np.isfinite(x)]
+    band = fast_kurtogram(x, fs, min_bandwidth=min(4 / period, 0.2 * fs)).band
+    y = bandpass(x, fs, band=band) if band is not None else x - x.mean()
+    thr = DETECTION_FACTOR * float(np.median(np.sqrt(squared_envelope(y, fs))))
+    return float(np.median(impulses(x, fs, band=band, min_separation=0.5 * period).peak)) / thr
+
+
+def test_the_inner_race_impulse_rows_fail_as_a_known_limitation_whose_evidence_holds(cwru, datafile):
+    """The stated reason: the model's inner-race pit is loaded over part of each shaft turn, the rig's over all of it."""
+    import xarray as xr
+    out, _, _, sums = cwru
+    s = sums["cwru-105"]
+    rows = _rows(s)
+    for q in ("shaft_hz", "bpfi", "excitation_period", "rms"):
+        assert rows[q]["pass"], rows[q]
+    for q in ("peak", "kurtosis", "impulse_strength", "impulse_duration"):
+        assert not rows[q]["pass"] and rows[q]["status"] == "known limitation", rows[q]
+    assert not s["unexplained_failures"]
+    # the same energy, packed into part of the turn: peak and kurtosis above the record's, the median impact below
+    assert rows["peak"]["simulation"] > 2 * rows["peak"]["experiment"]
+    assert rows["impulse_strength"]["simulation"] < 0.5 * rows["impulse_strength"]["experiment"]
+    # rig side, the whole record: impacts at every shaft angle (as record 130's pit, which stays in the load zone),
+    # a weak shaft line in the squared envelope
+    rec, shaft_rec = _peaks_by_shaft_angle(_record(datafile("cwru/105_IR007_0.mat")), 1796.0, BPFI_ORDER)
+    assert rec.max() / rec.min() < 3 and shaft_rec < 0.3, (rec, shaft_rec)
+    # model side, after the fixed path: impacts over part of the turn only, a shaft line as strong as the BPFI line
+    ds = xr.open_dataset(out / "cwru-105" / "comparison.nc")
+    fs = float(ds.attrs["sampling_rate_hz"])
+    sim, shaft_sim = _peaks_by_shaft_angle(ds["waveform"].sel(signal="path").values, 1796.0, BPFI_ORDER, fs=fs)
+    assert np.sum(sim < 0.1 * sim.max()) >= 3 and shaft_sim > 0.8, (sim, shaft_sim)
+    # the impulse duration: the record's impulses barely clear the detector's threshold, the model's clear it by far
+    period = 1.0 / float(ds.attrs["bpfi_hz"])
+    m_rec = _detection_margin(ds["waveform"].sel(signal="experiment").values, fs, period)
+    m_sim = _detection_margin(ds["waveform"].sel(signal="path+background").values, fs, period)
+    assert m_rec < 1.5 and m_sim > 3, (m_rec, m_sim)
