@@ -71,9 +71,11 @@ class RaceGeometry:
     @classmethod
     def from_bearing(cls, bearing, race: str, *, clearance: float = 0.0) -> "RaceGeometry":
         check_choice(race, ("outer", "inner"), "race", SceneError)
-        if not (math.isfinite(clearance) and clearance >= 0):
-            raise SceneError(f"clearance={clearance!r} m must be finite and not negative")
         db, dm = bearing.ball_diameter, bearing.pitch_diameter
+        # negative: a preload (the groove bottoms move towards the balls by |clearance| / 4)
+        if not (math.isfinite(clearance) and abs(clearance) < 0.1 * db):
+            raise SceneError(f"radial clearance {clearance * 1e6!r} µm: must be finite and smaller than a tenth "
+                             f"of the ball diameter ({0.1 * db * 1e6:.0f} µm)")
         if race == "outer":
             return cls("outer", db / 2, bearing.outer_conformity * db, dm / 2 + db / 2 + clearance / 4)
         return cls("inner", db / 2, bearing.inner_conformity * db, dm / 2 - db / 2 - clearance / 4)
