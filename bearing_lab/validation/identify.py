@@ -338,11 +338,7 @@ def identify(case, *, grid=None, refine=True, scheduler="serial", n_workers=None
         Interval threshold (default: max(3 × the recording's split-half misfit, 0.3 dB, twice the
         score's roughness at the best scene)).
     """
-    from . import load_case, simulation
-    from .candidates import comparison_overrides, setting_for
-    from .recording_case import prepare
-    from .rig import background_for, path_for
-    from .recording import open_spec
+    from . import load_case
     t_cpu, t_wall = time.process_time(), time.perf_counter()
     case = case if hasattr(case, "section") else load_case(case)
     declared = _declared(case)
@@ -351,15 +347,8 @@ def identify(case, *, grid=None, refine=True, scheduler="serial", n_workers=None
     if bad or not grid or any(not v for v in grid.values()):
         raise ValidationCaseError(f"identify: grid keys must be among {', '.join(PARAMS)} with at least one value "
                                   f"each; got {', '.join(bad) or 'an empty grid'}")
-    prep = prepare(case, mirror=mirror)
-    m = prep.measured["record"]
-    path = path_for(case, prep.recording, m, prep.simulated["model"], mirror=mirror)
-    reference = open_spec(case.reference, case.name, mirror) if case.reference is not None else None
-    bg = background_for(case, prep.recording, m, reference)
-    st = setting_for(prep, path, bg, level_weight=level_weight)
+    st, base = _setting(case, mirror, level_weight)
     thr = float(threshold_db) if threshold_db is not None else max(3 * st.noise_db, MIN_THRESHOLD_DB)
-    base = simulation.build_scene(case, rpm=prep.speed.rpm, fs=prep.fs, duration=prep.n / prep.fs,
-                                  overrides=comparison_overrides(case))
     n_coarse = int(np.prod([len(v) for v in grid.values()]))
     n_total = n_coarse + ((REFINE_MAX_SCENES + 2 * len(grid)) * (1 + len(grid)) if refine else 0)   # an estimate
     client, close = _client(scheduler, n_workers)
@@ -384,17 +373,42 @@ def identify(case, *, grid=None, refine=True, scheduler="serial", n_workers=None
     return _result(case, st, points, grid, thr, declared, t_cpu, t_wall, keep["signature"], roughness, walked)
 
 
+def _setting(case, mirror, level_weight):
+    """The comparison setting (recording's signature, fixed path, background, score) and the base scene
+    of a loaded case."""
+    from . import simulation
+    from .candidates import comparison_overrides, setting_for
+    from .recording import open_spec
+    from .recording_case import prepare
+    from .rig import background_for, path_for
+    prep = prepare(case, mirror=mirror)
+    m = prep.measured["record"]
+    path = path_for(case, prep.recording, m, prep.simulated["model"], mirror=mirror)
+    reference = open_spec(case.reference, case.name, mirror) if case.reference is not None else None
+    bg = background_for(case, prep.recording, m, reference)
+    st = setting_for(prep, path, bg, level_weight=level_weight)
+    base = simulation.build_scene(case, rpm=prep.speed.rpm, fs=prep.fs, duration=prep.n / prep.fs,
+                                  overrides=comparison_overrides(case))
+    return st, base
+
+
+def _scorer(st, base, grid, points, run):
+    """``score(point) -> dB``: simulates the scene ``point`` ({key: value} over ``grid``'s keys) and
+    appends it to ``points``, or reads back a scene already there."""
+    def score(point):
+        key = tuple(point[k] for k in grid)
+        found = [p for p in points if tuple(p[k] for k in grid) == key]
+        if not found:
+            _run_grid(st, base, {k: [point[k]] for k in grid}, **run)
+            found = points[-1:]
+        return found[0]["score_db"]
+    return score
+
+
 def _refinement(st, base, grid, points, run, thr, widen):
     """The steps after the coarse grid (see the module docstring); returns (roughness, threshold, walked
     profiles).  ``run``: keywords of :func:`_run_grid`; ``widen``: raise the threshold to twice the roughness."""
-    seen = {tuple(p[k] for k in grid): p["score_db"] for p in points}
-
-    def score(point):
-        key = tuple(point[k] for k in grid)
-        if key not in seen:
-            _run_grid(st, base, {k: [point[k]] for k in grid}, **run)
-            seen[key] = points[-1]["score_db"]
-        return seen[key]
+    score = _scorer(st, base, grid, points, run)
     best = min(points, key=lambda p: p["score_db"])
     _minimise(grid, {k: best[k] for k in grid}, score, list(grid), REFINE_MAX_SCENES)
     best = min(points, key=lambda p: p["score_db"])
@@ -406,7 +420,6 @@ def _refinement(st, base, grid, points, run, thr, widen):
         roughness = max(abs(p["score_db"] - best["score_db"]) for p in points[n_before:])
         if widen:                   # the best and any other scene each move by up to it
             thr = max(thr, 2 * roughness)
-    seen.update({tuple(p[k] for k in grid): p["score_db"] for p in points})
     walked = _walk_profiles(grid, best, score, lambda: min(p["score_db"] for p in points), thr, points)
     _polish(grid, walked, points, score, thr)
     return roughness, thr, walked
