@@ -11,11 +11,11 @@ import json
 import sys
 
 
-#: scenes the refinement typically adds (210 and 236 on the stand-ins), and CPU s per scene of a 1 s record (table
-#: cached, skewed table built: the README walkthrough, 40 s and 1027 s for 376 scenes);
+#: scenes the refinement typically adds (210 and 244 on the stand-ins), and CPU s per scene of a 1 s record (table
+#: cached, skewed table built: the README walkthrough, 37 s and 742 s for 384 scenes);
 #: measured in docs/identification.md ("The search")
 REFINE_TYPICAL = (100, 250)
-SCENE_CPU_S = (0.1, 2.7)
+SCENE_CPU_S = (0.1, 1.9)
 
 
 def register(subparsers):
