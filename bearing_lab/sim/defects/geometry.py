@@ -74,8 +74,8 @@ class RaceGeometry:
         db, dm = bearing.ball_diameter, bearing.pitch_diameter
         # negative: a preload (the groove bottoms move towards the balls by |clearance| / 4)
         if not (math.isfinite(clearance) and abs(clearance) < 0.1 * db):
-            raise SceneError(f"radial clearance {clearance * 1e6!r} µm: must be finite and smaller than a tenth "
-                             f"of the ball diameter ({0.1 * db * 1e6:.0f} µm)")
+            raise SceneError(f"radial clearance {clearance * 1e6:g} µm: must be finite and within ± a tenth of "
+                             f"the ball diameter (±{0.1 * db * 1e6:.0f} µm; negative is a preload)")
         if race == "outer":
             return cls("outer", db / 2, bearing.outer_conformity * db, dm / 2 + db / 2 + clearance / 4)
         return cls("inner", db / 2, bearing.inner_conformity * db, dm / 2 - db / 2 - clearance / 4)

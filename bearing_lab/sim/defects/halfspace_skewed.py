@@ -126,11 +126,11 @@ class IntactForce:
     The window's cells relative to the ball depend only on its offset (fu, fv) in [0, 1)^2
     (:func:`_anchor`), and a whole cell's shift gives the same contact, so the intact force
     is periodic in both.  It is solved on an m x m lattice of offsets (one batch, started
-    from the intact pressure ``p0`` at another offset) and read
-    between them by trigonometric interpolation, instead of one intact solve per ball
-    position (which doubled a table's solves).  On the tables' grids the force spreads by
-    0.04 % (fine) to 0.17 % (coarse) over the offsets; a 5 x 5 lattice reads it within
-    about a quarter of that."""
+    from the intact pressure ``p0`` at another offset) and read between them by
+    trigonometric interpolation, instead of one intact solve per ball position (which
+    doubled a table's solves).  On the tables' grids the force spreads by 0.03 % (fine) to
+    0.17 % (coarse) over the offsets; a 5 x 5 lattice reads it within about a quarter of
+    that."""
 
     def __init__(self, hs, geom: RaceGeometry, skew: float, g: SkewedGrid, delta: float,
                  m: int, tol: float, p0: np.ndarray):
@@ -146,8 +146,7 @@ class IntactForce:
     def __call__(self, fu: float, fv: float) -> float:
         eu = np.exp(2j * np.pi * self.k * fu)
         ev = np.exp(2j * np.pi * self.k * fv)
-        val = eu @ self.coef @ ev
-        return float(val.real)
+        return float((eu @ self.coef @ ev).real)
 
 
 def ratio_curve_skewed(defect: Defect, geom: RaceGeometry, delta: float, *, cells, e_star,
