@@ -96,7 +96,11 @@ def measure(x, fs, *, bearing, rpm=None, shaft_hz=None, fault=None, duration_lev
     dict
         The keys of :data:`MEASURED` (NaN where the signal shows nothing) and ``extras``:
         ``analysis`` (the :func:`bearing_lab.analysis.analyze` result), ``band``,
-        ``impact_times``, ``notes`` (why a value is NaN), ``fault``, ``shaft_hz_used``.
+        ``impact_times``, ``notes`` (why a value is NaN), ``fault``, ``shaft_hz_used``,
+        ``families`` (per BPFO/BPFI: ``detected``, the ``route`` that detected it, and
+        ``evidence_margin_db``, the best route's evidence above its decoy threshold: how far the
+        detection is from flipping).  BPFO and BPFI carry a value only where a route of the
+        analysis *detects* the family; the best line of a slip window alone is no measurement.
 
     Examples
     --------
@@ -119,11 +123,29 @@ def measure(x, fs, *, bearing, rpm=None, shaft_hz=None, fault=None, duration_lev
     out["shaft_hz"] = _num(fi)
     if fi is None:
         notes["shaft_hz"] = f"no shaft line in the amplitude spectrum (best candidate {snr:.1f} dB above the floor)"
+    routes = res.get("evidence", {}).get("routes", {})
+    first = res.get("evidence", {}).get("decided_by") or []
+    order = [r for r in [*first, res.get("evidence", {}).get("reported_route")] + sorted(routes) if r in routes]
+    families = {}
     for k in ("bpfo", "bpfi"):
-        out[k] = _num(ff[k]["measured_hz"])
-        if ff[k]["measured_hz"] is None:
-            notes[k] = (f"no {k.upper()} line family in the squared envelope spectrum "
-                        f"(expected {ff[k]['expected_hz']:.2f} Hz; best {ff[k]['snr_db']:.1f} dB)")
+        # a family's frequency only where a route of the analysis detects the family (noise rule and
+        # decoys): the best line of a slip window always exists in a dense spectrum, and comparing
+        # two such picks compares chance.  The routes that decided the diagnosis are asked first.
+        found = next(((r, routes[r]["families"][k]) for r in dict.fromkeys(order)
+                      if routes[r]["families"][k]["detected"] and not routes[r]["families"][k]["explained_by"]),
+                     None)
+        fk = ff[k]
+        margins = [f["evidence_db"] - f["decoy_threshold_db"] for f in (routes[r]["families"][k] for r in routes)
+                   if f.get("decoy_threshold_db") is not None]
+        families[k] = {"detected": found is not None, "route": None if found is None else found[0],
+                       "evidence_margin_db": max(margins) if margins else None}
+        out[k] = _num(found[1]["measured_hz"]) if found is not None else float("nan")
+        if found is None:
+            best = ("no line in the slip window" if fk["measured_hz"] is None else
+                    f"best candidate {fk['measured_hz']:.2f} Hz, {fk['snr_db']:.1f} dB, "
+                    f"{fk['harmonics']} harmonic(s)")
+            notes[k] = (f"no {k.upper()} line family in the squared envelope spectrum (expected "
+                        f"{fk['expected_hz']:.2f} Hz; {best}: below the detection rule)")
     key = fault or {"outer_race": "bpfo", "inner_race": "bpfi"}.get(res["diagnosis"])
     period = res["excitation_period_s"]
     if period is None and key is not None and ff[key]["measured_hz"]:
@@ -139,6 +161,6 @@ def measure(x, fs, *, bearing, rpm=None, shaft_hz=None, fault=None, duration_lev
     else:
         out["impulse_strength"] = out["impulse_duration"] = float("nan")
         notes["impulse_strength"] = notes["impulse_duration"] = "no impact train"
-    out["extras"] = {"analysis": res, "band": band, "impact_times": times, "notes": notes,
+    out["extras"] = {"analysis": res, "band": band, "impact_times": times, "notes": notes, "families": families,
                      "fault": key, "shaft_hz_used": fr}
     return out

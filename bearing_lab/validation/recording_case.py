@@ -146,7 +146,8 @@ def evaluate_rows(tolerances: dict, exp: dict, sim: dict, *, context: dict, grou
         label = (f"{group}: " if group else "") + q.label + (f" ({context['ratio']['label']})" if q.ratio else "")
         rows.append(make_row((f"{group}: " if group else "") + key, s, e, tol, label=label, units=q.units,
                              note=note, signal=q.signal, span=context["span_text"][q.span],
-                             independent=independent, untrusted=untrusted))
+                             independent=independent, untrusted=untrusted,
+                             absence_agrees=key in ("bpfo", "bpfi")))
     return rows
 
 

@@ -2,7 +2,8 @@
 
 Why strict rules: a validation table is evidence only if each row can fail.  So a
 row with a missing or NaN value on either side fails (a quantity the model or the
-recording does not show is a disagreement to report, not an agreement), ratios are
+recording does not show is a disagreement to report, not an agreement; only for a
+fault line family, which either signal may rightly lack, do both sides lacking it agree), ratios are
 compared with a tolerance (never by their ordering alone), and a failing row says
 whether it is a known model limitation (with the reason given in the case) or not.
 
@@ -92,16 +93,22 @@ def row_status(row: dict) -> str:
 
 def make_row(quantity: str, simulation, experiment, tolerance: Tolerance, *, label, units, note="",
              reference_value=None, reference_label="", signal="", span="", independent=True,
-             paper_simulation=None, untrusted="") -> dict:
+             paper_simulation=None, untrusted="", absence_agrees=False) -> dict:
     """One table row: simulation, experiment, difference, % difference, tolerance, pass, status.
 
     ``untrusted`` (a reason) makes the row fail whatever its numbers: used when a number
-    depends on a structural-path fit that is degraded.
+    depends on a structural-path fit that is degraded.  ``absence_agrees``: the quantity is a
+    detection (a fault line family); when *neither* signal shows it the row passes as an agreement
+    on its absence (one side showing it and the other not still fails).
     """
     s, e = _f(simulation), _f(experiment)
     ok = tolerance.check(s, e)
     notes = [note] if note else []
-    if not (math.isfinite(s) and math.isfinite(e)):
+    both_absent = absence_agrees and not math.isfinite(s) and not math.isfinite(e)
+    if both_absent:
+        ok = True
+        notes.insert(0, "neither signal shows this line family: they agree on its absence")
+    elif not (math.isfinite(s) and math.isfinite(e)):
         missing = " and ".join(w for w, v in (("simulation", s), ("experiment", e)) if not math.isfinite(v))
         notes.insert(0, f"missing value ({missing}): counts as a failure")
     if untrusted:

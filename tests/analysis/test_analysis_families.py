@@ -131,3 +131,19 @@ def test_cage_comb_does_not_pass_for_a_ball_family():
     assert fams["ftf"]["detected"]
     assert not fams["bsf"]["detected"]
     assert v["verdict"] in ("uncertain", "none") and v["candidates"] in ([], ["ball"])
+
+
+def test_measure_names_a_family_frequency_only_where_the_family_is_detected():
+    """An outer-race impact train plus one lone envelope line near BPFI (a rig tone): the BPFI slip window
+    holds a line, but no family; measure() gives BPFO and no BPFI, and says what it saw instead."""
+    from bearing_lab.analysis.measurement import measure
+    fr = 29.95
+    ff = get_bearing("6205").fault_frequencies(fr)
+    x, fs = bearing_signal(ff["bpfo"], shaft_hz=fr, shaft_amp=0.3)
+    t = np.arange(x.size) / fs
+    x = x + 0.3 * (1 + np.cos(2 * np.pi * 0.997 * ff["bpfi"] * t)) * np.sin(2 * np.pi * 3000 * t)
+    m = measure(x, fs, bearing="6205", rpm=60 * fr, shaft_hz=fr)
+    assert abs(m["bpfo"] / ff["bpfo"] - 1) < 0.01
+    assert np.isnan(m["bpfi"]) and not m["extras"]["families"]["bpfi"]["detected"]
+    assert "below the detection rule" in m["extras"]["notes"]["bpfi"]
+    assert m["extras"]["families"]["bpfo"]["detected"] and m["extras"]["families"]["bpfo"]["evidence_margin_db"] > 0

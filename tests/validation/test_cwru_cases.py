@@ -41,6 +41,19 @@ def test_kinematics_within_1_percent_and_the_contract_files(cwru):
             assert (out / name / f).is_file()
 
 
+def test_outer_race_records_show_no_bpfi_family_on_either_side(cwru):
+    """The outer-race recordings hold a single rig line near BPFI, no family; the model shows none either: the
+    row agrees on the absence, on any machine (the line search names no frequency below its detection rule)."""
+    _, _, _, sums = cwru
+    for name in ("cwru-130", "cwru-144", "cwru-234"):
+        r = _rows(sums[name])["bpfi"]
+        assert r["simulation"] is None and r["experiment"] is None, (name, r)
+        assert r["pass"] and "absence" in r["note"] and "below the detection rule" in r["note"]
+    # the inner-race record shows the family on both sides, within the kinematic 1 %
+    r = _rows(sums["cwru-105"])["bpfi"]
+    assert r["pass"] and r["simulation"] is not None and r["experiment"] is not None
+
+
 def test_the_path_is_identified_once_on_130_and_held_fixed(cwru):
     _, _, _, sums = cwru
     p130 = sums["cwru-130"]["structural_path"]

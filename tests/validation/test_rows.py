@@ -36,6 +36,16 @@ def test_a_missing_value_is_a_failure_on_either_side_or_both():
     assert _row(100.5, 100.0)["pass"]
 
 
+def test_a_line_family_absent_from_both_signals_agrees_and_absent_from_one_fails():
+    tol = QUANTITIES["bpfi"].tolerance
+    both = make_row("bpfi", NAN, NAN, tol, label="BPFI", units="Hz", absence_agrees=True)
+    assert both["pass"] and "absence" in both["note"]
+    for s, e in ((NAN, 161.7), (162.0, NAN)):
+        r = make_row("bpfi", s, e, tol, label="BPFI", units="Hz", absence_agrees=True)
+        assert not r["pass"] and "missing value" in r["note"]
+    assert not make_row("bpfi", 158.0, 161.7, tol, label="BPFI", units="Hz", absence_agrees=True)["pass"]
+
+
 def test_a_ratio_of_1295_against_1_24_fails():
     """The impulse-strength ratio the old ordering rule let pass (both on the same side of 1)."""
     tol = QUANTITIES["impulse_strength_ratio"].tolerance
