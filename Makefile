@@ -5,15 +5,25 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 
-.PHONY: install validate test bench study clean
+.PHONY: install lock validate test bench study verdicts clean
 
 install: $(STAMP)
 
-$(STAMP): pyproject.toml
+# the locked versions (constraints.txt) the suite is tested with; `make lock` refreshes them
+$(STAMP): pyproject.toml constraints.txt
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
-	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -e ".[test]"
+	$(PY) -m pip install --quiet -c constraints.txt pip
+	$(PY) -m pip install --quiet -c constraints.txt -e ".[test]"
 	touch $(STAMP)
+
+# re-resolve the newest versions pip finds today into constraints.txt (then run `make test`)
+lock:
+	rm -rf .lock-venv && $(PYTHON) -m venv .lock-venv
+	.lock-venv/bin/python -m pip install --quiet --upgrade pip
+	.lock-venv/bin/python -m pip install --quiet -e ".[test]"
+	{ sed -n '1,3p' constraints.txt; .lock-venv/bin/python -m pip freeze --all --exclude-editable \
+	    | grep -v -i -e '^bearing.lab' -e '^setuptools=' -e '^wheel='; } > constraints.txt.new
+	mv constraints.txt.new constraints.txt && rm -rf .lock-venv
 
 validate: install
 	$(VENV)/bin/bearing-lab validate -o reports
@@ -26,6 +36,10 @@ bench: install
 
 study: install
 	$(VENV)/bin/bearing-lab study paper
+
+# every shipped case's row verdicts and margins (benchmarks/verdicts.csv, compared by the tests)
+verdicts: install
+	$(PY) benchmarks/verdicts.py table
 
 clean:
 	rm -rf $(VENV) reports/* .pytest_cache
