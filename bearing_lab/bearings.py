@@ -100,7 +100,9 @@ class BearingGeometry:
         return {k: v * shaft_hz for k, v in self.frequency_factors().items()}
 
     def surface_speed(self, shaft_rad_s: float) -> float:
-        """Speed (m/s) of a ball centre relative to either race: omega (d_m^2 - D_b^2)/(4 d_m)."""
+        """Rolling speed (m/s): the speed at which a ball's contact point travels along either
+        raceway, ``omega (d_m^2 - D_b^2) / (4 d_m)`` (the cage's speed relative to the race times
+        the contact radius; pure rolling, zero contact angle)."""
         dm, db = self.pitch_diameter, self.ball_diameter
         return shaft_rad_s * (dm * dm - db * db) / (4 * dm)
 

@@ -64,6 +64,11 @@ P_TRIG = P_SIZE
 #   contact point is the same pit on the race meeting the ball).
 D_RACE, D_KIND, D_NPSI, D_NDEL, D_HOFF, D_GOFF, D_BALL = 0, 1, 2, 3, 4, 5, 6
 F_PSI0, F_PSIF, F_DPSI, F_DDEL, F_ZLO, F_ZHI, F_SCALE = 0, 1, 2, 3, 4, 5, 6
+# the largest approach (m) a force was evaluated at inside the table's psi range, written by
+# the time loop: a run that reached above the table's top is extended and re-run, never
+# trusted on an extrapolated force
+F_REACH = 7
+N_DFLT = 8
 
 TWO_PI = 2.0 * math.pi
 
@@ -164,7 +169,9 @@ def _interp_g23(k, psi, delta, dint, dflt, gbuf):
     The table holds G^(2/3) (an approach-like quantity, m), interpolated bilinearly: exact
     on intact surface (g = delta) and for a rigid drop (max(delta - h, 0)), where
     interpolating G itself would overstate the convex delta^1.5 between grid nodes.
-    Linear extrapolation above the grid's delta range.
+    Linear extrapolation above the grid's delta range, for trial evaluations only: a force
+    the run keeps is noted by :func:`_note_reach`, and a run that reached above the table is
+    extended and repeated (see ``integrate.simulate``).
     """
     npsi = dint[k, D_NPSI]
     nd = dint[k, D_NDEL]
@@ -193,6 +200,13 @@ def _interp_g23(k, psi, delta, dint, dflt, gbuf):
     dg_dd = ((1.0 - fx) * (a01 - a00) + fx * (a11 - a10)) / dd
     dg_dpsi = (g1 - g0) / dflt[k, F_DPSI]
     return g, dg_dd, dg_dpsi
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _note_reach(k, psi, delta, dflt):
+    """Remember the largest approach a defect force was taken at inside the table's psi range."""
+    if dflt[k, F_ZLO] < psi < dflt[k, F_ZHI] and delta > dflt[k, F_REACH]:
+        dflt[k, F_REACH] = delta
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -231,6 +245,7 @@ def contact_force(kk, rel, reld, delta, delta_rate, k, cmax, p, dint, dflt, hbuf
         rate = delta_rate - dh * reld if rolling else delta_rate
         return impact(pen, rate, k, p[P_EXP], cmax, p[P_DPEN])
     g, dg_dd, dg_dpsi = _interp_g23(kk, rel, delta, dint, dflt, gbuf)
+    _note_reach(kk, rel, delta, dflt)
     if g <= 0.0:
         return 0.0
     rate = dg_dd * delta_rate + dg_dpsi * reld if rolling else delta_rate
@@ -319,6 +334,7 @@ def _qs_ball(kk, rel, reld, dtot, dtot_rate, p, dint, dflt, hbuf, gbuf):
     # damping on the pair's equivalent penetration: the table's G^(2/3) at the split plus
     # the other contact's penetration (dtot on intact surface, as for a healthy ball)
     g, dg_dd, dg_dpsi = _interp_g23(kk, rel, x, dint, dflt, gbuf)
+    _note_reach(kk, rel, x, dflt)
     rate = dtot_rate
     if rolling:
         # d/dt (g + dtot - x), the split x following the series balance

@@ -231,7 +231,7 @@ def choose_contact_model(defect, requested: str, bearing) -> str:
     return "halfspace"
 
 
-def _defect_tables(scene: Scene, lz: float, delta_max: float, material):
+def _defect_tables(scene: Scene, lz: float, delta_max: float, material, delta_top=None):
     """Each defect's contact table, packed for the kernels: a ball defect gets one table per
     race it meets.  Returns (models, tables, entries, dint, dflt, hbuf, gbuf, table_time_s)."""
     import dataclasses
@@ -252,13 +252,16 @@ def _defect_tables(scene: Scene, lz: float, delta_max: float, material):
             entries.append((0 if defect.race == "outer" else 1, defect, lz + defect.angle, -1, model))
     n_e = max(len(entries), 1)
     dint = np.zeros((n_e, 7), dtype=np.int64)
-    dflt = np.zeros((n_e, 7))
+    dflt = np.zeros((n_e, K.N_DFLT))
     hparts, gparts = [], []
     hoff = goff = 0
     t_tables = time.perf_counter()
     for kk, (code, dfc, psi0, ball, model) in enumerate(entries):
+        # the loaded range above the deepest drop: a ball that falls into the defect is
+        # loaded there, and reads computed values, not an extrapolation
+        top = None if delta_top is None else delta_top[kk]
         tab = contact_table(dfc, b, model=model, clearance=scene.clearance, delta_max=delta_max,
-                            material=material)
+                            material=material, above_drop=delta_max, delta_top=top)
         tables.append(tab)
         psi = np.asarray(tab.psi, dtype=float)
         kind = 1 if CONTACT_MODELS[model].tabulated else 0
@@ -267,7 +270,7 @@ def _defect_tables(scene: Scene, lz: float, delta_max: float, material):
         G = np.ascontiguousarray(np.maximum(tab.G, 0.0) ** (2.0 / 3.0), dtype=float)
         scale = b.ball_diameter / 2 / tab.track_radius if code >= 2 else 1.0
         dint[kk] = [code, kind, len(psi), G.shape[1], hoff, goff, ball]
-        dflt[kk] = [psi0, psi[0], psi[1] - psi[0], tab.delta[1] - tab.delta[0], psi[0], psi[-1], scale]
+        dflt[kk, :7] = [psi0, psi[0], psi[1] - psi[0], tab.delta[1] - tab.delta[0], psi[0], psi[-1], scale]
         hparts.append(h)
         gparts.append(G.ravel() if kind == 1 else np.zeros(0))
         hoff += len(h)
@@ -393,7 +396,11 @@ def _parameters(scene: Scene, fid, st, hi, ho, k_eff, masses, loads, ftf, phi_c0
     return p, dyn
 
 
-def assemble(scene: Scene, *, fidelity: str | None = None) -> Assembly:
+def assemble(scene: Scene, *, fidelity: str | None = None, delta_top=None) -> Assembly:
+    """The scene's parameters, tables and initial state for the time loop.
+
+    ``delta_top``: per defect-table entry, a lower bound of the table's top approach (m), for a
+    re-run after the loop reached above a table."""
     d = scene.data
     b = scene.bearing
     fid = fidelity or scene.fidelity
@@ -447,7 +454,7 @@ def assemble(scene: Scene, *, fidelity: str | None = None) -> Assembly:
     # defects -> tables (a ball defect gets one table per race it meets)
     static_max = float(np.max(st["ball_loads"])) if len(st["ball_loads"]) else 0.0
     models, tables, entries, dint, dflt, hbuf, gbuf, table_time = _defect_tables(
-        scene, lz, max(3.0 * (max(static_max, 50.0) / ho.stiffness) ** (2 / 3), 5e-6), (E, nu))
+        scene, lz, max(3.0 * (max(static_max, 50.0) / ho.stiffness) ** (2 / 3), 5e-6), (E, nu), delta_top)
 
     p, dyn = _parameters(scene, fid, st, hi, ho, k_eff, (m_i, m_o, m_b), (tstep, f_in2, f_out2, g),
                          ftf, phi_c0, len(entries))

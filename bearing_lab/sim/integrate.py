@@ -29,6 +29,7 @@ from scipy import signal
 
 from .. import __version__
 from ..errors import BearingLabError, SolverError
+from . import _kernels as K
 from . import _stepper as S
 from .assembly import assemble
 from .scene import load_scene
@@ -206,11 +207,21 @@ def _decimate_acc(res):
     return win[s0:s0 + res["R"] * (res["n_out"] - 1) + 1:res["R"]] @ taps[::-1]
 
 
-def _assemble(sc):
+#: how many times a run whose balls reached above a defect table is repeated with the table extended
+TABLE_EXTENSIONS = 2
+
+
+def _tables_exceeded(asm) -> set:
+    """Table entries (tabulated contact laws) whose forces were taken above the table's top."""
+    return {k for k, t in enumerate(asm.tables)
+            if asm.dint[k, K.D_KIND] == 1 and asm.dflt[k, K.F_REACH] > t.delta_max * (1 + 1e-9)}
+
+
+def _assemble(sc, delta_top=None):
     """assemble(), with a failure to find the static equilibrium said in one line."""
     try:
         with np.errstate(all="ignore"):
-            return assemble(sc)
+            return assemble(sc, delta_top=delta_top)
     except (ValueError, ArithmeticError, RuntimeError) as exc:
         if isinstance(exc, BearingLabError):  # already one clear line (a SceneError, ...)
             raise
@@ -268,6 +279,25 @@ def simulate(scene, *, fidelity: str | None = None, duration: float | None = Non
     max_step = max_step if max_step is not None else 2.5e-5
     res = _run(asm, METHODS[method_name], rtol_, progress=progress, max_step=max_step, step=step_,
                defect_steps=d["solver"]["defect_steps"], loads=d["output"]["ball_loads"])
+    for _ in range(TABLE_EXTENSIONS):
+        over = _tables_exceeded(asm)
+        if not over:
+            break
+        # a force was taken above a table's top (extrapolated): extend those tables, run again
+        top = [max(1.25 * float(asm.dflt[k, K.F_REACH]), t.delta_max) if k in over else None
+               for k, t in enumerate(asm.tables)]
+        table_s = asm.table_time_s
+        asm = _assemble(sc, delta_top=top)
+        asm.table_time_s += table_s
+        res = _run(asm, METHODS[method_name], rtol_, progress=progress, max_step=max_step, step=step_,
+                   defect_steps=d["solver"]["defect_steps"], loads=d["output"]["ball_loads"])
+    over = _tables_exceeded(asm)
+    if over:
+        raise SolverError(f"scene {sc.name!r}: the balls' approach on defect table(s) {sorted(over)} "
+                          f"kept rising above the table after {TABLE_EXTENSIONS} extensions (reached "
+                          + ", ".join(f"{1e6 * asm.dflt[k, K.F_REACH]:.3g} um over a {1e6 * asm.tables[k].delta_max:.3g}"
+                                      " um table" for k in sorted(over))
+                          + "); the defect is deeper or the load larger than the contact law covers")
     acc = res["acc"]
     if d["sensor"]["enabled"]:
         acc = acc * d["sensor"]["gain"]
@@ -326,6 +356,9 @@ def simulate(scene, *, fidelity: str | None = None, duration: float | None = Non
         "fidelity_requested": sc.fidelity,
         "auto_choice": (choice["reason"] + f"; kind {choice['kind']}; expected peak-acceleration error "
                         f"{choice['expected_peak_error']}") if "auto" in (sc.fidelity, d["solver"]["method"]) else "",
+        "defect_table_top_um": ",".join(f"{1e6 * t.delta_max:.4g}" for t in asm.tables) if asm.tables else "none",
+        "defect_table_reach_um": (",".join(f"{1e6 * asm.dflt[k, K.F_REACH]:.4g}" for k in range(len(asm.tables)))
+                                  if asm.tables else "none"),
         "solver_steps": int(stats[0]),
         "solver_rejected_steps": int(stats[1]),
         "settle_time_s": float(sc.settle),

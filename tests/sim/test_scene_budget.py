@@ -111,7 +111,7 @@ def test_defect_off_the_ball_track_warns():
 def test_failed_equilibrium_is_a_solver_error(monkeypatch):
     from bearing_lab.sim import integrate
 
-    def broken(scene, fidelity=None):
+    def broken(scene, fidelity=None, delta_top=None):
         raise ValueError("f(a) and f(b) must have different signs")
 
     monkeypatch.setattr(integrate, "assemble", broken)

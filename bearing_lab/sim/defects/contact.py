@@ -85,8 +85,10 @@ from .geometry import RaceGeometry, drop_profile_1d, drop_profile_2d, hertz_semi
 from .model import Defect
 
 # CONTACT_MODELS, the registry of models (one entry each), closes this module.
-#: approach nodes of the "halfspace" model, as fractions of delta_max
+#: approach nodes of the "halfspace" model, as fractions of delta_max (the loaded range)
 HALFSPACE_NODES = (0.05, 0.1, 0.16, 0.25, 0.35, 0.5, 0.7, 1.0)
+#: spacing of the half-space nodes above the loaded range (inside a deep defect), as a fraction of it
+ABOVE_NODE_STEP = 0.1
 #: Young's modulus and Poisson ratio the tables assume unless told (52100 steel)
 DEFAULT_MATERIAL = (208e9, 0.3)
 _SUB = 4            # sub-samples per cell side for the outline coverage
@@ -133,9 +135,8 @@ class ContactTable:
 
     def lookup(self, psi, delta):
         """G (m^1.5) at (psi, delta), bilinear; intact ``max(delta, 0)^1.5`` outside the psi
-        range; above ``delta_max`` G is continued as ``G(delta_max) + 1.5 sqrt(delta_max) *
-        (delta - delta_max)`` (the table should be built with a delta_max above any
-        approach the simulation reaches)."""
+        range.  Inside it, an approach above the table's top (``delta_max``) is an error, not
+        an extrapolation: build the table with a larger range (``above_drop``, ``delta_top``)."""
         psi = np.asarray(psi, dtype=float)
         delta = np.asarray(delta, dtype=float)
         psi, delta = np.broadcast_arrays(psi, delta)
@@ -157,9 +158,12 @@ class ContactTable:
             G = self.G
             g = ((1 - fx) * ((1 - fy) * G[i, j] + fy * G[i, j + 1])
                  + fx * ((1 - fy) * G[i + 1, j] + fy * G[i + 1, j + 1]))
-            above = dl > self.delta[-1]
+            above = dl > self.delta[-1] * (1 + 1e-12)
             if np.any(above):
-                g = g + np.where(above, 1.5 * math.sqrt(self.delta[-1]) * (dl - self.delta[-1]), 0.0)
+                raise SceneError(f"contact table ({self.model}, {self.race} race): approach "
+                                 f"{1e6 * float(dl[above].max()):.3g} um lies above the table's top "
+                                 f"{1e6 * self.delta[-1]:.3g} um; build it with a larger range "
+                                 "(above_drop or delta_top)")
             out[inside] = g
         return out.reshape(shape)
 
@@ -277,6 +281,7 @@ def _correlate(f: np.ndarray, kern: np.ndarray, m: int, n_psi: int) -> np.ndarra
 def contact_table(defect: Defect, bearing, *, model: str, clearance: float = 0.0,
                   delta_max: float, n_psi: int | None = None, n_delta: int = 41,
                   against: str | None = None, material: tuple[float, float] | None = None,
+                  above_drop: float | None = None, delta_top: float | None = None,
                   cache: bool = True) -> ContactTable:
     """Tabulate the contact of a ball with the defected race (see the module docstring).
 
@@ -293,10 +298,18 @@ def contact_table(defect: Defect, bearing, *, model: str, clearance: float = 0.0
     bearing : BearingGeometry.
     model : "halfspace", "area", "drop" or "profile".
     clearance : diametral clearance, m (moves the groove bottoms by clearance/4).
-    delta_max : largest approach to tabulate, m (e.g. 2-3 x the static deflection of the
-        most loaded ball; 12e-6 for the 6308 at 480 N).
+    delta_max : the loaded approach range, m (e.g. 2-3 x the static deflection of the most
+        loaded ball; 12e-6 for the 6308 at 480 N): the psi range covers the contact's reach at
+        it, and the half-space nodes are densest below it.
     n_psi : psi grid size; default: about 40 points per along-track contact reach.
-    n_delta : delta grid size (default 41).
+    n_delta : delta grid points per ``delta_max`` (default 41); a table extended above
+        ``delta_max`` keeps that spacing.
+    above_drop : approach the table must cover above the deepest rigid drop of its psi range,
+        m: the table then reaches ``max(delta_max, max(drop) + above_drop)``, so a ball that
+        falls into the defect and is loaded there reads computed values, never an
+        extrapolation (give the loaded range, as the simulation does).
+    delta_top : a lower bound of the table's top approach, m (the simulation extends a table
+        this way when a run reached above it).
     against : for a ball defect only, the race it strikes, "outer" or "inner" (build one
         table per race).  psi is then measured on the ball: the contact point's angle on the
         ball relative to the defect centre (arc ``ball_radius * psi``), and the outline is
@@ -315,6 +328,10 @@ def contact_table(defect: Defect, bearing, *, model: str, clearance: float = 0.0
     material = DEFAULT_MATERIAL if material is None else (float(material[0]), float(material[1]))
     args = dict(model=model, clearance=float(clearance), delta_max=float(delta_max), n_psi=n_psi,
                 n_delta=int(n_delta), against=against, material=material)
+    if above_drop is not None:
+        args["above_drop"] = float(above_drop)
+    if delta_top is not None:
+        args["delta_top"] = float(delta_top)
     _check_arguments(defect, **args)
     key = _table_cache.table_key(replace(defect, angle=0.0), bearing, **args)
     hit = _MEMORY.get(key)
@@ -338,10 +355,14 @@ _MEMORY: dict = {}
 _MEMORY_SIZE = 64
 
 
-def _check_arguments(defect, *, model, clearance, delta_max, n_psi, n_delta, against, material):
+def _check_arguments(defect, *, model, clearance, delta_max, n_psi, n_delta, against, material,
+                     above_drop=None, delta_top=None):
     check_choice(model, CONTACT_MODELS, "contact model", SceneError)
     if not (math.isfinite(delta_max) and delta_max > 0):
         raise SceneError(f"{delta_max=} m must be positive and finite")
+    for name, v in (("above_drop", above_drop), ("delta_top", delta_top)):
+        if v is not None and not (math.isfinite(v) and v > 0):
+            raise SceneError(f"{name}={v!r} m must be positive and finite")
     if n_delta < 3:
         raise SceneError(f"{n_delta=} must be at least 3")
     if n_psi is not None and n_psi < 8:
@@ -360,11 +381,13 @@ def _check_arguments(defect, *, model, clearance, delta_max, n_psi, n_delta, aga
 
 
 def _build(defect, bearing, *, model, clearance, delta_max, n_psi, n_delta, against=None,
-           material=DEFAULT_MATERIAL, halfspace_settings=None) -> ContactTable:
+           material=DEFAULT_MATERIAL, halfspace_settings=None, above_drop=None,
+           delta_top=None) -> ContactTable:
     t0 = time.perf_counter()
     c0 = time.process_time()
     _check_arguments(defect, model=model, clearance=clearance, delta_max=delta_max, n_psi=n_psi,
-                     n_delta=n_delta, against=against, material=material)
+                     n_delta=n_delta, against=against, material=material, above_drop=above_drop,
+                     delta_top=delta_top)
     race = defect.race if defect.race != "ball" else against
     geom = RaceGeometry.from_bearing(bearing, race, clearance=clearance)
     # psi is measured on the defected body: the ball for a ball defect
@@ -383,14 +406,23 @@ def _build(defect, bearing, *, model, clearance, delta_max, n_psi, n_delta, agai
     if n_psi is None:
         n_psi = int(min(max(math.ceil((s_hi - s_lo) / (b_reach / _PSI_PER_REACH)) + 1, 64), 8001))
     psi = np.linspace(s_lo / R, s_hi / R, n_psi)
-    delta = np.linspace(0.0, delta_max, n_delta)
     drop2 = drop_profile_2d(defect, geom, psi, psi_radius=R)
+    # the approach range: the loaded range, above the deepest drop when asked, and never
+    # below delta_top; the grid keeps the loaded range's spacing
+    top = delta_max
+    if above_drop is not None:
+        top = max(top, float(np.max(drop2)) + above_drop)
+    if delta_top is not None:
+        top = max(top, delta_top)
+    n_d = n_delta if top <= delta_max * (1 + 1e-12) else int(math.ceil(top / delta_max * (n_delta - 1))) + 1
+    delta = np.linspace(0.0, top, n_d)
     spec = CONTACT_MODELS[model]
     drop = drop_profile_1d(defect, geom, psi, psi_radius=R) if spec.along_track_drop else drop2
     cells = (_CELLS_ALONG, _CELLS_ACROSS) if spec.area_law else (_FRACTION_CELLS,) * 2
     lat = _lattice(defect, geom, psi, R, delta, cells=cells, area_law=spec.area_law)
     info = {"reach_along_m": b_reach, "reach_across_m": a_reach, "misses_track": misses,
-            "drop_2d": drop2, **lat["info"]}
+            "drop_2d": drop2, "loaded_range_m": float(delta_max), "max_drop_m": float(np.max(drop2)),
+            **lat["info"]}
     G = spec.g(dict(defect=defect, geom=geom, psi=psi, R=R, delta=delta, drop=drop, drop2=drop2,
                     lattice=lat, material=material, misses=misses, info=info,
                     halfspace_settings=halfspace_settings))
@@ -469,7 +501,12 @@ def _halfspace_G(defect, geom, s_tab, delta, drop, *, e_star, misses, settings=N
     from .halfspace import TABLE_CELLS, ratio_curve
     settings = dict(settings or {})
     n_psi, n_delta = s_tab.size, delta.size
-    nodes_d = np.array(settings.pop("nodes", HALFSPACE_NODES)) * delta[-1]
+    loaded = settings.pop("loaded_range", delta[-1])
+    nodes_d = np.array(settings.pop("nodes", HALFSPACE_NODES)) * loaded
+    if delta[-1] > loaded * (1 + 1e-9):
+        # above the loaded range (a ball inside a deep defect): nodes a third of it apart
+        extra = int(math.ceil((delta[-1] - loaded) / (loaded * ABOVE_NODE_STEP)))
+        nodes_d = np.concatenate([nodes_d, loaded + (delta[-1] - loaded) * np.arange(1, extra + 1) / extra])
     cells = tuple(settings.pop("cells", TABLE_CELLS))
     # rectangles: sides on cell boundaries (aligned, or on a grid rotated with the defect)
     richardson = settings.pop("richardson", True) and defect.shape == "rectangle"
@@ -547,9 +584,10 @@ class ContactModel:
 
 def _g_halfspace(c):
     E, nu = c["material"]
+    settings = dict(c["halfspace_settings"] or {})
+    settings.setdefault("loaded_range", c["info"]["loaded_range_m"])
     G, info = _halfspace_G(c["defect"], c["geom"], c["psi"] * c["R"], c["delta"], c["drop2"],
-                           e_star=E / (2 * (1 - nu * nu)), misses=c["misses"],
-                           settings=c["halfspace_settings"])
+                           e_star=E / (2 * (1 - nu * nu)), misses=c["misses"], settings=settings)
     c["info"].update(info)
     return G
 
