@@ -25,13 +25,17 @@ Testing*, 2000, ch. 4, for single-mode fitting of measured responses):
    to 0.45 fs, kept where the recording rings (within 20 dB of its strongest bin):
    it sets the resonance frequency.
 
-The recording's noise floor (median envelope) is added to the model envelope in
-quadrature, so a quiet simulation is not pushed to fit background.  The search
+The part of the recording's floor (median envelope) that the model's own floor does not
+hold is added to the model envelope in quadrature (independent powers add), so a quiet
+simulation is not pushed to fit background, and a simulation that already holds the
+recording's floor (the model's own recording) is not given it twice.  The search
 starts at the strongest peaks of the measured impact spectrum inside the given
 bounds; the bounds are used as given (an upper frequency bound above 0.45 fs is
 lowered to 0.45 fs, and the fit says so).  A fit that ends at a bound, does not
 converge, or ends no better than the unfitted simulation is *degraded*, and says
-why.
+why.  Such a fit is then compared with the path without a resonance (the gain alone,
+fitted on the same residuals): when the gain alone explains the impacts as well, the
+recording shows no housing resonance, and the path is that gain (a note says so).
 
 Public API
 ----------
@@ -220,11 +224,17 @@ def _jsonable(v):
 
 
 # ------------------------------------------------------------------ the fit
+def _floor(x) -> float:
+    """The floor of a signal: its median Hilbert envelope."""
+    from scipy.signal import hilbert
+    x = np.asarray(x, float)
+    return float(np.median(np.abs(hilbert(x - np.mean(x)))))
+
+
 class _PathProblem:
     """Residuals of the path fit (see the module docstring)."""
 
     def __init__(self, recording, simulation, fs, period, *, band, pre, post, n_resonances):
-        from scipy.signal import hilbert
         self.fs, self.period, self.nres = fs, period, n_resonances
         self.e = np.asarray(recording, float) - np.mean(recording)
         self.s = np.asarray(simulation, float) - np.mean(simulation)
@@ -238,7 +248,7 @@ class _PathProblem:
         if self.env_e is None:
             raise AnalysisError("structural path: no impact window fits inside the recording")
         self.pk = int(np.argmax(self.env_e))
-        self.floor = float(np.median(np.abs(hilbert(self.e))))
+        self.floor = _floor(self.e)
         self.f_seg, self.p_e = segment_spectrum(self.e, fs, self.te, pre=pre, post=post)
         edges = np.geomspace(300.0, 0.45 * fs, 41)
         bins = [(self.f_seg >= lo) & (self.f_seg < hi) for lo, hi in zip(edges[:-1], edges[1:])]
@@ -272,7 +282,7 @@ class _PathProblem:
         if shift:
             moved = mean_envelope(y, self.fs, self.ts + shift / self.fs, pre=self.pre, post=self.post)
             env = moved if moved is not None and moved.size == env.size else np.roll(env, -shift)
-        return np.sqrt(env ** 2 + self.floor ** 2)
+        return np.sqrt(env ** 2 + max(self.floor ** 2 - _floor(y) ** 2, 0.0))
 
     def residuals(self, params):
         return self.residuals_of(self.path_of(params).apply(self.s, self.fs))
@@ -448,4 +458,49 @@ def fit_structural_path(recording, simulation, fs, period, *, band=None, n_reson
         r = least_squares(prob.residuals, x0, bounds=(lo, hi), x_scale=0.3, max_nfev=60)
         if best is None or r.cost < best.cost:
             best = r
-    return _finish(prob, best, lo, hi, bounds, notes, source)
+    path = _finish(prob, best, lo, hi, bounds, notes, source)
+    if path.problems:
+        flat = _flat_path(prob, bounds, notes, source)
+        if flat is not None and flat.fit["residual_db"] <= path.fit["residual_db"] + FLAT_MARGIN_DB:
+            flat.fit["notes"] = list(notes) + [
+                f"no resonance: a flat gain explains the impacts ({flat.fit['residual_db']:.2f} dB residual) as well "
+                f"as the best {'resonance' if k == 1 else 'pair of resonances'} ({path.describe()}, "
+                f"{path.fit['residual_db']:.2f} dB; " + "; ".join(path.problems) + "): the recording shows no "
+                "housing resonance, and the path is the gain alone"]
+            flat.fit["resonant_fit"] = {"path": path.describe(), "residual_db": path.fit["residual_db"],
+                                        "problems": path.problems}
+            return flat
+    return path
+
+
+#: a flat gain replaces a resonant fit that ended at a bound when its residual is at most this much larger (dB)
+FLAT_MARGIN_DB = 0.05
+
+
+def _flat_path(prob, bounds, notes, source):
+    """The path without a resonance (the gain alone), fitted on the same residuals; None when it cannot be."""
+    from scipy.optimize import least_squares
+    glo, ghi = (math.log(v) for v in bounds["gain"])
+    peak_s = prob.impact_peak(prob.s, prob.ts)
+    if not peak_s > 0:
+        return None
+    g0 = min(max(math.log(prob.peak_e / peak_s), glo + 1e-6), ghi - 1e-6)
+    best = least_squares(lambda p: prob.residuals_of(math.exp(p[0]) * prob.s), [g0], bounds=([glo], [ghi]),
+                         x_scale=0.3, max_nfev=60)
+    path = StructuralPath((), float(math.exp(best.x[0])), source or "fitted on the pooled impulse responses")
+    _, parts = prob.residuals_of(path.apply(prob.s, prob.fs), parts=True)
+    _, parts0 = prob.residuals_of(prob.s, parts=True)
+    fit_db, before_db = _rms_db(np.concatenate(parts)), _rms_db(np.concatenate(parts0))
+    problems = []
+    if abs(best.x[0] - glo) < 1e-3 or abs(best.x[0] - ghi) < 1e-3:
+        problems.append(f"the fit ended at a bound: gain at its {'lower' if abs(best.x[0] - glo) < 1e-3 else 'upper'}"
+                        f" bound ({math.exp(best.x[0]):.4g})")
+    if fit_db > before_db + FLAT_MARGIN_DB:
+        problems.append(f"the fit ends worse than the unfitted simulation ({fit_db:.1f} dB against "
+                        f"{before_db:.1f} dB before)")
+    path.fit = {"residual_db": fit_db, "initial_db": before_db, "bounds": bounds,
+                "n_impacts_recording": int(prob.te.size), "n_impacts_simulation": int(prob.ts.size),
+                "evaluations": int(best.nfev), "notes": list(notes), "problems": problems}
+    path.curves = {"time_s": (np.arange(prob.env_e.size) - prob.pk) / prob.fs, "recording": prob.env_e,
+                   "before": prob.envelope(prob.s), "after": prob.envelope(path.apply(prob.s, prob.fs))}
+    return path

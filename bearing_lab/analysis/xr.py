@@ -52,8 +52,10 @@ def _kw(out_sizes=None):
     return kw
 
 
-def amplitude_spectrum(da, *, window, dim="time", fs=None):
-    """:func:`bearing_lab.analysis.amplitude_spectrum` over ``dim``; new dim ``frequency`` (Hz)."""
+def amplitude_spectrum(da, *, window="boxcar", dim="time", fs=None):
+    """:func:`bearing_lab.analysis.amplitude_spectrum` over ``dim``; new dim ``frequency`` (Hz).
+
+    ``window`` defaults to ``"boxcar"`` (no window), as :func:`scipy.signal.periodogram` does."""
     fs = sampling_rate(da, dim=dim, fs=fs)
     n = da.sizes[dim]
     f = np.fft.rfftfreq(n, 1 / fs)
@@ -65,9 +67,13 @@ def amplitude_spectrum(da, *, window, dim="time", fs=None):
     return out
 
 
-def welch_psd(da, *, window, nperseg, noverlap=None, dim="time", fs=None):
-    """:func:`bearing_lab.analysis.welch_psd` over ``dim``; units (U)^2 Hz-1."""
+def welch_psd(da, *, window="hann", nperseg=None, noverlap=None, dim="time", fs=None):
+    """:func:`bearing_lab.analysis.welch_psd` over ``dim``; units (U)^2 Hz-1.
+
+    Defaults as :func:`scipy.signal.welch`: ``window="hann"``, ``nperseg`` 256 samples (the record
+    when shorter), ``noverlap`` half a segment."""
     fs = sampling_rate(da, dim=dim, fs=fs)
+    nperseg = min(256, da.sizes[dim]) if nperseg is None else nperseg
     f = np.fft.rfftfreq(int(nperseg), 1 / fs)
     out = xr.apply_ufunc(lambda x: _spectral.welch_psd(x, fs, window=window, nperseg=nperseg,
                                                        noverlap=noverlap)[1], da,
@@ -143,8 +149,10 @@ def kurtogram_band(da, *, dim="time", fs=None, nlevel=None, min_bandwidth=None):
     return out
 
 
-def shaft_frequency(da, *, window, rpm=None, dim="time", fs=None, **kwargs):
-    """:func:`bearing_lab.analysis.shaft_frequency` per signal (Hz)."""
+def shaft_frequency(da, *, window="hann", rpm=None, dim="time", fs=None, **kwargs):
+    """:func:`bearing_lab.analysis.shaft_frequency` per signal (Hz); ``window`` defaults to ``"hann"``, the
+    window :func:`bearing_lab.analysis.analyze` searches the shaft line with (it leaks less next to mains
+    lines)."""
     fs = sampling_rate(da, dim=dim, fs=fs)
     out = xr.apply_ufunc(lambda x: _speed.shaft_frequency(x, fs, window=window, rpm=rpm, **kwargs)[0],
                          da, input_core_dims=[[dim]], vectorize=True, dask="parallelized",

@@ -27,6 +27,9 @@ def _cmd_new(args) -> int:
     from .._files import atomic_open
     with atomic_open(out, "w", encoding="utf-8") as fh:
         fh.write(text)
+    for line in text.splitlines():
+        if line.startswith("# NOTE: "):
+            print(f"bearing-lab case new: note: {line[len('# NOTE: '):]} (see {out})", file=sys.stderr)
     print(f"{out}: starting case for {args.recording}; give the bearing, load and defect (see the comments), "
           f"then run `bearing-lab validate {out}`")
     return 0

@@ -84,6 +84,11 @@ def _structural_path(case):
                               "leave method at \"fit\"")
     if sp.get("from_case") == case.name:
         raise _err(case.name, "structural_path.from_case names this case itself")
+    given = [k for k in ("frequency_hz", "damping_ratio", "gain") if k in sp]
+    if method == "none" and given:
+        raise _err(case.name, f"structural_path: method = \"none\" compares the bare model and takes no "
+                              f"{', '.join(given)}; remove {'it' if len(given) == 1 else 'them'} (or use method = "
+                              "\"fit\" with bounds, \"fixed\" with values)")
     if method == "fixed":
         for key in ("frequency_hz", "damping_ratio", "gain"):
             if key not in sp:

@@ -8,14 +8,18 @@ placeholders, and the case refuses to run until they are given (naming what is m
 Public API
 ----------
 new_case_text(recording, *, name=None, bearing=None, speed=None, channel=None, fmt=None, case_dir=None) -> str
+compared_duration(record_s) -> float          -- the compared duration: the whole record, up to 10 s
+resolution_limits(bearing, rpm, duration_s)   -- fault lines a record that short cannot tell from shaft harmonics
 """
 from __future__ import annotations
 
+import math
+import os
 from pathlib import Path
 
 from .quantities import QUANTITIES
 
-__all__ = ["new_case_text", "DEFAULT_ROWS"]
+__all__ = ["new_case_text", "resolution_limits", "compared_duration", "DEFAULT_ROWS"]
 
 #: rows a new recording case compares (each with the quantity table's default tolerance and reason)
 DEFAULT_ROWS = ("shaft_hz", "bpfo", "excitation_period", "rms", "peak", "crest_factor", "kurtosis",
@@ -23,22 +27,53 @@ DEFAULT_ROWS = ("shaft_hz", "bpfo", "excitation_period", "rms", "peak", "crest_f
 
 
 def _relative(path, case_dir) -> str:
-    """The recording relative to the case's folder when it lies inside it, else absolute."""
-    p = Path(path).resolve()
-    if case_dir is not None:
-        try:
-            return p.relative_to(Path(case_dir).resolve()).as_posix()
-        except ValueError:
-            pass
-    return p.as_posix()
+    """The recording relative to the case's folder (as docs/case-format.md reads it), symlinks kept as named;
+    absolute only when no relative path exists (another drive)."""
+    p = Path(os.path.abspath(path))
+    if case_dir is None:
+        return p.as_posix()
+    try:
+        return Path(os.path.relpath(p, os.path.abspath(case_dir))).as_posix()
+    except ValueError:
+        return p.as_posix()
 
 
 def _channels(ds) -> list:
+    from ..errors import BearingLabError
+    from ..units import lookup_unit
     out = []
     for k, v in ds.data_vars.items():
-        out.append(f"#   {k:14s} {v.attrs.get('quantity', '?'):13s} stored as {v.attrs.get('original_units') or '?'}"
-                   f" (read as {v.attrs.get('units', '?')})")
+        units = v.attrs.get("units", "?")
+        quantity = v.attrs.get("quantity")
+        if not quantity:
+            try:
+                quantity = lookup_unit(units).quantity
+            except BearingLabError:
+                quantity = "?"
+        stored = v.attrs.get("original_units")
+        out.append(f"#   {k:14s} {quantity:13s} " + (f"stored as {stored} (read as {units})" if stored else
+                                                       f"in {units}"))
     return out
+
+
+def _source(ds) -> str:
+    """What wrote the file: the reader of an imported recording, or the simulator."""
+    if ds.attrs.get("reader"):
+        return f"reader {ds.attrs['reader']}"
+    if ds.attrs.get("scene_name") or ds.attrs.get("fidelity"):
+        return f"a bearing_lab simulation of scene {ds.attrs.get('scene_name', '?')!r}"
+    return "a bearing_lab netCDF file"
+
+
+#: longest compared (and simulated) duration ``case new`` writes, s: beyond it, the line search is
+#: finer than any slip holds and the simulation only costs time
+MAX_COMPARED_S = 10.0
+
+
+def compared_duration(record_s: float) -> float:
+    """The duration ``case new`` compares: the whole record (up to :data:`MAX_COMPARED_S`), so the
+    recording's line search (over its whole record) and the simulation's see the same resolution."""
+    return float(min(record_s, MAX_COMPARED_S))
 
 
 def _speed_lines(ds, speed) -> list:
@@ -55,6 +90,46 @@ def _speed_lines(ds, speed) -> list:
             "speed = \"estimate\""]
 
 
+def resolution_limits(bearing, rpm, duration_s) -> list:
+    """What a record of ``duration_s`` s cannot resolve at ``rpm`` r/min: the fault fundamentals (BPFO, BPFI)
+    that lie within two bins (1 / duration) of a shaft harmonic, where the line search cannot tell them apart
+    (:func:`bearing_lab.analysis._diagnosis.coincidences`).  Each entry: ``family``, ``text`` and
+    ``min_duration_s``, the shortest record that separates the two lines by two bins."""
+    from ..analysis._diagnosis import coincidences
+    from ..bearings import get_bearing
+    geo = get_bearing(bearing) if isinstance(bearing, str) else bearing
+    fr = float(rpm) / 60.0
+    out = []
+    for c in coincidences(geo.fault_frequencies(fr), fr, 1.0 / float(duration_s)):
+        if c["family"] in ("bpfo", "bpfi") and c["harmonic"] == 1 and c["near"] == "shaft" and "bins from" in c["text"]:
+            gap = abs(c["frequency_hz"] - c["order"] * fr)
+            out.append({"family": c["family"], "text": c["text"],
+                        "min_duration_s": 2.0 / gap if gap > 0 else float("inf")})
+    return out
+
+
+def _limit_lines(bearing, rpm, dur) -> list:
+    if not bearing or not rpm:
+        return []
+    try:
+        limits = resolution_limits(bearing, rpm, dur)
+    except Exception:        # an unknown catalog name is reported when the case loads
+        return []
+    lines = []
+    for lim in limits:
+        need = lim["min_duration_s"]
+        lines += [f"# NOTE: at {float(rpm):g} r/min this {dur:.4g} s record cannot resolve {lim['family'].upper()}: "
+                  f"{lim['text']}.", f"#   The {lim['family']} line, the excitation period and the impact rows "
+                  f"need a record of at least {need:.2g} s" + (" (the path fit needs the impact train too)."
+                                                             if lim["family"] == "bpfo" else ".")]
+    return lines
+
+
+def _seconds(v: float) -> str:
+    """``v`` s written so that it never rounds up past the record (4 decimals, floored)."""
+    return repr(math.floor(v * 1e4) / 1e4)
+
+
 def new_case_text(recording, *, name=None, bearing=None, speed=None, channel=None, fmt=None, case_dir=None) -> str:
     """The text of a starting case for ``recording`` (see the module docstring).
 
@@ -67,12 +142,15 @@ def new_case_text(recording, *, name=None, bearing=None, speed=None, channel=Non
     ch = channel or ds.attrs.get("default_channel") or next(iter(ds.data_vars))
     fs = float(ds.attrs["sampling_rate_hz"])
     dur = ds.sizes["time"] / fs
-    compared = min(1.0, round(dur / 2, 3)) if dur < 2 else 1.0
+    compared = compared_duration(dur)
     name = name or path.stem
+    rpm = float(speed) if speed is not None else ds.attrs.get("shaft_speed_rpm")
+    limits = _limit_lines(bearing, rpm, compared)
     lines = [f"# Validation case for {path.name}, written by bearing_lab {__version__} `case new`.",
              "# Every key is explained in docs/case-format.md.  What the file tells:",
-             f"#   reader {ds.attrs.get('reader')}, {fs:g} Hz, {ds.sizes['time']} samples ({dur:.4g} s)",
+             f"#   {_source(ds)}, {fs:g} Hz, {ds.sizes['time']} samples ({dur:.4g} s)",
              "#   channels:", *_channels(ds),
+             *limits,
              "# What it cannot tell (bearing, load, defect) is left for you below.",
              f"name = \"{name}\"", f"title = \"{path.name}: simulation against the recording\"",
              (f"bearing = \"{bearing}\"" if bearing else
@@ -82,7 +160,9 @@ def new_case_text(recording, *, name=None, bearing=None, speed=None, channel=Non
              f"channel = \"{ch}\"", *( [f"format = \"{fmt}\""] if fmt else []),
              "scale = 1.0                    # calibration factor on the SI values (1: the file is calibrated)",
              "start_s = 0.0                  # start of the compared segment, s",
-             f"duration_s = {float(compared):.1f}               # compared and simulated duration, s", "",
+             f"duration_s = {_seconds(compared)}{' ' * max(1, 17 - len(_seconds(compared)))}# compared and simulated "
+             f"duration, s: {'the whole record' if compared >= dur else 'the first %g s of the record' % compared}",
+             "",
              "# [reference]                  # a healthy recording of the same rig (optional): background, healthy rows",
              "# file = \"healthy.uff\"", "",
              "# [load]                       # the radial load you applied",
@@ -95,8 +175,10 @@ def new_case_text(recording, *, name=None, bearing=None, speed=None, channel=Non
              "# skew_deg = 0.0               # skew θ against the centre line",
              "# angle_deg = 0.0              # from the load-zone centre", "",
              "[structural_path]              # housing and sensor: fitted once on the impacts, then held fixed",
-             "method = \"fit\"", "frequency_hz = [500.0, %g]" % (0.45 * fs), "damping_ratio = [0.005, 0.5]",
-             "gain = [0.001, 1000.0]", "",
+             "method = \"fit\"                 # a resonance, or the gain alone when the recording shows none;",
+             "                               # \"none\": the bare model; \"fixed\": give the three values below",
+             "# frequency_hz = [500.0, %.1f]  # fit: search bounds (these are the defaults)" % (0.45 * fs),
+             "# damping_ratio = [0.005, 0.5]", "# gain = [0.001, 1000.0]", "",
              "[background]                   # the rig's tones and noise, measured, added to the simulation",
              "enabled = true", "",
              "[tolerances]                   # {} = the quantity's default tolerance and reason"]

@@ -100,6 +100,9 @@ def build_report(case, result, wall) -> Report:
     report = Report(f"Validation: {case.name}", subtitle=case.title)
     _overview(report, result.rows)
     _render_sections(report, result.sections)
+    # the page counts the case's rows, as summary.json, the index and the terminal do (a rows table shown
+    # twice, e.g. the healthy rows in their own section, is not counted twice)
+    report.rows = list(result.rows)
     from ..report import esc, table_html
     model = result.extra.get("model") or {}
     runs = model if model and all(isinstance(v, dict) for v in model.values()) else {"simulation": model}

@@ -164,7 +164,8 @@ def run_recording_case(case, *, steps, mirror=None) -> CaseResult:
     from .rig import background_for, path_for
     path = path_for(case, prep.recording, prep.measured["record"], prep.simulated["model"], mirror=mirror)
     reference = open_spec(case.reference, case.name, mirror) if case.reference is not None else None
-    background = background_for(case, prep.recording, prep.measured["record"], reference)
+    model = path.apply(prep.simulated["model"], prep.fs) if path.status in ("ok", "given") else None
+    background = background_for(case, prep.recording, prep.measured["record"], reference, model=model)
     steps.step("structural path and background")
     signals = simulate_signals(prep, path, background)
     sim_m = measure_signals(prep, signals)

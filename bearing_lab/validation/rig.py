@@ -190,14 +190,18 @@ def path_for(case, rec, measured, sim_x, *, mirror=None) -> StructuralPath:
     return path
 
 
-def background_for(case, rec, measured, reference=None):
-    """The rig's background (tones and broadband), or None when ``[background] enabled = false``."""
+def background_for(case, rec, measured, reference=None, *, model=None):
+    """The rig's background (tones and broadband), or None when ``[background] enabled = false``.
+
+    ``model``: the declared scene's signal through the path; measured on the recording itself, the
+    background is then what that model does not explain (its own power is removed, so a recording the
+    model explains fully gets no background added a second time)."""
     if not case.section("background").get("enabled", True):
         return None
-    return _measured_background(case, rec, measured, reference)
+    return _measured_background(case, rec, measured, reference, model=model)
 
 
-def _measured_background(case, rec, measured, reference):
+def _measured_background(case, rec, measured, reference, *, model=None):
     from ..analysis.background import estimate_background
     cfg = case.section("background")
     src = cfg.get("source", "auto")
@@ -223,6 +227,13 @@ def _measured_background(case, rec, measured, reference):
     rates = [measured[k] for k in ("bpfo", "bpfi") if np.isfinite(measured[k])]
     if times is None or len(times) < 3:
         times, where = None, "whole record (no impact train)"
+    extra = {}
+    if model is not None:
+        from ..analysis.impacts import impact_times
+        y = np.asarray(model, float)
+        mt = impact_times(y, rec.fs, period, band=measured["extras"]["band"]) if times is not None else None
+        extra = {"model": y, "model_times": mt}
+        where += ", less what the declared scene through the path explains"
     return estimate_background(rec.x, rec.fs, times=times, period=period if times is not None else None,
                                exclude_hz=rates, shaft_hz=fr,
-                               source=f"the recording {rec.path.name} ({rec.channel}), {where}", **opts)
+                               source=f"the recording {rec.path.name} ({rec.channel}), {where}", **opts, **extra)

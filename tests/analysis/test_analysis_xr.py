@@ -84,3 +84,16 @@ def test_envelope_wrappers(da):
     assert se.dims == da.dims and se.attrs["units"] == "(m s-2)2"
     bp = da.bearing.bandpass(band=(100, 2000))
     np.testing.assert_allclose(bp.values, ba.bandpass(da.values, 12000.0, band=(100, 2000)))
+
+
+def test_accessor_defaults_are_scipys(da):
+    import scipy.signal as ss
+    x = da.sel(channel="b")
+    f, ref = ss.welch(x.values, 12000.0)                # scipy's defaults: Hann, 256 samples, half overlap
+    p = x.bearing.welch_psd()
+    np.testing.assert_allclose(p.frequency.values, f)
+    np.testing.assert_allclose(p.values, ref, rtol=1e-6, atol=1e-12 * ref.max())
+    a = x.bearing.amplitude_spectrum()                  # periodogram's default: no window
+    line = float(a.sel(frequency=30.0))
+    assert line == pytest.approx(1.0, abs=0.02)         # the fundamental's amplitude, 1 m s-2
+    assert float(x.bearing.shaft_frequency()) == pytest.approx(30.0, abs=2e-3)
