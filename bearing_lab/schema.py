@@ -19,7 +19,8 @@ import numpy as np
 
 from .errors import BearingLabError
 
-SI_UNITS = {"m s-2", "m", "N", "Pa", "V", "m s-1", "1", "rad", "rad s-1", "K", "s"}
+SI_UNITS = {"m s-2", "m", "N", "Pa", "V", "m s-1", "1", "rad", "rad s-1", "K", "s",
+            "degree"}  # contact angles are named and given in degrees, as bearing catalogues give them
 
 #: the simulator's accelerometer signal (its Datasets' ``default_channel``)
 DEFAULT_CHANNEL = "outer_ring_acc_y"
@@ -35,6 +36,14 @@ SIMULATION_VARIABLES = {
     "inner_ring_disp_x": "m",
     "ball_load_outer": "N",
     "ball_load_inner": "N",
+}
+
+#: the 3-D bearing's extra variables (a scene with an axial load), checked where present
+SIMULATION_3D_VARIABLES = {
+    "outer_ring_acc_z": "m s-2",
+    "outer_ring_disp_z": "m",
+    "contact_angle_outer_deg": "degree",
+    "contact_angle_inner_deg": "degree",
 }
 
 
@@ -71,6 +80,9 @@ def check_dataset(ds, *, kind: str | None = None) -> None:
         for name, var in ds.data_vars.items():
             if "quantity" not in var.attrs:
                 problems.append(f"variable {name!r} has no 'quantity' attribute")
+        for name, units in SIMULATION_3D_VARIABLES.items():
+            if name in ds and ds[name].attrs.get("units") != units:
+                problems.append(f"{name!r} has units {ds[name].attrs.get('units')!r}, expected {units!r}")
         for name, units in SIMULATION_VARIABLES.items():
             if name not in ds:
                 problems.append(f"simulation variable {name!r} missing")

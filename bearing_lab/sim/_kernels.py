@@ -49,7 +49,13 @@ P_CDRAG = 52
 P_UNB = 53      # shaft unbalance U = m e (kg m): a force U omega^2 turning with the shaft on the inner ring
 P_DRATE = 54    # damping rate over a defect: 0 the bodies' approach rate, 1 the rate of the
                 # contact law's equivalent penetration (including the rolling term)
-P_SIZE = 55
+# the 3-D bearing (an axial load or preload): flag; index of the axial states (zi, zo, vzi, vzo,
+# then for multibody balls each ball's axial position and rate); groove curvature radius minus
+# ball radius, inner and outer (m); axial support stiffness and damping, inner and outer; the
+# axial springs' rest positions; the constant axial forces on the rings
+P_3D, P_ZOFF, P_AGI, P_AGO = 55, 56, 57, 58
+P_KZI, P_CZI, P_KZO, P_CZO, P_ZIR, P_ZOR, P_FIZ, P_FOZ = 59, 60, 61, 62, 63, 64, 65, 66
+P_SIZE = 67
 # after P_SIZE: cos(2 pi j / Z) for j < Z, then sin(2 pi j / Z) (ball offsets around the cage,
 # so the right-hand side rotates them with 4 products instead of calling cos/sin per ball)
 P_TRIG = P_SIZE
@@ -597,9 +603,237 @@ def _balls_dynamic(y, p, z, phic, theta_s, omega_s, dint, dflt, hbuf, gbuf, dy, 
     return fix, fiy, fox, foy, pocket_torque
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def _geom_outer(y, zb, j, z, c, s, phidot, pd4, ago):
+    """Ball j's outer contact in 3-D: the vector from the outer groove's curvature centre to the
+    ball centre (radial, axial), its length, and their rates (multibody balls)."""
+    ro = y[8 + j] - (y[4] * c + y[5] * s) - pd4 + ago
+    ro_r = y[8 + z + j] - (y[6] * c + y[7] * s) - (y[4] * (-s) + y[5] * c) * phidot
+    wb = zb + 4
+    zo = y[wb + j] - y[zb + 1]
+    zo_r = y[wb + z + j] - y[zb + 3]
+    return ro, zo, math.sqrt(ro * ro + zo * zo), ro_r, zo_r
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _geom_inner(y, zb, j, z, c, s, phidot, pd4, agi):
+    """Ball j's inner contact in 3-D: the vector from the ball centre to the inner groove's
+    curvature centre (radial, axial), its length, and their rates (multibody balls)."""
+    ri = (y[0] * c + y[1] * s) - y[8 + j] - pd4 + agi
+    ri_r = (y[2] * c + y[3] * s) + (y[0] * (-s) + y[1] * c) * phidot - y[8 + z + j]
+    wb = zb + 4
+    zi = y[zb] - y[wb + j]
+    zi_r = y[zb + 2] - y[wb + z + j]
+    return ri, zi, math.sqrt(ri * ri + zi * zi), ri_r, zi_r
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _balls_kinematic_3d(y, p, z, c0, s0, phic, phidot, theta_s, omega_s, dint, dflt, hbuf, gbuf, dy, fi_out,
+                        fo_out):
+    """Multibody balls in a kinematic cage, in 3-D: each ball has a radial and an axial position;
+    each contact acts along the line through the ball centre and its groove's curvature centre
+    (the contact angle), its approach measured along it.  Returns the ball forces on the inner
+    and outer ring (x, y, z)."""
+    pd4 = 0.25 * p[P_PD]
+    ko = p[P_KO]
+    ki = p[P_KI]
+    e = p[P_EXP]
+    cmax = p[P_CMAX]
+    dpen = p[P_DPEN]
+    inv_mb = 1.0 / p[P_MB]
+    rp = p[P_RP]
+    g = p[P_G]
+    agi = p[P_AGI]
+    ago = p[P_AGO]
+    zb = int(p[P_ZOFF])
+    wb = zb + 4
+    w2 = phidot * phidot
+    fix = 0.0
+    fiy = 0.0
+    fiz = 0.0
+    fox = 0.0
+    foy = 0.0
+    foz = 0.0
+    for j in range(z):
+        c, s = _ball_dir(p, z, j, c0, s0)
+        ro, zo, lo, ro_r, zo_r = _geom_outer(y, zb, j, z, c, s, phidot, pd4, ago)
+        ri, zi, li, ri_r, zi_r = _geom_inner(y, zb, j, z, c, s, phidot, pd4, agi)
+        fo = impact(lo - ago, (ro * ro_r + zo * zo_r) / lo, ko, e, cmax, dpen)
+        fi = impact(li - agi, (ri * ri_r + zi * zi_r) / li, ki, e, cmax, dpen)
+        fo_out[j] = fo
+        fi_out[j] = fi
+        dy[8 + j] = y[8 + z + j]
+        dy[8 + z + j] = (fi * ri / li - fo * ro / lo) * inv_mb + (rp + y[8 + j]) * w2 - g * s
+        dy[wb + j] = y[wb + z + j]
+        dy[wb + z + j] = (fi * zi / li - fo * zo / lo) * inv_mb
+        fix -= fi * ri / li * c
+        fiy -= fi * ri / li * s
+        fiz -= fi * zi / li
+        fox += fo * ro / lo * c
+        foy += fo * ro / lo * s
+        foz += fo * zo / lo
+    ndef = int(p[P_NDEF])
+    if ndef == 0:
+        return fix, fiy, fiz, fox, foy, foz
+    sp = TWO_PI / z
+    spin = p[P_SPIN]
+    for m in range(ndef):
+        kk = ndef - 1 - m
+        ja, jb, cnt = _zone_candidates(kk, z, phic, theta_s, dint, dflt)
+        outer = dint[kk, D_RACE] % 2 == 0
+        for q in range(cnt):
+            j = q if cnt == z else (ja if q == 0 else jb)
+            rel, reld = rel_angle(kk, j, phic + sp * j, phidot, theta_s, omega_s, spin, dint, dflt)
+            if not (dflt[kk, F_ZLO] <= rel <= dflt[kk, F_ZHI]):
+                continue
+            c, s = _ball_dir(p, z, j, c0, s0)
+            if outer:
+                ro, zo, lo, ro_r, zo_r = _geom_outer(y, zb, j, z, c, s, phidot, pd4, ago)
+                f = contact_force(kk, rel, reld, lo - ago, (ro * ro_r + zo * zo_r) / lo, ko, cmax, p, dint, dflt,
+                                  hbuf, gbuf)
+                df = f - fo_out[j]
+                fo_out[j] = f
+                fox += df * ro / lo * c
+                foy += df * ro / lo * s
+                foz += df * zo / lo
+                dy[8 + z + j] -= df * ro / lo * inv_mb
+                dy[wb + z + j] -= df * zo / lo * inv_mb
+            else:
+                ri, zi, li, ri_r, zi_r = _geom_inner(y, zb, j, z, c, s, phidot, pd4, agi)
+                f = contact_force(kk, rel, reld, li - agi, (ri * ri_r + zi * zi_r) / li, ki, cmax, p, dint, dflt,
+                                  hbuf, gbuf)
+                df = f - fi_out[j]
+                fi_out[j] = f
+                fix -= df * ri / li * c
+                fiy -= df * ri / li * s
+                fiz -= df * zi / li
+                dy[8 + z + j] += df * ri / li * inv_mb
+                dy[wb + z + j] += df * zi / li * inv_mb
+    return fix, fiy, fiz, fox, foy, foz
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _qs_geom(y, zb, c, s, phidot, pd4, a0):
+    """Massless ball in 3-D: the vector between the two grooves' curvature centres (radial,
+    axial), its length and their rates."""
+    rho = a0 - 2.0 * pd4 + (y[0] - y[4]) * c + (y[1] - y[5]) * s
+    rho_r = (y[2] - y[6]) * c + (y[3] - y[7]) * s + ((y[0] - y[4]) * (-s) + (y[1] - y[5]) * c) * phidot
+    zeta = y[zb] - y[zb + 1]
+    zeta_r = y[zb + 2] - y[zb + 3]
+    return rho, zeta, math.sqrt(rho * rho + zeta * zeta), rho_r, zeta_r
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _balls_quasi_static_3d(y, p, z, c0, s0, phic, phidot, theta_s, omega_s, dint, dflt, hbuf, gbuf, fi_out,
+                           fo_out):
+    """Massless balls in 3-D: the two contacts in series along the line through both grooves'
+    curvature centres (one contact angle per ball).  Returns the forces on the rings (x, y, z)."""
+    pd4 = 0.25 * p[P_PD]
+    keff = p[P_KEFF]
+    e = p[P_EXP]
+    cser = 0.5 * p[P_CMAX]
+    dpen = p[P_DPEN]
+    a0 = p[P_AGI] + p[P_AGO]
+    zb = int(p[P_ZOFF])
+    for j in range(z):
+        c, s = _ball_dir(p, z, j, c0, s0)
+        rho, zeta, ln, rho_r, zeta_r = _qs_geom(y, zb, c, s, phidot, pd4, a0)
+        q = impact(ln - a0, (rho * rho_r + zeta * zeta_r) / ln, keff, e, cser, dpen)
+        fi_out[j] = q
+        fo_out[j] = q
+    ndef = int(p[P_NDEF])
+    sp = TWO_PI / z
+    spin = p[P_SPIN]
+    for m in range(2 * ndef):
+        kk = ndef - 1 - (m % ndef)
+        if dint[kk, D_RACE] % 2 != (1 if m < ndef else 0):
+            continue
+        ja, jb, cnt = _zone_candidates(kk, z, phic, theta_s, dint, dflt)
+        for q in range(cnt):
+            j = q if cnt == z else (ja if q == 0 else jb)
+            rel, reld = rel_angle(kk, j, phic + sp * j, phidot, theta_s, omega_s, spin, dint, dflt)
+            if not (dflt[kk, F_ZLO] <= rel <= dflt[kk, F_ZHI]):
+                continue
+            c, s = _ball_dir(p, z, j, c0, s0)
+            rho, zeta, ln, rho_r, zeta_r = _qs_geom(y, zb, c, s, phidot, pd4, a0)
+            qd = _qs_ball(kk, rel, reld, ln - a0, (rho * rho_r + zeta * zeta_r) / ln, p, dint, dflt, hbuf, gbuf)
+            fi_out[j] = qd
+            fo_out[j] = qd
+    fix = 0.0
+    fiy = 0.0
+    fiz = 0.0
+    fox = 0.0
+    foy = 0.0
+    foz = 0.0
+    for j in range(z):
+        c, s = _ball_dir(p, z, j, c0, s0)
+        rho, zeta, ln, _, _ = _qs_geom(y, zb, c, s, phidot, pd4, a0)
+        fr = rho / ln
+        fz = zeta / ln
+        fix -= fi_out[j] * fr * c
+        fiy -= fi_out[j] * fr * s
+        fiz -= fi_out[j] * fz
+        fox += fo_out[j] * fr * c
+        foy += fo_out[j] * fr * s
+        foz += fo_out[j] * fz
+    return fix, fiy, fiz, fox, foy, foz
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _rhs_3d(t, y, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, dy, fi_out, fo_out):
+    """dy/dt of the 3-D bearing (rings with an axial translation, contact angles)."""
+    z = int(p[P_Z])
+    xi, yi, vxi, vyi = y[0], y[1], y[2], y[3]
+    xo, yo, vxo, vyo = y[4], y[5], y[6], y[7]
+    zb = int(p[P_ZOFF])
+    theta_s, omega_s = shaft_state(t, sp_t, sp_w, sp_th)
+    phic = p[P_PHI0] + p[P_FTF] * theta_s
+    phidot = p[P_FTF] * omega_s
+    if p[P_FID] > 0.5:
+        fix, fiy, fiz, fox, foy, foz = _balls_quasi_static_3d(y, p, z, math.cos(phic), math.sin(phic), phic, phidot,
+                                                              theta_s, omega_s, dint, dflt, hbuf, gbuf, fi_out, fo_out)
+    else:
+        fix, fiy, fiz, fox, foy, foz = _balls_kinematic_3d(y, p, z, math.cos(phic), math.sin(phic), phic, phidot,
+                                                           theta_s, omega_s, dint, dflt, hbuf, gbuf, dy, fi_out,
+                                                           fo_out)
+    if t >= p[P_TSTEP]:
+        lix, liy, lox, loy = p[P_FIX2], p[P_FIY2], p[P_FOX2], p[P_FOY2]
+    else:
+        lix, liy, lox, loy = p[P_FIX], p[P_FIY], p[P_FOX], p[P_FOY]
+    if p[P_UNB] > 0.0:
+        fu = p[P_UNB] * omega_s * omega_s
+        lix += fu * math.cos(theta_s)
+        liy += fu * math.sin(theta_s)
+    axo = (fox - p[P_KMX] * (xo - p[P_XOR]) - p[P_CMX] * vxo + lox) / p[P_MO]
+    ayo = (foy - p[P_KMY] * (yo - p[P_YOR]) - p[P_CMY] * vyo + loy) / p[P_MO]
+    dy[0] = vxi
+    dy[1] = vyi
+    dy[2] = (fix - p[P_KSX] * (xi - p[P_XIR]) - p[P_CSX] * vxi + lix) / p[P_MI]
+    dy[3] = (fiy - p[P_KSY] * (yi - p[P_YIR]) - p[P_CSY] * vyi + liy) / p[P_MI]
+    dy[4] = vxo
+    dy[5] = vyo
+    dy[6] = axo
+    dy[7] = ayo
+    dy[zb] = y[zb + 2]
+    dy[zb + 1] = y[zb + 3]
+    dy[zb + 2] = (fiz - p[P_KZI] * (y[zb] - p[P_ZIR]) - p[P_CZI] * y[zb + 2] + p[P_FIZ]) / p[P_MI]
+    dy[zb + 3] = (foz - p[P_KZO] * (y[zb + 1] - p[P_ZOR]) - p[P_CZO] * y[zb + 3] + p[P_FOZ]) / p[P_MO]
+    if p[P_SENS] > 0.5:
+        sb = int(p[P_SENSOFF])
+        w = p[P_SW]
+        zt = p[P_SZ]
+        dy[sb] = y[sb + 2]
+        dy[sb + 1] = y[sb + 3]
+        dy[sb + 2] = -2.0 * zt * w * y[sb + 2] - w * w * y[sb] - axo
+        dy[sb + 3] = -2.0 * zt * w * y[sb + 3] - w * w * y[sb + 1] - ayo
+
+
 @njit(cache=True, error_model="numpy", **NO_REFCOUNT)
 def rhs(t, y, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, dy, fi_out, fo_out):
     """dy/dt of the bearing model; also writes the ball loads into fi_out/fo_out."""
+    if p[P_3D] > 0.5:
+        _rhs_3d(t, y, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, dy, fi_out, fo_out)
+        return
     z = int(p[P_Z])
     xi, yi, vxi, vyi = y[0], y[1], y[2], y[3]
     xo, yo, vxo, vyo = y[4], y[5], y[6], y[7]

@@ -15,6 +15,7 @@ from scipy.optimize import brentq, root
 
 from ..errors import SceneError, SolverError, check_choice
 from . import _kernels as K
+from .bearing3d import groove_offsets, needs_3d, static_equilibrium_3d
 from .hertz import race_contact, series_stiffness
 from .scene import Scene
 
@@ -231,7 +232,28 @@ def choose_contact_model(defect, requested: str, bearing) -> str:
     return "halfspace"
 
 
-def _defect_tables(scene: Scene, lz: float, delta_max: float, material, delta_top=None):
+def _track_offset(defect, st, race, psi0, bearing):
+    """The defect as the contact meets it in the 3-D bearing: the groove's cross-section turned
+    about its curvature centre by the contact angle at the defect's position, so that the table,
+    built for a ball at the groove bottom, sees the outline where the contact track really runs.
+    The defect's centre at axial offset H (groove angle asin(H / r_g)) moves to r_g sin(asin(H /
+    r_g) - alpha); the along-track radius change ((1 - cos alpha) r_g / R, 0.2 % at 10 deg) is
+    neglected."""
+    import dataclasses
+    a_i, a_o = groove_offsets(bearing)
+    if race == "outer":
+        r_g = a_o + bearing.ball_diameter / 2
+        alpha = float(np.interp(psi0 % (2 * math.pi), np.sort(st["phis"] % (2 * math.pi)),
+                                st["alpha_o"][np.argsort(st["phis"] % (2 * math.pi))], period=2 * math.pi))
+    else:
+        # a rotating (inner-race) defect: the angle of the most loaded ball
+        r_g = a_i + bearing.ball_diameter / 2
+        alpha = -float(st["alpha_i"][int(np.argmax(st["ball_loads_inner"]))])
+    beta = math.asin(max(-1.0, min(1.0, defect.offset / r_g)))
+    return dataclasses.replace(defect, offset=r_g * math.sin(beta - alpha)), alpha
+
+
+def _defect_tables(scene: Scene, lz: float, delta_max: float, material, delta_top=None, st3d=None):
     """Each defect's contact table, packed for the kernels: a ball defect gets one table per
     race it meets.  Returns (models, tables, entries, dint, dflt, hbuf, gbuf, table_time_s)."""
     import dataclasses
@@ -257,6 +279,8 @@ def _defect_tables(scene: Scene, lz: float, delta_max: float, material, delta_to
     hoff = goff = 0
     t_tables = time.perf_counter()
     for kk, (code, dfc, psi0, ball, model) in enumerate(entries):
+        if st3d is not None and code < 2:
+            dfc, _ = _track_offset(dfc, st3d, dfc.race, psi0, b)
         # the loaded range above the deepest drop: a ball that falls into the defect is
         # loaded there, and reads computed values, not an extrapolation
         top = None if delta_top is None else delta_top[kk]
@@ -393,7 +417,37 @@ def _parameters(scene: Scene, fid, st, hi, ho, k_eff, masses, loads, ftf, phi_c0
     p[K.P_IB] = 0.4 * m_b * (b.ball_diameter / 2) ** 2
     p[K.P_NDEF] = n_defects
     p[K.P_SPIN] = b.frequency_factors()["bsf"]
+    if "zi" in st:
+        a_i, a_o = groove_offsets(b)
+        p[K.P_3D] = 1.0
+        p[K.P_AGI], p[K.P_AGO] = a_i, a_o
+        from .bearing3d import _axial
+        p[K.P_KZI], p[K.P_CZI] = _axial(d["shaft"])
+        p[K.P_KZO], p[K.P_CZO] = _axial(d["mount"])
+        p[K.P_ZIR], p[K.P_ZOR] = st["rest_zi"], st["rest_zo"]
+        p[K.P_FIZ], p[K.P_FOZ] = st["f_inz"], st["f_outz"]
     return p, dyn
+
+
+def _axial_states(scene, st, p, fid, y0, atol):
+    """The 3-D bearing's extra states after the planar ones: zi, zo, their rates, then (multibody)
+    each ball's axial position and rate; the balls' radial positions from the 3-D equilibrium."""
+    z = scene.bearing.n_balls
+    zb = y0.size
+    p[K.P_ZOFF] = zb
+    extra = 4 + (2 * z if fid != "quasi-static" else 0)
+    y = np.concatenate([y0, np.zeros(extra)])
+    a = np.concatenate([atol, np.zeros(extra)])
+    y[zb], y[zb + 1] = st["zi"], st["zo"]
+    x_scale, v_scale = atol[0], atol[2]
+    a[zb:zb + 2] = x_scale
+    a[zb + 2:zb + 4] = v_scale
+    if fid != "quasi-static":
+        y[8:8 + z] = st["q"]
+        y[zb + 4:zb + 4 + z] = st["w"]
+        a[zb + 4:zb + 4 + z] = x_scale
+        a[zb + 4 + z:zb + 4 + 2 * z] = v_scale
+    return y, a
 
 
 def assemble(scene: Scene, *, fidelity: str | None = None, delta_top=None) -> Assembly:
@@ -422,9 +476,18 @@ def assemble(scene: Scene, *, fidelity: str | None = None, delta_top=None) -> As
     phi_c0 = lz
     _, rpm0 = scene.speed_profile()
     omega_c0 = ftf * rpm0[0] * 2 * math.pi / 60
-    st = static_equilibrium(scene, phi_c0, hi.stiffness, ho.stiffness,
-                            ball_mass=0.0 if fid == "quasi-static" else m_b, omega_cage=omega_c0,
-                            exponent=d["contact"]["exponent"])
+    three_d = needs_3d(scene)
+    if three_d:
+        if d["cage"]["model"] == "dynamic":
+            raise SceneError("load.axial_n: the 3-D bearing runs with the kinematic cage only (cage.model = "
+                             "'kinematic'); the dynamic cage is planar")
+        st = static_equilibrium_3d(scene, phi_c0, hi.stiffness, ho.stiffness,
+                                   ball_mass=0.0 if fid == "quasi-static" else m_b, omega_cage=omega_c0,
+                                   exponent=d["contact"]["exponent"])
+    else:
+        st = static_equilibrium(scene, phi_c0, hi.stiffness, ho.stiffness,
+                                ball_mass=0.0 if fid == "quasi-static" else m_b, omega_cage=omega_c0,
+                                exponent=d["contact"]["exponent"])
 
     # speed profile (rad/s), shaft angle at the nodes
     sp_t, rpm = scene.speed_profile()
@@ -454,12 +517,15 @@ def assemble(scene: Scene, *, fidelity: str | None = None, delta_top=None) -> As
     # defects -> tables (a ball defect gets one table per race it meets)
     static_max = float(np.max(st["ball_loads"])) if len(st["ball_loads"]) else 0.0
     models, tables, entries, dint, dflt, hbuf, gbuf, table_time = _defect_tables(
-        scene, lz, max(3.0 * (max(static_max, 50.0) / ho.stiffness) ** (2 / 3), 5e-6), (E, nu), delta_top)
+        scene, lz, max(3.0 * (max(static_max, 50.0) / ho.stiffness) ** (2 / 3), 5e-6), (E, nu), delta_top,
+        st if three_d else None)
 
     p, dyn = _parameters(scene, fid, st, hi, ho, k_eff, (m_i, m_o, m_b), (tstep, f_in2, f_out2, g),
                          ftf, phi_c0, len(entries))
     y0, atol = _initial_state(scene, st, p, fid, dyn, hi, ho, k_eff, m_b, g, ftf * sp_w[0], phi_c0,
                               static_max)
+    if three_d:
+        y0, atol = _axial_states(scene, st, p, fid, y0, atol)
     return Assembly(scene, p, np.ascontiguousarray(sp_t, dtype=float), np.ascontiguousarray(sp_w),
                     np.ascontiguousarray(sp_th), dint, dflt, hbuf, gbuf, y0, atol, z, fid,
                     tuple(models), tuple(tables), st, lz, hi, ho, table_time)

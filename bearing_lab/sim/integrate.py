@@ -95,15 +95,22 @@ def _run(asm, method, rtol, *, progress, t_end_override=None, step=None, max_ste
     n_fine = m_pad + (n_out - 1) * R + m_pad + 1
     n = asm.y0.size
     z = asm.n_balls
-    vel_idx = np.full((2, 2), -1, dtype=np.int64)
-    vel_sign = np.ones((2, 2))
+    three_d = asm.p[K.P_3D] > 0.5
+    zb = int(asm.p[K.P_ZOFF])
+    vel_idx = np.full((3 if three_d else 2, 2), -1, dtype=np.int64)
+    vel_sign = np.ones((3 if three_d else 2, 2))
     vel_idx[0, 0], vel_idx[1, 0] = 6, 7
+    if three_d:
+        vel_idx[2, 0] = zb + 3      # the outer ring's axial velocity (no sensor model along the axis)
     if d["sensor"]["enabled"]:
         sb = asm.sensor_index
         vel_idx[0, 1], vel_idx[1, 1] = sb + 2, sb + 3
     out_t_all = t0 + np.arange(n_out) / fs
     acc = np.zeros((n_out, 2))
     disp = np.zeros((n_out, 4))
+    acc_z = np.zeros((n_out, 2)) if three_d else None
+    disp_z = np.zeros(n_out) if three_d else None
+    angles = np.zeros((2, z, n_out)) if three_d else None
     dyn = d["cage"]["model"] == "dynamic"
     cage_idx = 8 + 5 * z + 1
     cage_speed = np.zeros(n_out) if dyn else None
@@ -128,7 +135,7 @@ def _run(asm, method, rtol, *, progress, t_end_override=None, step=None, max_ste
     m_next = 0                      # next fine velocity index to produce
     o_next = 0                      # next output index whose state is produced
     k_acc = 0                       # next output index whose acceleration is computed
-    v_buf = np.zeros((0, 2))        # fine velocities [v_start, m_next)
+    v_buf = np.zeros((0, vel_idx.shape[0]))  # fine velocities [v_start, m_next)
     v_start = 0
     args = (asm.p, asm.sp_t, asm.sp_w, asm.sp_th, asm.dint, asm.dflt, asm.hbuf, asm.gbuf)
     work = S.work_arrays(n, z)      # the loop's stage derivatives, state vectors and ball loads
@@ -146,7 +153,7 @@ def _run(asm, method, rtol, *, progress, t_end_override=None, step=None, max_ste
             while m_hi > m_next and base + (m_hi - 1 - 0.5) * dt_f > t_stop:
                 m_hi -= 1
             fine_t = base + (np.arange(m_next, max(m_hi, m_next)) - 0.5) * dt_f
-            fine_out = np.zeros((fine_t.size, 2))
+            fine_out = np.zeros((fine_t.size, vel_idx.shape[0]))
             o_hi = o_next
             while o_hi < n_out and out_t_all[o_hi] <= t_stop:
                 o_hi += 1
@@ -163,6 +170,9 @@ def _run(asm, method, rtol, *, progress, t_end_override=None, step=None, max_ste
             # states at the output samples of this chunk: displacements and ball loads
             if out_t.size:
                 disp[o_next:o_hi] = out_state[:, [0, 1, 4, 5]]
+                if three_d:
+                    disp_z[o_next:o_hi] = out_state[:, zb + 1]
+                    angles[:, :, o_next:o_hi] = _contact_angles(asm, out_t, out_state)
                 if dyn:
                     cage_speed[o_next:o_hi] = out_state[:, cage_idx]
                 if loads:
@@ -178,6 +188,8 @@ def _run(asm, method, rtol, *, progress, t_end_override=None, step=None, max_ste
             if k_hi > k_acc:
                 s0 = m_pad + k_acc * R - half - v_start
                 S.fir_decimate(a_fine, taps_rev, s0, R, acc[k_acc:k_hi])
+                if three_d:
+                    S.fir_decimate(np.ascontiguousarray(a_fine[:, [2, 2]]), taps_rev, s0, R, acc_z[k_acc:k_hi])
                 k_acc = k_hi
             # drop the velocities no later output needs; v_buf[0] is always fine index v_start
             drop = min(max(m_pad + k_acc * R - half - v_start, 0), v_buf.shape[0])
@@ -192,7 +204,21 @@ def _run(asm, method, rtol, *, progress, t_end_override=None, step=None, max_ste
     if t_end_override is None and (k_acc != n_out or o_next != n_out):
         raise SolverError(f"scene {scene.name!r}: output incomplete ({k_acc}/{o_next} of {n_out} samples)")
     return dict(acc=acc, disp=disp, fi=fi_all, fo=fo_all, out_t=out_t_all, cage_speed=cage_speed, taps=taps, R=R,
+                acc_z=None if acc_z is None else acc_z[:, 0], disp_z=disp_z, angles=angles,
                 m_pad=m_pad, n_out=n_out, stats=stats, dt_f=dt_f, t0=t0, t_end=t_end)
+
+
+def _contact_angles(asm, out_t, out_state):
+    """(2, Z, n) contact angles (deg) at the outer and inner race from output states: positive when
+    the load line leans as under a +Z force on the outer ring (see :mod:`.bearing3d`)."""
+    from .bearing3d import contact_angles, groove_offsets
+    p, z = asm.p, asm.n_balls
+    theta = np.array([K.shaft_state(t, asm.sp_t, asm.sp_w, asm.sp_th)[0] for t in out_t])
+    phis = (p[K.P_PHI0] + p[K.P_FTF] * theta)[:, None] + 2 * np.pi * np.arange(z)[None, :] / z
+    a_i, a_o = groove_offsets(asm.scene.bearing)
+    ao, ai = contact_angles(out_state, phis, zoff=int(p[K.P_ZOFF]), pd=p[K.P_PD], a_i=a_i, a_o=a_o,
+                            multibody=p[K.P_FID] < 0.5, z=z)
+    return np.stack([-ao, -ai])
 
 
 def _decimate_acc(res):
@@ -327,6 +353,14 @@ def simulate(scene, *, fidelity: str | None = None, duration: float | None = Non
         },
         coords=coords,
     )
+    if res["angles"] is not None:
+        ds["outer_ring_acc_z"] = v(res["acc_z"], "m s-2", "outer-ring acceleration Z (along the axis)")
+        ds["outer_ring_disp_z"] = v(res["disp_z"], "m", "outer-ring displacement Z (along the axis)")
+        for k, race in enumerate(("outer", "inner")):
+            ds[f"contact_angle_{race}_deg"] = (("ball", "time"), res["angles"][k], {
+                "units": "degree", "quantity": "angle",
+                "long_name": f"ball-{race} race contact angle (positive: the load line leans as under a +Z "
+                             "force on the outer ring)"})
     if res["cage_speed"] is not None:
         ds["cage_speed"] = (("time",), res["cage_speed"], {"units": "rad s-1", "long_name": "cage angular speed",
                                                            "quantity": "angular velocity"})
@@ -356,6 +390,8 @@ def simulate(scene, *, fidelity: str | None = None, duration: float | None = Non
         "fidelity_requested": sc.fidelity,
         "auto_choice": (choice["reason"] + f"; kind {choice['kind']}; expected peak-acceleration error "
                         f"{choice['expected_peak_error']}") if "auto" in (sc.fidelity, d["solver"]["method"]) else "",
+        "bearing_model": (f"3-D: axial load {float(d['load']['axial_n']):g} N, contact angles and axial ring "
+                          "motion" if res["angles"] is not None else "planar (no axial load)"),
         "defect_table_top_um": ",".join(f"{1e6 * t.delta_max:.4g}" for t in asm.tables) if asm.tables else "none",
         "defect_table_reach_um": (",".join(f"{1e6 * asm.dflt[k, K.F_REACH]:.4g}" for k in range(len(asm.tables)))
                                   if asm.tables else "none"),

@@ -48,6 +48,9 @@ SCHEMA: dict[str, dict[str, tuple]] = {
         "stiffness_y_n_m": (1e8, _NUM, "pos", "inner ring to ground, Y"),
         "damping_x_n_s_m": (1e3, _NUM, "nonneg", "inner ring to ground, X"),
         "damping_y_n_s_m": (1e3, _NUM, "nonneg", "inner ring to ground, Y"),
+        "stiffness_z_n_m": (None, _NUM, "pos", "inner ring to ground along the axis (3-D bearing only); "
+                            "default: the Y value"),
+        "damping_z_n_s_m": (None, _NUM, "nonneg", "inner ring to ground along the axis; default: the Y value"),
         "unbalance_g_mm": (130.0, _NUM, "nonneg",
                            "residual unbalance U = m e turning with the shaft (a force U omega^2 on the inner "
                            "ring): 130 g mm is ISO 21940-11 grade G2.5 for a 10 kg rotor share at 1800 r/min "
@@ -58,6 +61,9 @@ SCHEMA: dict[str, dict[str, tuple]] = {
         "stiffness_y_n_m": (1e8, _NUM, "pos", "outer-ring bushing to ground, Y"),
         "damping_x_n_s_m": (1e3, _NUM, "nonneg", "outer-ring bushing, X"),
         "damping_y_n_s_m": (1e3, _NUM, "nonneg", "outer-ring bushing, Y"),
+        "stiffness_z_n_m": (None, _NUM, "pos", "outer-ring bushing along the axis (3-D bearing only); "
+                            "default: the Y value"),
+        "damping_z_n_s_m": (None, _NUM, "nonneg", "outer-ring bushing along the axis; default: the Y value"),
     },
     "speed": {
         "rpm": (1800.0, _NUM, "nonneg", "constant shaft (inner ring) speed"),
@@ -65,6 +71,8 @@ SCHEMA: dict[str, dict[str, tuple]] = {
     },
     "load": {
         "radial_n": (150.0, _NUM, "nonneg", "radial load magnitude"),
+        "axial_n": (0.0, _NUM, "any", "constant axial force on the loaded ring, N, along +Z (a thrust or a "
+                    "spring preload); non-zero runs the 3-D bearing (contact angles, axial ring motion)"),
         "direction_deg": (270.0, _NUM, "any", "direction of the force on the ring (270 = -Y, downward)"),
         "on": ("outer", str, ("inner", "outer"), "ring the load is applied to"),
         "path": ("bearing", str, ("bearing", "springs"), "see module docs: who carries the static load"),

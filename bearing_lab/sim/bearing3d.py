@@ -1,0 +1,258 @@
+"""The 3-D bearing: rings that also move axially, and contacts at their real contact angle.
+
+Why: under an axial load (a thrust, or a motor's wave-spring preload) a deep-groove ball bearing
+runs at a contact angle.  Each contact then acts along the line through the ball centre and the
+groove's curvature centre, its approach is measured along that line, and the contact point moves
+across the groove by ``r_g sin(alpha)`` (about 1.1-1.3 mm on the 6308 at 300-500 N, more than the
+width of the paper's defects).  The planar model cannot represent any of this, so a scene with an
+axial load runs this model; a scene without one runs the planar model, unchanged.
+
+Geometry (exact, rigid rings, Harris & Kotzalas 2007, ch. 1-3): in the plane of ball j (azimuth
+``phi_j``), with ``u = x cos(phi_j) + y sin(phi_j)`` a ring's radial displacement there and ``z``
+its axial one, the outer groove's curvature centre sits at radius ``d_m/2 + P_d/4 + D_b/2 - r_go
++ u_o``, the inner one's at ``d_m/2 - P_d/4 - D_b/2 + r_gi + u_i``.  A ball whose centre is at
+radius ``d_m/2 + q`` and axial position ``w``:
+
+* outer contact: vector from the curvature centre to the ball centre ``(rho_o, zeta_o) = (q - u_o
+  - P_d/4 + a_o, w - z_o)`` with ``a_o = r_go - D_b/2``; approach ``|.| - a_o``; contact angle
+  ``atan2(zeta_o, rho_o)``;
+* inner contact: vector from the ball centre to the curvature centre ``(rho_i, zeta_i) = (u_i - q -
+  P_d/4 + a_i, z_i - w)``, ``a_i = r_gi - D_b/2``; approach ``|.| - a_i``.
+
+The load is ``K delta^1.5`` (Hertz, each race's own constant) along the line; a ball with mass
+carries its centrifugal force ``m_b (d_m/2 + q) omega_c^2`` radially, so at speed the outer contact
+angle is smaller than the inner one (Jones; Harris & Kotzalas 2007, ch. 3).  A massless ball
+(quasi-static fidelity) has one line through both curvature centres: ``(rho, zeta) = (a_i + a_o -
+P_d/2 + u_i - u_o, z_i - z_o)``, approach ``|.| - (a_i + a_o)``, the same angle at both races.
+
+With ``rho`` along the radius and ``zeta`` along the axis, an axial load reaches zero contact
+angle only at zero load: the planar model is this model's limit ``zeta = 0``, which it computes
+with fewer operations (and so the planar scenes keep their results to the last bit).
+
+Public API
+----------
+needs_3d(scene) -> bool                       -- the scene has an axial load
+static_equilibrium_3d(scene, phi_c0, k_in, k_out, *, ball_mass, omega_cage, exponent) -> dict
+contact_angles(...)                           -- per ball, from states (see :func:`contact_angles`)
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.optimize import root
+
+from ..errors import SceneError, SolverError
+
+__all__ = ["needs_3d", "static_equilibrium_3d", "contact_angles", "groove_offsets"]
+
+
+def needs_3d(scene) -> bool:
+    """True when the scene loads the bearing axially (``load.axial_n`` not zero)."""
+    return abs(float(scene.data["load"].get("axial_n") or 0.0)) > 0.0
+
+
+def groove_offsets(bearing):
+    """``(a_i, a_o)``: groove curvature radius minus ball radius, inner and outer race (m)."""
+    db = bearing.ball_diameter
+    return (bearing.inner_conformity - 0.5) * db, (bearing.outer_conformity - 0.5) * db
+
+
+def _unit(angle):
+    return np.array([math.cos(angle), math.sin(angle)])
+
+
+def _hz(k, d, e):
+    return k * max(d, 0.0) ** e
+
+
+def _ball_multibody(u_i, z_i, u_o, z_o, fc, pd4, a_i, a_o, k_in, k_out, e, guess):
+    """Ball centre (q, w) where its two contact forces and its body force ``fc`` (radial) balance."""
+    def parts(x):
+        q, w = x
+        ro, zo = q - u_o - pd4 + a_o, w - z_o
+        ri, zi = u_i - q - pd4 + a_i, z_i - w
+        lo, li = math.hypot(ro, zo), math.hypot(ri, zi)
+        fo, fi = _hz(k_out, lo - a_o, e), _hz(k_in, li - a_i, e)
+        return fo, fi, ro, zo, lo, ri, zi, li
+
+    def res(xs):
+        fo, fi, ro, zo, lo, ri, zi, li = parts(xs * 1e-6)
+        return [(fi * ri / li - fo * ro / lo + fc) / scale, (fi * zi / li - fo * zo / lo) / scale]
+    scale = max(abs(fc), 1.0)
+    if guess is None:
+        # on the line through both curvature centres, the approach split as the two stiffnesses ask
+        co = np.array([u_o + pd4 - a_o, z_o])
+        ci = np.array([u_i - pd4 + a_i, z_i])
+        ln = float(np.hypot(*(ci - co)))
+        tot = max(ln - a_i - a_o, 0.0)
+        share = 1.0 / (1.0 + (k_out / k_in) ** (1.0 / e))
+        guess = co + (ci - co) / ln * (a_o + tot * share)
+    sol = root(res, np.asarray(guess) * 1e6, method="hybr", options={"xtol": 1e-13})
+    return sol.x * 1e-6, parts(sol.x * 1e-6)
+
+
+def ball_forces(e_vec, phis, *, k_in, k_out, pd, a_i, a_o, exponent, ball_mass, omega_cage, g, pitch_radius,
+                guesses=None):
+    """Balls between rings displaced by ``e_vec = (inner - outer)`` (x, y, z), outer ring at the origin.
+
+    Returns ``(force on inner ring (3,), force on outer ring (3,), Q_i (Z,), Q_o (Z,), alpha_i, alpha_o
+    (Z, rad), q (Z,), w (Z,))``: q, w the ball centres relative to the outer ring (radial, axial)."""
+    z = len(phis)
+    pd4 = pd / 4
+    f_i, f_o = np.zeros(3), np.zeros(3)
+    qi, qo, ai, ao, qq, ww = (np.zeros(z) for _ in range(6))
+    for j, phi in enumerate(phis):
+        c, s = math.cos(phi), math.sin(phi)
+        u = e_vec[0] * c + e_vec[1] * s
+        if ball_mass > 0:
+            fc = ball_mass * (pitch_radius * omega_cage ** 2 - g * s)
+            guess = guesses[j] if guesses is not None else None
+            (q, w), (fo, fi, ro, zo, lo, ri, zi, li) = _ball_multibody(u, e_vec[2], 0.0, 0.0, fc, pd4, a_i, a_o,
+                                                                       k_in, k_out, exponent, guess)
+            nri, nzi, nro, nzo = ri / li, zi / li, ro / lo, zo / lo
+        else:
+            rho, zeta = a_i + a_o - 2 * pd4 + u, e_vec[2]
+            ln = math.hypot(rho, zeta)
+            k_eff = (k_in ** (-1 / exponent) + k_out ** (-1 / exponent)) ** (-exponent)
+            fi = fo = _hz(k_eff, ln - a_i - a_o, exponent)
+            nri = nro = rho / ln
+            nzi = nzo = zeta / ln
+            q, w = u / 2, zeta / 2
+        f_i -= fi * np.array([nri * c, nri * s, nzi])
+        f_o += fo * np.array([nro * c, nro * s, nzo])
+        qi[j], qo[j] = fi, fo
+        ai[j], ao[j] = math.atan2(nzi, nri), math.atan2(nzo, nro)
+        qq[j], ww[j] = q, w
+    return f_i, f_o, qi, qo, ai, ao, qq, ww
+
+
+def static_equilibrium_3d(scene, phi_c0, k_in, k_out, *, ball_mass=0.0, omega_cage=0.0, exponent=1.5) -> dict:
+    """Static equilibrium of the 3-D bearing at the start of a run (no defects).
+
+    Load path "bearing": the loaded ring's supports (radial and axial) are preloaded so that they
+    carry nothing at the start: the bearing carries the whole load.  Path "springs": every support
+    spring is unstressed at the centre.  Returns the keys of the planar ``static_equilibrium``
+    (x, y parts) plus ``zi``, ``zo``, ``rest_zi``, ``rest_zo``, ``f_inz``, ``f_outz``, the balls'
+    ``q``, ``w`` (absolute, m) and contact angles ``alpha_i``, ``alpha_o`` (rad).
+    """
+    d = scene.data
+    b = scene.bearing
+    z = b.n_balls
+    m_i, m_o, _ = scene.masses()
+    g = d["gravity"]["g_m_s2"] if d["gravity"]["enabled"] else 0.0
+    radial = d["load"]["radial_n"] * _unit(math.radians(d["load"]["direction_deg"]))
+    axial = float(d["load"]["axial_n"] or 0.0)
+    on_outer = d["load"]["on"] == "outer"
+    load = np.array([radial[0], radial[1], axial])
+    grav = np.array([0.0, -g, 0.0])
+    f_in = m_i * grav + (0.0 if on_outer else load)
+    f_out = m_o * grav + (load if on_outer else 0.0)
+    ks = np.array([d["shaft"]["stiffness_x_n_m"], d["shaft"]["stiffness_y_n_m"], _axial(d["shaft"])[0]])
+    km = np.array([d["mount"]["stiffness_x_n_m"], d["mount"]["stiffness_y_n_m"], _axial(d["mount"])[0]])
+    a_i, a_o = groove_offsets(b)
+    if a_i <= 0 or a_o <= 0:
+        raise SceneError(f"bearing {b.name!r}: an axial load needs groove conformities above 0.5 "
+                         f"(inner {b.inner_conformity:g}, outer {b.outer_conformity:g})")
+    pd = scene.clearance
+    phis = phi_c0 + 2 * math.pi * np.arange(z) / z
+    kw = dict(k_in=k_in, k_out=k_out, pd=pd, a_i=a_i, a_o=a_o, exponent=exponent, ball_mass=ball_mass,
+              omega_cage=omega_cage, g=g, pitch_radius=b.pitch_diameter / 2)
+    k_eff = (k_in ** (-1 / exponent) + k_out ** (-1 / exponent)) ** (-exponent)
+    # scale: the deflection of one ball carrying the whole load, plus the clearance
+    scale = pd / 2 + (max(float(np.linalg.norm(load)), 1.0) / k_eff) ** (1 / exponent) * 4
+    a0 = a_i + a_o
+    # start: the axial play taken up (rigid rings, no load) plus a deflection, e = inner - outer
+    sgn = -1.0 if on_outer else 1.0
+    dr = _unit(math.radians(d["load"]["direction_deg"])) * (0.25 * scale if d["load"]["radial_n"] else 0.0)
+    e0 = sgn * np.array([dr[0], dr[1], math.copysign(a0 * math.sin(_axial_angle(abs(axial), z, k_eff, a0, pd,
+                                                                                exponent)), axial)
+                         if axial else 0.0])
+    path = d["load"]["path"]
+
+    def forces(e):
+        return ball_forces(e, phis, **kw)
+
+    if path == "bearing":
+        def resid(e):
+            fi, fo = forces(e)[:2]
+            return ((fo + f_out) if on_outer else (fi + f_in)) / max(float(np.linalg.norm(load)), 1.0)
+    else:
+        def resid(e):
+            fi, fo = forces(e)[:2]
+            xi, xo = (fi + f_in) / ks, (fo + f_out) / km
+            return (xi - xo - e) / scale
+    # unknowns in units of their expected size (the axial one can be 10-100 times the radial one)
+    unit = np.array([scale, scale, max(abs(e0[2]), scale)])
+    best = None
+    for start in (e0, e0 * np.array([1.0, 1.0, 1.5]), e0 * np.array([2.0, 2.0, 0.8])):
+        sol = root(lambda x: resid(x * unit), start / unit, method="hybr", options={"xtol": 1e-15})
+        r = np.max(np.abs(resid(sol.x * unit)))
+        if best is None or r < best[1]:
+            best = (sol, r)
+        if r <= 1e-9:
+            break
+    sol, r = best
+    if not np.all(np.isfinite(sol.x)) or r > 1e-8:
+        raise SolverError(f"scene {scene.name!r}: 3-D static equilibrium not found ({sol.message}; "
+                          f"residual {r:.3g})")
+    e = sol.x * unit
+    fi, fo, q_in, q_out, al_i, al_o, q, w = forces(e)
+    if path == "bearing":
+        if on_outer:
+            xi = (fi + f_in) / ks
+            xo = xi - e
+            rest_i, rest_o = np.zeros(3), xo.copy()
+        else:
+            xo = (fo + f_out) / km
+            xi = xo + e
+            rest_i, rest_o = xi.copy(), np.zeros(3)
+    else:
+        xi, xo = (fi + f_in) / ks, (fo + f_out) / km
+        rest_i, rest_o = np.zeros(3), np.zeros(3)
+    return {"xi": xi[:2], "xo": xo[:2], "zi": float(xi[2]), "zo": float(xo[2]),
+            "rest_i": rest_i[:2], "rest_o": rest_o[:2], "rest_zi": float(rest_i[2]), "rest_zo": float(rest_o[2]),
+            "f_in": f_in[:2], "f_out": f_out[:2], "f_inz": float(f_in[2]), "f_outz": float(f_out[2]),
+            "ball_loads": q_out, "ball_loads_inner": q_in, "ball_loads_outer": q_out,
+            "phis": phis, "load_vec": radial, "gvec": grav[:2], "alpha_i": al_i, "alpha_o": al_o,
+            "q": q + np.array([xo[0] * math.cos(p) + xo[1] * math.sin(p) for p in phis]), "w": w + xo[2],
+            "residual": float(np.max(np.abs(resid(e))))}
+
+
+def _axial_angle(fa, z, k_eff, a0, pd, exponent):
+    """Contact angle (rad) of a pure axial load ``fa`` shared by ``z`` massless balls (rigid rings,
+    Harris & Kotzalas 2007, sec. 7.2): ``fa = z K (a0 (cos a_f / cos a - 1))^e sin a``, a_f the free
+    contact angle of the clearance."""
+    from scipy.optimize import brentq
+    cf = 1.0 - pd / (2 * a0)
+    a_f = math.acos(max(-1.0, min(1.0, cf)))
+
+    def f(a):
+        return z * k_eff * max(a0 * (cf / math.cos(a) - 1.0), 0.0) ** exponent * math.sin(a) - fa
+    return brentq(f, a_f + 1e-9, 1.4, xtol=1e-14)
+
+
+def _axial(section):
+    """(stiffness N/m, damping N s/m) of a support along the axis: its own keys, else its Y values."""
+    k = section.get("stiffness_z_n_m")
+    c = section.get("damping_z_n_s_m")
+    return (section["stiffness_y_n_m"] if k is None else k), (section["damping_y_n_s_m"] if c is None else c)
+
+
+def contact_angles(state, phis, *, zoff, pd, a_i, a_o, multibody, z):
+    """Contact angles (deg) of each ball at the outer and inner race from output states.
+
+    ``state`` (n_out, n_states), ``phis`` (n_out, Z) the balls' azimuths.  Returns (alpha_o, alpha_i)
+    as (Z, n_out) arrays."""
+    c, s = np.cos(phis), np.sin(phis)
+    ui = state[:, [0]] * c + state[:, [1]] * s
+    uo = state[:, [4]] * c + state[:, [5]] * s
+    zi, zo = state[:, [zoff]], state[:, [zoff + 1]]
+    if multibody:
+        q = state[:, 8:8 + z]
+        w = state[:, zoff + 4:zoff + 4 + z]
+        ao = np.degrees(np.arctan2(w - zo, q - uo - pd / 4 + a_o))
+        ai = np.degrees(np.arctan2(zi - w, ui - q - pd / 4 + a_i))
+    else:
+        ao = ai = np.degrees(np.arctan2(np.broadcast_to(zi - zo, ui.shape), a_i + a_o - pd / 2 + ui - uo))
+    return ao.T, ai.T

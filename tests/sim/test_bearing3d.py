@@ -1,0 +1,160 @@
+"""The 3-D bearing: axial load, contact angles, axial ring motion.
+
+Independent numbers: the rigid-ring axial-load relation of Harris & Kotzalas (2007, sec. 7.2)
+F_a = Z K_n (B D_b)^1.5 sin(a) (1/cos(a) - 1)^1.5, tabulated for the 6308 and the 6205 (zero
+clearance, no speed); a quasi-static solve of combined radial and axial load written here (Newton
+on the ring displacement, exact geometry, massless balls); the ball's own force balance with its
+centrifugal force at the kinematic cage speed."""
+import math
+
+import numpy as np
+import pytest
+
+from bearing_lab.bearings import get_bearing
+from bearing_lab.sim import load_scene, simulate
+from bearing_lab.sim.assembly import assemble
+from bearing_lab.sim.hertz import race_contact, series_stiffness
+
+# (bearing, F_a N, alpha deg, Q N): Harris's relation solved independently (f_i 0.52, f_o 0.53, E 208 GPa)
+HARRIS = [("6308", 100, 6.252, 114.8), ("6308", 300, 8.220, 262.3), ("6308", 500, 9.334, 385.4),
+          ("6308", 1000, 11.085, 650.1), ("6205", 100, 8.357, 76.5), ("6205", 300, 10.978, 175.0),
+          ("6205", 500, 12.458, 257.5), ("6205", 1000, 14.782, 435.5)]
+
+BASE = {"paper-healthy": "6308", "cwru-normal": "6205"}
+
+
+def _pure_axial(bearing, fa, fidelity, rpm=1.0):
+    name = next(k for k, v in BASE.items() if v == bearing)
+    return load_scene(name, **{"load.axial_n": float(fa), "load.radial_n": 0.0, "clearance.radial_um": 0.0,
+                               "gravity.enabled": False, "speed.rpm": rpm, "fidelity": fidelity,
+                               "shaft.unbalance_g_mm": 0.0})
+
+
+@pytest.mark.parametrize("bearing,fa,alpha_deg,q_n", HARRIS)
+@pytest.mark.parametrize("fidelity", ["quasi-static", "multibody"])
+def test_pure_axial_load_contact_angle_and_ball_load_against_harris(bearing, fa, alpha_deg, q_n, fidelity):
+    st = assemble(_pure_axial(bearing, fa, fidelity)).static
+    for a in (st["alpha_o"], st["alpha_i"]):
+        assert np.degrees(np.abs(a)) == pytest.approx(alpha_deg, rel=0.01)
+    assert st["ball_loads_outer"] == pytest.approx(q_n, rel=0.01)
+    # every ball carries F_a / (Z sin a)
+    z = get_bearing(bearing).n_balls
+    assert st["ball_loads_outer"] == pytest.approx(fa / (z * math.sin(math.radians(alpha_deg))), rel=0.01)
+
+
+def test_the_time_loop_holds_the_axial_equilibrium_and_reports_contact_angles():
+    ds = simulate(_pure_axial("6308", 300, "multibody", rpm=60.0), duration=0.05, progress=False)
+    assert "3-D" in ds.attrs["bearing_model"]
+    for v in ("contact_angle_outer_deg", "contact_angle_inner_deg"):
+        assert ds[v].dims == ("ball", "time") and ds[v].attrs["units"] == "degree"
+        assert np.abs(ds[v].values) == pytest.approx(8.220, rel=0.01)
+    assert ds["ball_load_outer"].values == pytest.approx(262.3, rel=0.01)
+    assert {"outer_ring_disp_z", "outer_ring_acc_z"} <= set(ds.data_vars)
+
+
+def _independent_qs(bearing, fr, fa, clearance):
+    """Rigid rings, massless balls, exact geometry: Newton on the inner ring's displacement (x, z)
+    relative to the outer ring under a radial load fr (-Y on the outer... here +X on the inner) and an
+    axial load fa, both on the inner ring.  Returns (ball loads Q (Z,), angles (Z,) rad, residual)."""
+    b = get_bearing(bearing)
+    hi = race_contact(b.ball_diameter, b.pitch_diameter, b.inner_conformity, "inner")
+    ho = race_contact(b.ball_diameter, b.pitch_diameter, b.outer_conformity, "outer")
+    k = series_stiffness(hi.stiffness, ho.stiffness)
+    a0 = (b.inner_conformity + b.outer_conformity - 1) * b.ball_diameter
+    psi = 2 * np.pi * np.arange(b.n_balls) / b.n_balls
+
+    def balls(d):
+        rho = a0 - clearance / 2 + d[0] * np.cos(psi)
+        zeta = np.full_like(psi, d[1])
+        ln = np.hypot(rho, zeta)
+        q = k * np.maximum(ln - a0, 0) ** 1.5
+        return q, rho / ln, zeta / ln
+
+    def resid(d):
+        q, cr, cz = balls(d)
+        return np.array([np.sum(q * cr * np.cos(psi)) - fr, np.sum(q * cz) - fa])
+    d = np.array([1e-6, a0 * 0.15])
+    for _ in range(100):
+        r = resid(d)
+        J = np.empty((2, 2))
+        for m in range(2):
+            h = np.zeros(2)
+            h[m] = 1e-10
+            J[:, m] = (resid(d + h) - r) / 1e-10
+        d = d - np.linalg.solve(J, r)
+    q, cr, cz = balls(d)
+    return q, np.arctan2(cz, cr), resid(d)
+
+
+@pytest.mark.parametrize("fr,fa", [(480.0, 300.0), (150.0, 200.0), (1000.0, 100.0)])
+def test_combined_load_ball_loads_against_an_independent_quasi_static_solve(fr, fa):
+    sc = load_scene("paper-healthy", **{"load.radial_n": fr, "load.axial_n": fa, "load.on": "inner",
+                                        "load.direction_deg": 0.0, "gravity.enabled": False, "speed.rpm": 1.0,
+                                        "fidelity": "quasi-static", "shaft.unbalance_g_mm": 0.0})
+    asm = assemble(sc)
+    st = asm.static
+    q_ref, a_ref, res = _independent_qs("6308", fr, fa, sc.clearance)
+    assert np.max(np.abs(res)) < 1e-6 * (fr + fa)
+    # the balls sit at the same azimuths (one in the load direction)
+    order = np.argsort(np.mod(st["phis"] - st["phis"][0] + 1e-9, 2 * np.pi))
+    q = st["ball_loads_outer"][order]
+    np.testing.assert_allclose(q, q_ref, rtol=0.01, atol=1e-3 * q_ref.max())
+    np.testing.assert_allclose(np.abs(st["alpha_o"][order]), np.abs(a_ref), rtol=0.01, atol=1e-4)
+    # the axial balance: the balls carry the axial load to 0.1 %
+    assert abs(np.sum(st["ball_loads_outer"] * np.sin(np.abs(st["alpha_o"]))) - fa) < 1e-3 * fa
+
+
+def test_centrifugal_force_makes_the_outer_contact_angle_smaller():
+    """At 3600 r/min the ball's centrifugal force m_b (d_m/2) omega_c^2 loads the outer contact more
+    and flattens it: a_o < a_i, and each ball's radial balance Q_o cos a_o - Q_i cos a_i equals that
+    force (omega_c the kinematic cage speed), its axial balance Q_o sin a_o = Q_i sin a_i."""
+    sc = _pure_axial("6308", 300, "multibody", rpm=3600.0)
+    st = assemble(sc).static
+    b = sc.bearing
+    m_b = sc.masses()[2]
+    w_c = b.frequency_factors()["ftf"] * 3600 * 2 * math.pi / 60
+    ao, ai = np.abs(st["alpha_o"]), np.abs(st["alpha_i"])
+    assert np.all(ao < ai - math.radians(0.1))
+    qo, qi = st["ball_loads_outer"], st["ball_loads_inner"]
+    fc = qo * np.cos(ao) - qi * np.cos(ai)
+    assert fc == pytest.approx(m_b * (b.pitch_diameter / 2) * w_c ** 2, rel=0.01)
+    assert qo * np.sin(ao) == pytest.approx(qi * np.sin(ai), rel=1e-6)
+
+
+def test_without_an_axial_load_the_planar_model_runs():
+    ds = simulate("paper-O1", duration=0.02, progress=False)
+    assert ds.attrs["bearing_model"].startswith("planar")
+    assert "contact_angle_outer_deg" not in ds and "outer_ring_acc_z" not in ds
+
+
+def test_an_axial_load_moves_the_contact_track_off_a_centred_defect():
+    """O1 (1 x 1 mm at H = 0): 300 N axial moves the outer contact 1.14 mm across the groove
+    (f_o D_b sin a, toward -Z for a +Z force on the outer ring), past the defect's 0.5 mm half-width: the
+    impacts all but vanish; at H = -1.14 mm
+    the track runs over the defect again."""
+    peaks = {}
+    for h_mm, fa in ((0.0, 0.0), (0.0, 300.0), (-1.14, 300.0), (1.14, 300.0)):
+        ds = simulate("paper-O1", duration=0.1, progress=False,
+                      **{"load.axial_n": fa, "defect.offset_mm": h_mm, "load.on": "outer"})
+        peaks[(h_mm, fa)] = float(np.abs(ds["outer_ring_acc_y"]).max())
+    assert peaks[(0.0, 300.0)] < 0.2 * peaks[(0.0, 0.0)]
+    assert peaks[(-1.14, 300.0)] > 0.5 * peaks[(0.0, 0.0)]
+    assert peaks[(1.14, 300.0)] < 0.2 * peaks[(0.0, 0.0)]
+
+
+def test_the_dynamic_cage_is_refused_with_an_axial_load():
+    from bearing_lab.errors import SceneError
+    with pytest.raises(SceneError, match="kinematic cage"):
+        assemble(load_scene("paper-healthy", **{"load.axial_n": 100.0, "cage.model": "dynamic"}))
+
+
+def test_break_it_a_table_blind_to_the_contact_track_keeps_striking_the_centred_defect(monkeypatch):
+    """With the defect table built at the groove bottom whatever the contact angle, the centred defect is
+    struck under 300 N axial as without it: the previous test would fail."""
+    from bearing_lab.sim import assembly
+    monkeypatch.setattr(assembly, "_track_offset", lambda defect, st, race, psi0, bearing: (defect, 0.0))
+    p0 = float(np.abs(simulate("paper-O1", duration=0.1, progress=False, **{"load.on": "outer"})
+                      ["outer_ring_acc_y"]).max())
+    p1 = float(np.abs(simulate("paper-O1", duration=0.1, progress=False, **{"load.on": "outer", "load.axial_n": 300.0})
+                      ["outer_ring_acc_y"]).max())
+    assert p1 > 0.5 * p0
