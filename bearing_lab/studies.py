@@ -74,10 +74,21 @@ STUDIES = {
                             ("penetration rate, 700 N s/m", {"contact.defect_damping": "penetration_rate",
                                                              "contact.damping_n_s_m": 700.0})],
              "section 4", "experiment and simulation about ±60 g with the 1 x 23 mm slot at 150 N"),
+    # beyond the paper: the offset study under an axial load on the outer ring (the 3-D bearing), where
+    # the contact track leaves the groove bottom by f_o D_b sin(alpha) toward -Z
+    "offset_axial": ("paper-O1", [(f"H = {h}, {fa:g} N axial", {"defect.offset_mm": hv, "load.axial_n": fa,
+                                                                  "load.on": "outer"})
+                                  for fa in (0.0, 100.0, 300.0)
+                                  for h, hv in (("0", 0.0), ("-B/3", -1.0 / 3.0), ("-B/2", -0.5))],
+                     "beyond the paper (its section 5.2 has no axial load)",
+                     "not studied in the paper: the contact track's position against the defect under an "
+                     "axial load"),
 }
 #: what each study varies, for the report
 VARIES = {"size": "the defect's length", "offset": "its axial offset H", "skew": "its skew θ",
           "speed": "the shaft speed",
+          "offset_axial": "the defect's axial offset H (toward -Z, where the track moves) and an axial force on "
+                          "the outer ring toward +Z, 0, 100 and 300 N (contact angles about 0, 6.3 and 8.2 degrees)",
           "slot": "how the contact is damped: the rate IMPACT multiplies (the bodies' approach, the default, "
                   "or the rate of the defect law's penetration, which adds the exit edge sweeping into the "
                   "contact) and c_max"}
@@ -145,6 +156,11 @@ def _one(scene_name, overrides):
         "crossing_ms": t_cross * 1e3,
         "wall_s": ds.attrs["wall_time_s"],
         "contact_model": ds.attrs["defect_contact_models"],
+        # where the outer contact runs across the groove (m from the groove bottom, +Z positive):
+        # f_o D_b sin(alpha) of the defected ball, 0 in the planar model
+        "track_mm": (float(-sc.bearing.outer_conformity * sc.bearing.ball_diameter * 1e3
+                           * np.sin(np.radians(np.mean(ds["contact_angle_outer_deg"].values[ball, w]))))
+                     if "contact_angle_outer_deg" in ds else 0.0),
         "scene": sc,
     }
 
@@ -257,6 +273,7 @@ _COLUMNS = (  # row key -> (variable, scale to SI, units, long name)
     ("min_load", "minimum_ball_load", 1.0, "N", "defected ball's smallest outer-race load"),
     ("min_share", "minimum_carried_share", 1.0, "1", "smallest share of the intact load carried"),
     ("min_intact", "minimum_intact_fraction", 1.0, "1", "smallest intact fraction of the Hertz ellipse"),
+    ("track_mm", "outer_contact_track", 1e-3, "m", "axial position of the outer contact from the groove bottom"),
     ("wall_s", "wall_time", 1.0, "s", "compute time of the run's time loop"),
 )
 
@@ -294,6 +311,10 @@ def _findings(s, rs):
     if s == "offset" and rs[0]["peak_acc_g"] > 0:
         ratios = ", ".join(f"{r['peak_acc_g'] / rs[0]['peak_acc_g']:.2f}" for r in rs)
         parts.append(f"Acceleration ratios to H = 0: {ratios} (paper: 1.00, 0.78, 0.54).")
+    if s == "offset_axial":
+        parts.append("Track: the defected ball's outer contact runs at " + seq("track_mm", "{:+.2f} mm")
+                     + " from the groove bottom; the defect (1 mm wide) is struck where its centre H lies within "
+                     "about half its width of the track, and missed where the track has left it.")
     if s == "slot":
         pk = [r["peak_acc_g"] for r in rs]
         parts.append(f"The peak acceleration spans {min(pk):.1f}-{max(pk):.1f} g over these choices "

@@ -51,6 +51,10 @@ from ..errors import SceneError, check_choice
 from .scene_keys import _NUM, DEFECT_KEYS, G0, SCHEMA, STEEL_DENSITY  # noqa: F401  (the table of scene keys)
 
 
+#: the shortest settling time of a scene with an axial load (the 3-D bearing), s
+SETTLE_3D_S = 0.1
+
+
 class SceneWarning(UserWarning):
     """A valid scene that probably does not say what was meant (e.g. a defect off the track)."""
 
@@ -283,7 +287,15 @@ class Scene:
 
     @property
     def settle(self) -> float:
-        return self.data["output"]["settle_s"]
+        """Seconds simulated and discarded before the record starts (``output.settle_s``); with an
+        axial load at least ``SETTLE_3D_S``: the balls' axial modes, excited by the start from the
+        static equilibrium (which leaves out the damping of the orbiting contacts), ring down
+        within it (on cwru-normal with 188 N axial, the healthy kurtosis is 15 after 0.02 s of
+        settling, 7.6 after 0.05 s, 1.8 after 0.1 s; planar 1.7)."""
+        s = self.data["output"]["settle_s"]
+        if abs(float(self.data["load"].get("axial_n") or 0.0)) > 0.0:
+            return max(s, SETTLE_3D_S)
+        return s
 
     def speed_profile(self):
         """(t, rpm) arrays of the piecewise-linear speed, t from the start of settling."""
