@@ -53,6 +53,28 @@ SCENES = [
     ("paper-slot-300rpm", "paper-slot", {"speed_rpm": 300.0}, "defect-slow"),
 ]
 
+#: output rates of the auto-rule study (``run_rate_study``): a setting is scored at each, since a
+#: higher output rate resolves a sharper impulse peak, which needs a more accurate integration
+RATES_HZ = (20_000.0, 100_000.0, 200_000.0)
+#: the paper's scenes at every size, offset and skew its studies use, the slot, and the bench's
+#: CWRU defect scene (so the lowest band covers every defect scene the kind rule was made on)
+RATE_SCENES = [
+    ("paper-O1-H=0", "paper-O1", {}),
+    ("paper-O1-H=B/3", "paper-O1", {"defect.offset_mm": 1.0 / 3.0}),
+    ("paper-O1-H=B/2", "paper-O1", {"defect.offset_mm": 0.5}),
+    ("paper-O2-theta=0", "paper-O2", {}),
+    ("paper-O2-theta=30", "paper-O2", {"defect.skew_deg": 30.0}),
+    ("paper-O2-theta=60", "paper-O2", {"defect.skew_deg": 60.0}),
+    ("paper-O3", "paper-O3", {}),
+    ("paper-slot", "paper-slot", {}),
+    ("cwru-or007-6", "cwru-or007-6", {}),
+]
+#: the candidates of the rate study: the adaptive multibody settings (fixed steps and the
+#: quasi-static fidelity are no candidates, see ``_rules``), with one tighter dp54 tolerance
+RATE_SETTINGS = ([("dp54", r) for r in (1e-3, 1e-4, 1e-5, 1e-6, 1e-7)]
+                 + [("bs32", r) for r in (1e-3, 1e-4, 1e-5)])
+RATE_KIND = "defect"
+
 MB_SETTINGS = ([("dp54", r, None, None) for r in (1e-3, 1e-4, 1e-5, 1e-6)]
                + [("bs32", r, None, None) for r in (1e-3, 1e-4, 1e-5)]
                + [("rk4", 0.0, h, None) for h in (1e-5, 5e-6, 2e-6)])
@@ -149,9 +171,123 @@ def _err(a, b):
     return abs(a - b) / abs(b)
 
 
+def run_rate_study(out_dir="reports/performance", *, duration=1.0, rates=RATES_HZ, scenes=None,
+                   progress=True) -> list:
+    """Every candidate setting (``RATE_SETTINGS``) on every ``RATE_SCENES`` scene at every output
+    rate, against a converged reference at that rate (dp54 rtol 1e-9, 2 µs ceiling; checked by
+    rtol 1e-10, 1 µs).  Writes ``auto_rate_study.csv`` (one row per scene, rate and setting) and
+    returns the rows."""
+    import csv
+    from tqdm.auto import tqdm
+    _warm_up()
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    chosen = [s for s in RATE_SCENES if scenes is None or s[0] in scenes]
+    rows = []
+    jobs = [(fs, sc) for fs in rates for sc in chosen]
+    for fs, (label, base, ov) in tqdm(jobs, desc="rate study", disable=not progress):
+        sc = _scene(base, {**ov, "output.sample_rate_hz": float(fs)}, duration, "multibody", REF_CONTACT)
+        asm = assemble(sc)
+        ref, ref_cost = _timed(asm, "dp54", 1e-9, None, 2e-6)
+        ref2, _ = _timed(asm, "dp54", 1e-10, None, 1e-6)
+        m_ref = _measures(ref["acc"][:, 1], fs, sc)
+        m_ref2 = _measures(ref2["acc"][:, 1], fs, sc)
+        for method, rtol in RATE_SETTINGS:
+            res, cost = _timed(asm, method, rtol, None, None)
+            m = _measures(res["acc"][:, 1], fs, sc)
+            rows.append(dict(kind=RATE_KIND, scene=label, rate_hz=float(fs), method=method, rtol=float(rtol),
+                             max_step=2.5e-5, cost=cost, peak=m["peak"], ref_peak=m_ref["peak"],
+                             ref_period=m_ref["period"], err_peak=_err(m["peak"], m_ref["peak"]),
+                             err_period=_err(m["period"], m_ref["period"]),
+                             ref_check_peak=_err(m_ref2["peak"], m_ref["peak"]),
+                             ref_check_period=_err(m_ref2["period"], m_ref["period"]), duration_s=duration))
+    if not rows:
+        return rows
+    with open(out / "auto_rate_study.csv", "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)
+    return rows
+
+
+def read_rate_study(path) -> list:
+    """The rows of an ``auto_rate_study.csv`` (numbers as floats)."""
+    import csv
+    with open(path, newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    for r in rows:
+        for k in r:
+            if k not in ("kind", "scene", "method"):
+                r[k] = float(r[k]) if r[k] not in ("", "nan") else math.nan
+    return rows
+
+
+def rate_choices(rows) -> dict:
+    """Per (kind, output rate): the cheapest setting (mean cost over the scenes) within tolerance
+    on EVERY scene the study ran at that rate, as ``(method, rtol, worst peak error, mean cost,
+    scenes)``; None where no candidate held."""
+    out = {}
+    for kind in sorted({r["kind"] for r in rows}):
+        for fs in sorted({r["rate_hz"] for r in rows if r["kind"] == kind}):
+            rs = [r for r in rows if r["kind"] == kind and r["rate_hz"] == fs]
+            scenes = sorted({r["scene"] for r in rs})
+            best = None
+            for key in dict.fromkeys((r["method"], r["rtol"]) for r in rs):
+                sel = [r for r in rs if (r["method"], r["rtol"]) == key]
+                if len(sel) != len(scenes) or not all(_ok(r) for r in sel):
+                    continue
+                cost = float(np.mean([r["cost"] for r in sel]))
+                if best is None or cost < best[3]:
+                    best = (key[0], key[1], max(r["err_peak"] for r in sel), cost, scenes)
+            out[(kind, fs)] = best
+    return out
+
+
+def _rate_rules(rows) -> str:
+    """``[[<kind>.by_rate]]`` tables: the rule for output rates up to ``max_rate_hz`` (and above
+    the band below it) is the cheapest setting the rate study found within tolerance at that rate."""
+    lines = ["", f"# by output rate: the cheapest setting within {TOL_PEAK:.0%} peak and {TOL_PERIOD:.1%} period "
+             "error on every scene of the rate study at that rate (auto_rate_study.csv); a rule covers the "
+             "rates above the band below it up to max_rate_hz", ""]
+    for (kind, fs), best in rate_choices(rows).items():
+        if best is None:
+            lines += [f"# {kind} at {fs:g} Hz: no candidate held on every scene", ""]
+            continue
+        method, rtol, worst, cost, scenes = best
+        lines += [f"[[{kind}.by_rate]]", f"max_rate_hz = {fs!r}", 'fidelity = "multibody"', f'method = "{method}"',
+                  f"rtol = {rtol!r}", "step_s = 0.0", f"max_step_s = {2.5e-5!r}", f"expected_peak_error = {worst!r}",
+                  f"cost_s_per_s = {cost!r}", f"scenes = {scenes!r}".replace("'", '"'), ""]
+    return "\n".join(lines)
+
+
+def _worst(values) -> str:
+    v = [x for x in values if math.isfinite(x)]
+    return f"{max(v):.1e}" if v else "-"
+
+
+def rate_table(rows) -> str:
+    """Markdown: per output rate and setting, the worst peak and period errors over the scenes,
+    the scene where the peak error is worst, the mean cost, and whether it held on every scene."""
+    lines = ["| output | setting | worst peak err | at | worst period err | mean CPU s/s | within on every scene |",
+             "|---|---|---|---|---|---|---|"]
+    choice = rate_choices(rows)
+    for fs in sorted({r["rate_hz"] for r in rows}):
+        for key in dict.fromkeys((r["method"], r["rtol"]) for r in rows if r["rate_hz"] == fs):
+            sel = [r for r in rows if r["rate_hz"] == fs and (r["method"], r["rtol"]) == key]
+            w = max(sel, key=lambda r: r["err_peak"])
+            picked = any(c is not None and c[:2] == key and f == fs for (_, f), c in choice.items())
+            lines.append(f"| {fs / 1e3:g} kHz | {key[0]} rtol={key[1]:g} | {w['err_peak']:.1e} | {w['scene']} | "
+                         f"{_worst(r['err_period'] for r in sel)} | {np.mean([r['cost'] for r in sel]):.3f} | "
+                         f"{'yes' if all(_ok(r) for r in sel) else 'no'}{' (auto)' if picked else ''} |")
+    return "\n".join(lines)
+
+
 def run_bench(out_dir="reports/performance", *, duration=0.3, scipy_duration=0.1, scenes=None,
-              progress=True, scipy=True) -> xr.Dataset:
-    """Run the work-precision study; write HTML, PNG, netCDF and rules under ``out_dir``."""
+              progress=True, scipy=True, rates=True, rate_duration=1.0) -> xr.Dataset:
+    """Run the work-precision study; write HTML, PNG, netCDF and rules under ``out_dir``.
+
+    With ``rates`` the rate study (:func:`run_rate_study`, ``rate_duration`` simulated seconds per
+    run) also runs, and its per-rate rules join ``auto_rules.toml``."""
     from tqdm.auto import tqdm
     _warm_up()
     out = Path(out_dir)
@@ -205,6 +341,11 @@ def run_bench(out_dir="reports/performance", *, duration=0.3, scipy_duration=0.1
     from .io_netcdf import write_netcdf
     write_netcdf(ds, out / "performance.nc")
     rules = _rules(rows)
+    if rates:
+        rate_rows = run_rate_study(out, duration=rate_duration, scenes=scenes, progress=progress)
+        if rate_rows:
+            rules += _rate_rules(rate_rows)
+            ds.attrs["rate_table_md"] = rate_table(rate_rows)
     write_text(out / "auto_rules.toml", rules)
     speed_md = ""
     if scipy:

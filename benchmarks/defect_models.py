@@ -66,8 +66,9 @@ def _table_cpu(sc):
         races = ("outer", "inner") if d.race == "ball" else (d.race,)
         for race in races:
             t = next(tables)
+            loaded = t.info["loaded_range_m"]   # the table reaches the deepest drop + this
             contact_table(dataclasses.replace(d, race=race), sc.bearing, model=t.model,
-                          clearance=sc.clearance, delta_max=t.delta_max, cache=False)
+                          clearance=sc.clearance, delta_max=loaded, above_drop=loaded, cache=False)
     return time.process_time() - c
 
 
@@ -96,6 +97,7 @@ def run(name, ov, model, duration):
 def main(duration=1.0):
     warm_up()
     _warm_up()
+    simulate("paper-O1", duration=0.05, progress=False)   # a process's first call pays one-time setup
     print("| scene | model | table build CPU s | loop CPU s / sim s | peak acc (g) | error | period (ms) | error | within tolerance |")
     print("|---|---|---|---|---|---|---|---|---|")
     for name, ov in CASES:

@@ -4,7 +4,8 @@ Run:  .venv/bin/python benchmarks/defect_tables.py [--quick]
 
 Prints (markdown):
 1. the rigid drops against the independent figures (exact sphere in torus);
-2. per paper defect (at the delta_max its scene uses): CPU time of a cold "halfspace"
+2. per paper defect (on the loaded range delta_max its scene uses, without the part above it
+   that reaches the deepest drop: section 9 times the tables as the simulation builds them): CPU time of a cold "halfspace"
    table (one core, minimum of 3, numba already compiled) and of reading it back from the
    disk cache, and the "area" table's cold time;
 3. the default half-space table against a converged one (cells 64 x 48, Richardson with
@@ -23,7 +24,18 @@ Prints (markdown):
    the second difference of the carried share at the approach nodes between neighbouring
    tables (largest, RMS)
    against the first (largest): a smooth table has second differences well below the first.
-``--quick`` skips 3 and 7 (the converged tables take several minutes).
+9. table range before and after the tables reached the deepest drop: per paper defect (O1 at
+   every offset, O2 at every skew, O3, the slot) and the CWRU 0.021 in pit, the "halfspace"
+   table built on the loaded range only (``contact_table`` without ``above_drop``: before) and
+   the one the simulation builds (loaded range above the deepest rigid drop: after): approach
+   range, delta and psi grid sizes, half-space solves, cold build CPU time (cache off, one core,
+   minimum of 3), and the largest approach the balls reach in a 0.3 s run at 20 kHz (the
+   kernel's note, ``defect_table_reach_um``).
+10. paper-slot's peak acceleration (1 s at 20 and 100 kHz, as a user runs it) with the default
+   table and with a converged one (64 x 48 cells, 32 approach nodes per loaded range, and above it
+   nodes 1/32 of it apart instead of 1/10).
+``--quick`` skips 3, 7 and 10 (the converged tables take several minutes); ``--range`` runs 9
+only, ``--slot`` 10 only.
 """
 from __future__ import annotations
 
@@ -58,12 +70,13 @@ CONVERGED = {"cells": (64, 48), "nodes": np.linspace(1 / 32, 1.0, 32), "refine_t
 
 
 def _scene_defect(name, ov):
-    """(defect, delta_max, static approach of the most loaded ball) as the scene uses them."""
+    """(defect, loaded range delta_max, static approach of the most loaded ball) as the scene uses
+    them (the scene's table reaches above delta_max, to the deepest drop plus it: section 9)."""
     sc = load_scene(name, **ov)
     asm = assemble(sc)
     t = asm.tables[0]
     d_static = (float(np.max(asm.static["ball_loads"])) / asm.hertz_outer.stiffness) ** (2 / 3)
-    return sc.defects[0], t.delta_max, d_static
+    return sc.defects[0], t.info["loaded_range_m"], d_static
 
 
 def _cpu(fn, repeat=3):
@@ -209,6 +222,58 @@ def smoothness() -> None:
               f"{np.sqrt(np.mean(d2 ** 2)):.5f} |", flush=True)
 
 
+RANGE_CASES = CASES + [("CWRU 0.021 in pit", "cwru-or021-6", {})]
+
+
+def table_range() -> None:
+    """Section 9: before (loaded range only) and after (the simulation's table) per defect."""
+    from bearing_lab.sim import simulate
+    print("\n## Table range before/after reaching the deepest drop (\"halfspace\", cold, cache off)\n")
+    print("| defect | rigid drop (µm) | loaded range (µm) | range before / after (µm) | δ nodes before / after "
+          "| ψ nodes before / after | half-space solves before / after | build CPU s before / after | reached in 0.3 s (µm) |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    for label, name, ov in RANGE_CASES:
+        sc = load_scene(name, **ov)
+        asm = assemble(sc)
+        Ta = asm.tables[0]
+        d, b = sc.defects[0], sc.bearing
+        mat = sc.data["material"]
+        kw = dict(model="halfspace", clearance=sc.clearance, delta_max=Ta.info["loaded_range_m"],
+                  material=(mat["youngs_modulus_gpa"] * 1e9, mat["poisson_ratio"]), cache=False)
+        t_b, Tb = _cpu(lambda: contact_table(d, b, **kw))
+        t_a, Ta2 = _cpu(lambda: contact_table(d, b, above_drop=Ta.info["loaded_range_m"], **kw))
+        assert Ta2.delta.size == Ta.delta.size and Ta2.psi.size == Ta.psi.size  # the simulation's table
+        ds = simulate(name, duration=0.3, progress=False, **ov)
+        reach = float(ds.attrs["defect_table_reach_um"].split(",")[0])
+        print(f"| {label} | {Ta.info['max_drop_m'] * 1e6:.2f} | {Ta.info['loaded_range_m'] * 1e6:.2f} | "
+              f"{Tb.delta_max * 1e6:.2f} / {Ta2.delta_max * 1e6:.2f} | {Tb.delta.size} / {Ta2.delta.size} | "
+              f"{Tb.psi.size} / {Ta2.psi.size} | {Tb.info.get('halfspace_solves', 0)} / {Ta2.info.get('halfspace_solves', 0)} | "
+              f"{t_b:.3f} / {t_a:.3f} | {reach:.2f} |", flush=True)
+
+
+def slot_with_converged_table(fs_list=(20_000.0, 100_000.0), duration=1.0) -> None:
+    """Section 10: the slot with the default and a converged table (module settings patched, so
+    the cache keys differ)."""
+    from bearing_lab.sim import simulate
+    from bearing_lab.sim.defects import contact as C, halfspace as H
+    print("\n## paper-slot peak acceleration (g), 1 s, default and converged half-space table\n")
+    print("| output | default table | converged table | difference | converged table build or read (wall s) |")
+    print("|---|---|---|---|---|")
+    saved = (C.HALFSPACE_NODES, H.TABLE_CELLS, C.ABOVE_NODE_STEP)
+    conv = (tuple(CONVERGED["nodes"]), CONVERGED["cells"], 1 / 32)
+    for fs in fs_list:
+        peaks, build = [], 0.0
+        for nodes, cells, step in (saved, conv):
+            C.HALFSPACE_NODES, H.TABLE_CELLS, C.ABOVE_NODE_STEP = nodes, cells, step
+            C._MEMORY.clear()
+            ds = simulate("paper-slot", duration=duration, fs=fs, progress=False)
+            peaks.append(float(np.max(np.abs(ds.outer_ring_acc_y.values))) / 9.80665)
+            build = ds.attrs["table_time_s"]
+        C.HALFSPACE_NODES, H.TABLE_CELLS, C.ABOVE_NODE_STEP = saved
+        print(f"| {fs / 1e3:.0f} kHz | {peaks[0]:.2f} | {peaks[1]:.2f} | {peaks[0] / peaks[1] - 1:+.1%} | "
+              f"{build:.1f} |", flush=True)
+
+
 def main(quick: bool = False) -> None:
     warm_up()
     drops()
@@ -222,4 +287,14 @@ def main(quick: bool = False) -> None:
 
 
 if __name__ == "__main__":
-    main(quick="--quick" in sys.argv)
+    if "--range" in sys.argv:
+        warm_up()
+        table_range()
+    elif "--slot" in sys.argv:
+        warm_up()
+        slot_with_converged_table()
+    else:
+        main(quick="--quick" in sys.argv)
+        table_range()
+        if "--quick" not in sys.argv:
+            slot_with_converged_table()

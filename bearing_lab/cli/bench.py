@@ -11,11 +11,15 @@ def _bench(args) -> int:
             check_choice(s, names, "--scene")
     ds = run_bench(args.output, duration=args.duration, scenes=args.scene, progress=not args.quiet,
                    scipy=not args.no_scipy,
-                   scipy_duration=args.scipy_duration)
+                   scipy_duration=args.scipy_duration, rates=not args.no_rates,
+                   rate_duration=args.rate_duration)
     print(summary_table(ds))
+    if ds.attrs.get("rate_table_md"):
+        print("\nAuto-rule study by output rate (auto_rate_study.csv):\n" + ds.attrs["rate_table_md"])
     if ds.attrs.get("equal_accuracy_md"):
         print("\nSpeed at equal accuracy (CPU s per simulated s):\n" + ds.attrs["equal_accuracy_md"])
-    print(f"\nwrote {args.output}/index.html, performance.nc, auto_rules.toml and work-precision PNGs")
+    print(f"\nwrote {args.output}/index.html, performance.nc, auto_rules.toml, auto_rate_study.csv and "
+          "work-precision PNGs")
     return 0
 
 
@@ -27,5 +31,8 @@ def register(sub) -> None:
     p.add_argument("--scipy-duration", type=float, default=0.1, metavar="S",
                    help="simulated seconds of the equal-accuracy comparison with scipy")
     p.add_argument("--no-scipy", action="store_true", help="skip the equal-accuracy comparison with scipy")
+    p.add_argument("--rate-duration", type=float, default=1.0, metavar="S",
+                   help="simulated seconds per run of the auto-rule study at 20, 100 and 200 kHz output")
+    p.add_argument("--no-rates", action="store_true", help="skip the auto-rule study by output rate")
     p.add_argument("-q", "--quiet", action="store_true")
     p.set_defaults(func=_bench)

@@ -11,6 +11,13 @@ reference on EVERY bench scene of its kind:
 - ``defect-slow``: a defect at shaft speeds up to the slow bench scene's (300 r/min);
 - ``defect``: any other defect.
 
+A kind may carry rules by output rate (``[[defect.by_rate]]``, from the rate study of
+``bearing-lab bench``, ``auto_rate_study.csv``): a higher output rate resolves a sharper
+impulse peak, which needs a more accurate integration, so the rule measured at the lowest
+studied rate at or above the scene's output rate is used (a 50 kHz scene takes the 100 kHz
+rule); above the highest studied rate the highest one is used and the reason says it was not
+measured there.  Kinds without rate rules were measured at 20 kHz output.
+
 The choice and its expected error go into the output's attributes.  Without a rule
 for a kind the conservative default is used (multibody, dp54, rtol 1e-5).
 """
@@ -43,6 +50,20 @@ def scene_kind(scene) -> str:
     return "defect-slow" if scene.nominal_rpm <= SLOW_RPM else "defect"
 
 
+def rate_rule(rule: dict, fs: float) -> tuple[dict, str]:
+    """(the rule for output rate ``fs`` Hz, how it was chosen) from a kind's rule and its
+    ``by_rate`` bands; the kind's rule itself when it has none."""
+    bands = sorted(rule.get("by_rate", ()), key=lambda b: b["max_rate_hz"])
+    if not bands:
+        return rule, "measured at 20 kHz output"
+    for b in bands:
+        if fs <= b["max_rate_hz"] * (1 + 1e-9):
+            return b, f"measured at {b['max_rate_hz'] / 1e3:g} kHz output (rule for up to it)"
+    b = bands[-1]
+    return b, (f"measured at up to {b['max_rate_hz'] / 1e3:g} kHz output only: the {fs / 1e3:g} kHz asked for "
+               "was not studied")
+
+
 def resolve(scene) -> dict:
     """The settings auto picks for ``scene``: fidelity, method, rtol, max_step_s, kind, reason."""
     kind = scene_kind(scene)
@@ -50,10 +71,11 @@ def resolve(scene) -> dict:
     rule = rules.get(kind) or (rules.get("defect") if kind == "defect-slow" else None)
     out = dict(DEFAULT)
     if rule:
+        rule, how = rate_rule(rule, float(scene.fs_out))
         out.update({k: rule[k] for k in ("fidelity", "method", "rtol", "max_step_s", "step_s") if k in rule})
         out["expected_peak_error"] = rule.get("expected_peak_error")
         out["reason"] = (f"auto rule '{kind}' from the work-precision study: cheapest setting within 1 % "
-                         f"peak acceleration and 0.1 % period on {rule.get('scenes')}")
+                         f"peak acceleration and 0.1 % period on {rule.get('scenes')}, {how}")
     else:
         out["reason"] = f"no measured rule for '{kind}': conservative default"
     out["kind"] = kind

@@ -1,7 +1,11 @@
 """fidelity/solver "auto": on scenes NOT used to make the rules (the bench scenes are paper-healthy,
 paper-slot, paper-O1 at H = B/2, paper-O2 at 60°, cwru-or007-6 and paper-slot at 300 r/min),
 auto's error stays within the default tolerance (1 % peak acceleration, 0.1 % period) of a
-converged reference, and the choice is recorded in the output."""
+converged reference at 20, 100 and 200 kHz output, and the choice is recorded in the output; the
+rule auto takes at each output rate is one the shipped rate study (``auto_rate_study.csv``)
+found within tolerance on every one of its scenes at that rate."""
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -13,6 +17,10 @@ CASES = [
     ("cwru-or021-6", {}, "bpfo"),
     ("cwru-ir007", {}, "bpfi"),
     ("paper-O2", {"defect.offset_mm": 0.25, "defect.skew_deg": 20.0}, "bpfo"),
+    # at the output rates of the rate study's upper bands
+    ("paper-O2", {"defect.offset_mm": 0.25, "defect.skew_deg": 20.0, "output.sample_rate_hz": 200_000.0}, "bpfo"),
+    ("paper-O2", {"defect.skew_deg": 45.0, "output.sample_rate_hz": 100_000.0}, "bpfo"),
+    ("cwru-ir007", {"output.sample_rate_hz": 200_000.0}, "bpfi"),
 ]
 
 
@@ -33,3 +41,65 @@ def test_auto_within_tolerance_on_unseen_scenes(scene, ov, line):
           f"rtol {auto.attrs['solver_rtol']:g}: peak error {peak_err:.1e}, period error {abs(pa - pr) / pr:.1e}")
     assert peak_err < 0.01
     assert abs(pa - pr) / pr < 0.001
+
+
+# --- the rules by output rate against the rate study they were made from --------------------------
+
+STUDY = Path(__file__).resolve().parents[2] / "bearing_lab" / "sim" / "auto_rate_study.csv"
+
+
+def _study_rows():
+    from bearing_lab.bench import read_rate_study
+    return read_rate_study(STUDY)
+
+
+def _within(r):
+    from bearing_lab.bench import TOL_PEAK, TOL_PERIOD
+    period_ok = (not np.isfinite(r["ref_period"])) or (np.isfinite(r["err_period"]) and r["err_period"] <= TOL_PERIOD)
+    return np.isfinite(r["err_peak"]) and r["err_peak"] <= TOL_PEAK and period_ok
+
+
+def test_rule_chosen_at_each_rate_held_on_every_scene_of_the_written_study():
+    """For a defect scene at each studied output rate, and between them (a rate takes the band of
+    the lowest studied rate at or above it), the setting auto picks is one the shipped study
+    measured at that band's rate on every one of its scenes, within 1 % peak and 0.1 % period."""
+    from bearing_lab.sim import load_scene
+    from bearing_lab.sim.auto import resolve
+    rows = _study_rows()
+    rates = sorted({r["rate_hz"] for r in rows})
+    assert len(rates) >= 3 and rates[-1] >= 200_000.0
+    scenes = {r["scene"] for r in rows}
+    assert {"paper-slot", "paper-O3"} <= scenes and sum(s.startswith("paper-O1") for s in scenes) == 3
+    assert sum(s.startswith("paper-O2") for s in scenes) == 3
+    asked = [(fs, fs) for fs in rates] + [(12_000.0, rates[0])]
+    asked += [(0.5 * (lo + hi), hi) for lo, hi in zip(rates, rates[1:])]
+    for fs, band in asked:
+        choice = resolve(load_scene("paper-O2", **{"output.sample_rate_hz": fs, "defect.skew_deg": 20.0}))
+        assert choice["kind"] == "defect"
+        sel = [r for r in rows if r["rate_hz"] == band and r["method"] == choice["method"]
+               and r["rtol"] == choice["rtol"]]
+        assert {r["scene"] for r in sel} == scenes, (fs, choice)
+        bad = [(r["scene"], r["err_peak"], r["err_period"]) for r in sel if not _within(r)]
+        assert not bad, (fs, choice["method"], choice["rtol"], bad)
+        assert choice["expected_peak_error"] == pytest.approx(max(r["err_peak"] for r in sel), rel=1e-9)
+        assert f"{band / 1e3:g} kHz" in choice["reason"]
+
+
+def test_rate_rules_are_the_cheapest_within_tolerance_in_the_study():
+    """The shipped rules by rate are the cheapest setting within tolerance on every scene of the
+    shipped study at that rate (so the study shipped is the one behind them)."""
+    from bearing_lab.bench import rate_choices
+    from bearing_lab.sim.auto import load_rules
+    rows = _study_rows()
+    bands = {b["max_rate_hz"]: b for b in load_rules()["defect"]["by_rate"]}
+    for (kind, fs), best in rate_choices(rows).items():
+        assert best is not None, f"no candidate held at {fs} Hz"
+        assert (bands[fs]["method"], bands[fs]["rtol"]) == best[:2]
+
+
+def test_rate_above_the_study_says_so():
+    from bearing_lab.sim import load_scene
+    from bearing_lab.sim.auto import resolve
+    top = max(r["rate_hz"] for r in _study_rows())
+    choice = resolve(load_scene("paper-O1", **{"output.sample_rate_hz": 2 * top}))
+    assert "was not studied" in choice["reason"]

@@ -305,7 +305,8 @@ def contact_table(defect: Defect, bearing, *, model: str, clearance: float = 0.0
     n_delta : delta grid points per ``delta_max`` (default 41); a table extended above
         ``delta_max`` keeps that spacing.
     above_drop : approach the table must cover above the deepest rigid drop of its psi range,
-        m: the table then reaches ``max(delta_max, max(drop) + above_drop)``, so a ball that
+        m: the table then reaches ``max(delta_max, max(drop) + above_drop)`` (no extension for
+        less than 5 % of delta_max), so a ball that
         falls into the defect and is loaded there reads computed values, never an
         extrapolation (give the loaded range, as the simulation does).
     delta_top : a lower bound of the table's top approach, m (the simulation extends a table
@@ -410,8 +411,10 @@ def _build(defect, bearing, *, model, clearance, delta_max, n_psi, n_delta, agai
     # the approach range: the loaded range, above the deepest drop when asked, and never
     # below delta_top; the grid keeps the loaded range's spacing
     top = delta_max
-    if above_drop is not None:
-        top = max(top, float(np.max(drop2)) + above_drop)
+    if above_drop is not None and float(np.max(drop2)) + above_drop > 1.05 * delta_max:
+        # (a drop that would lift the top by under 5 % of the loaded range adds no nodes: the
+        # loaded range then still reaches the drop plus 95 % of above_drop)
+        top = float(np.max(drop2)) + above_drop
     if delta_top is not None:
         top = max(top, delta_top)
     n_d = n_delta if top <= delta_max * (1 + 1e-12) else int(math.ceil(top / delta_max * (n_delta - 1))) + 1
