@@ -658,20 +658,28 @@ def _balls_kinematic_3d(y, p, z, c0, s0, phic, phidot, theta_s, omega_s, dint, d
         c, s = _ball_dir(p, z, j, c0, s0)
         ro, zo, lo, ro_r, zo_r = _geom_outer(y, zb, j, z, c, s, phidot, pd4, ago)
         ri, zi, li, ri_r, zi_r = _geom_inner(y, zb, j, z, c, s, phidot, pd4, agi)
-        fo = impact(lo - ago, (ro * ro_r + zo * zo_r) / lo, ko, e, cmax, dpen)
-        fi = impact(li - agi, (ri * ri_r + zi * zi_r) / li, ki, e, cmax, dpen)
+        ilo = 1.0 / lo
+        ili = 1.0 / li
+        fo = impact(lo - ago, (ro * ro_r + zo * zo_r) * ilo, ko, e, cmax, dpen)
+        fi = impact(li - agi, (ri * ri_r + zi * zi_r) * ili, ki, e, cmax, dpen)
         fo_out[j] = fo
         fi_out[j] = fi
+        # force components: on the outer ring (+) and on the ball (-) from the outer contact,
+        # on the ball (+) and on the inner ring (-) from the inner contact
+        for_ = fo * ro * ilo
+        foz_ = fo * zo * ilo
+        fir_ = fi * ri * ili
+        fiz_ = fi * zi * ili
         dy[8 + j] = y[8 + z + j]
-        dy[8 + z + j] = (fi * ri / li - fo * ro / lo) * inv_mb + (rp + y[8 + j]) * w2 - g * s
+        dy[8 + z + j] = (fir_ - for_) * inv_mb + (rp + y[8 + j]) * w2 - g * s
         dy[wb + j] = y[wb + z + j]
-        dy[wb + z + j] = (fi * zi / li - fo * zo / lo) * inv_mb
-        fix -= fi * ri / li * c
-        fiy -= fi * ri / li * s
-        fiz -= fi * zi / li
-        fox += fo * ro / lo * c
-        foy += fo * ro / lo * s
-        foz += fo * zo / lo
+        dy[wb + z + j] = (fiz_ - foz_) * inv_mb
+        fix -= fir_ * c
+        fiy -= fir_ * s
+        fiz -= fiz_
+        fox += for_ * c
+        foy += for_ * s
+        foz += foz_
     ndef = int(p[P_NDEF])
     if ndef == 0:
         return fix, fiy, fiz, fox, foy, foz
