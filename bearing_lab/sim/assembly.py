@@ -237,8 +237,9 @@ def _track_offset(defect, st, race, psi0, bearing):
     about its curvature centre by the contact angle at the defect's position, so that the table,
     built for a ball at the groove bottom, sees the outline where the contact track really runs.
     The defect's centre at axial offset H (groove angle asin(H / r_g)) moves to r_g sin(asin(H /
-    r_g) - alpha); the along-track radius change ((1 - cos alpha) r_g / R, 0.2 % at 10 deg) is
-    neglected."""
+    r_g) - alpha), and for an unskewed rectangle or ellipse its axial edges alike (its width then
+    grows by about 1 / cos(alpha)); a skewed outline or a polygon only moves.  The along-track
+    radius change ((1 - cos alpha) r_g / R, 0.2 % at 10 deg) is neglected."""
     import dataclasses
     a_i, a_o = groove_offsets(bearing)
     if race == "outer":
@@ -249,8 +250,13 @@ def _track_offset(defect, st, race, psi0, bearing):
         # a rotating (inner-race) defect: the angle of the most loaded ball
         r_g = a_i + bearing.ball_diameter / 2
         alpha = -float(st["alpha_i"][int(np.argmax(st["ball_loads_inner"]))])
-    beta = math.asin(max(-1.0, min(1.0, defect.offset / r_g)))
-    return dataclasses.replace(defect, offset=r_g * math.sin(beta - alpha)), alpha
+    def turn(zz):
+        return r_g * math.sin(math.asin(max(-1.0, min(1.0, zz / r_g))) - alpha)
+    if defect.skew == 0.0 and defect.shape in ("rectangle", "ellipse"):
+        # the axial edges turned too: a width B at the contact spans B / cos(alpha) of groove arc
+        lo, hi = turn(defect.offset - defect.width / 2), turn(defect.offset + defect.width / 2)
+        return dataclasses.replace(defect, offset=0.5 * (lo + hi), width=hi - lo), alpha
+    return dataclasses.replace(defect, offset=turn(defect.offset)), alpha
 
 
 def _defect_tables(scene: Scene, lz: float, delta_max: float, material, delta_top=None, st3d=None):
