@@ -39,7 +39,7 @@ import hashlib
 import importlib
 import inspect
 import json
-import mmap
+import os
 import re
 import warnings
 from abc import ABC, abstractmethod
@@ -131,10 +131,30 @@ def file_sha256(path, data=None) -> str:
     return h.hexdigest()
 
 
-def map_file(path):
-    """Return a read-only mmap of a non-empty file (the caller closes it)."""
+def read_file(path) -> bytes:
+    """Return the whole content of a regular file, refusing a file that changes while read.
+
+    Why not ``mmap``: a mapped file that another program truncates while it is read takes
+    the process down with SIGBUS the moment numpy or the checksum touch a page that no
+    longer exists; no Python code can catch that.  A plain read of the size ``fstat``
+    reports costs the same page-cache copy and turns the same event into a short read,
+    refused here with a message.
+
+    Raises
+    ------
+    RecordingError
+        If the file grew, shrank or was rewritten while it was read.
+    """
     with open(path, "rb") as fh:
-        return mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ)
+        before = os.fstat(fh.fileno())
+        data = fh.read(before.st_size + 1)
+        after = os.fstat(fh.fileno())
+    if (len(data) != before.st_size or after.st_size != before.st_size
+            or after.st_mtime_ns != before.st_mtime_ns):
+        raise RecordingError(f"{path}: the file changed while it was read ({before.st_size} bytes "
+                             f"when opened, {len(data)} read, {after.st_size} now): another program "
+                             "is writing or truncating it; read it again once it is complete")
+    return data
 
 
 _NAME_BAD = re.compile(r"[^A-Za-z0-9_+\-.]+")

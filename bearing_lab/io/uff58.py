@@ -5,7 +5,8 @@ truncated last set silently, returns 42 values for a header that promises
 2 508 876, lets NaN tokens through, reports 0 from ``get_set_formats()`` for
 binary sets and reads the whole file twice (once to find the blocks, once to
 parse them) with a per-value ``struct.unpack``.  This module reads the fixed
-headers itself (the same field widths as pyuff), maps the file once, seeks past
+headers itself (the same field widths as pyuff), reads the file once (a plain read, not a
+memory map: a map of a file truncated while it is read kills the process), seeks past
 each binary payload while scanning (so a 1 GB 58b is scanned header by header)
 and converts each payload with one ``numpy.frombuffer``.  pyuff stays the
 reference: the tests compare our values with pyuff's on every real file, the
@@ -30,7 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import RecordingError, check_choice
-from ._base import ENGINES, RecordingBuilder, RecordingReader, clean_name, map_file
+from ._base import ENGINES, RecordingBuilder, RecordingReader, clean_name, read_file
 
 _DELIM = re.compile(rb"^[ \t]*-1[ \t]*\r?$", re.M)
 _MAX_PAD = 64  # bytes of blanks/NULs a writer may leave after a binary payload
@@ -127,14 +128,8 @@ class Uff58Reader(RecordingReader):
         b = RecordingBuilder(path, self, units=units, sensitivity=sensitivity, checksum=checksum)
         check_choice(byte_order, (None, "little", "big"), f"{path}: byte_order", RecordingError)
         self._force_bo = {None: None, "little": 1, "big": 2}[byte_order]
-        mm = map_file(path)
-        try:
-            return self._read(mm, b, channels, allow_truncated, fs, snap_rate)
-        finally:
-            try:
-                mm.close()
-            except BufferError:  # a view is still referenced by a traceback; GC closes it
-                pass
+        data = read_file(path)
+        return self._read(data, b, channels, allow_truncated, fs, snap_rate)
 
     # -- scanning -------------------------------------------------------------------
     def _line(self, mm, pos):
@@ -359,7 +354,7 @@ class Uff58Reader(RecordingReader):
                        f"only make sense {other}-endian: the byte order in the file is wrong; "
                        f"pass byte_order='{other}' to read it anyway")
             vals = raw.astype(np.float64)
-            del raw  # no view of the map may outlive it
+            del raw
         else:
             text = mm[st.data_start:st.data_end]
             if b"D" in text or b"d" in text:
@@ -466,7 +461,7 @@ class Uff58Reader(RecordingReader):
         return label, factor
 
     def _read(self, mm, b, channels, allow_truncated, fs_override, snap_rate):
-        if len(mm) == 0:  # pragma: no cover - mmap refuses empty files earlier
+        if len(mm) == 0:  # pragma: no cover - open_recording refuses empty files earlier
             b.fail("file is empty")
         sets = self._scan(mm, b, allow_truncated)
         if not sets:

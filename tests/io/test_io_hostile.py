@@ -76,3 +76,38 @@ def test_unreadable_file(tmp_path):
             open_recording(p)
     finally:
         p.chmod(stat.S_IRUSR | stat.S_IWUSR)
+
+
+# ------------------------------------------------------------------ files that change while read
+def test_uff_truncated_while_read_is_refused(write, sine, monkeypatch):
+    """The file is cut between the size check and the read: a message, never SIGBUS."""
+    from bearing_lab.io import _base
+    from bearing_lab.io._testing import uff58_block
+    p = write("cut.uff", uff58_block(sine, binary=True))
+    real_fstat = os.fstat
+    calls = []
+
+    def fstat_then_truncate(fd):
+        st = real_fstat(fd)
+        if not calls:  # another program truncates the file right after it was opened
+            os.truncate(p, 1000)
+        calls.append(st.st_size)
+        return st
+
+    monkeypatch.setattr(_base.os, "fstat", fstat_then_truncate)
+    with pytest.raises(RecordingError, match=r"cut.uff: the file changed while it was read \(\d+ "
+                                             r"bytes when opened, 1000 read, 1000 now\)"):
+        open_recording(p, format="uff58")
+
+
+def test_uff_reader_does_not_map_the_file(write, sine, monkeypatch):
+    """A mapped file truncated by another program kills the process (SIGBUS): no mmap."""
+    import mmap
+    from bearing_lab.io._testing import uff58_block
+    p = write("m.uff", uff58_block(sine, binary=True))
+
+    def no_map(*a, **k):
+        raise AssertionError("the reader maps the file")
+
+    monkeypatch.setattr(mmap, "mmap", no_map)
+    np.testing.assert_array_equal(open_recording(p)["acc"].values, sine)
