@@ -53,6 +53,24 @@ from .. import units as _units
 MIN_RATE_HZ = 1e-3   # slower than a sample every 17 minutes: not a vibration recording
 MAX_RATE_HZ = 1e9    # faster than any vibration data-acquisition front end
 
+MAX_RPM = 1e6        # faster than any rolling bearing turns (dental turbines: about 4e5 r/min)
+
+
+def speed_problem(rpm) -> str | None:
+    """None if ``rpm`` is a plausible shaft speed in r/min, else what is wrong with it."""
+    try:
+        rpm = float(rpm)
+    except (TypeError, ValueError):
+        return "is not a number"
+    if not np.isfinite(rpm):
+        return "is not finite"
+    if rpm <= 0:
+        return "is not positive"
+    if rpm > MAX_RPM:
+        return f"is faster than any rolling bearing turns (more than {MAX_RPM:.0e} r/min)"
+    return None
+
+
 ENGINES: dict[str, type["RecordingReader"]] = {}
 """Format name -> reader class, in sniffing order (registered by each format module)."""
 
@@ -457,6 +475,15 @@ class RecordingBuilder:
         if self.sha256 is None:
             # after parsing, so the bytes come from the page cache (or the reader's map)
             self.sha256 = file_sha256(self.path, data) if self.checksum else ""
+        rpm = None
+        if shaft_speed_rpm is not None:
+            problem = speed_problem(shaft_speed_rpm)
+            if problem is None:
+                rpm = float(shaft_speed_rpm)
+            else:  # the vibration data are fine: keep them, drop the speed, and say so
+                self.warn(f"the stored shaft speed {shaft_speed_rpm!r} r/min {problem}: not used "
+                          "(give the speed with --rpm)")
+                self.attrs["file_shaft_speed_rpm"] = str(shaft_speed_rpm)
         q_acc = [k for k, (_, a) in self.channels.items() if a.get("quantity") == "acceleration"]
         default = default_channel if default_channel in self.channels else \
             (q_acc[0] if q_acc else next(iter(self.channels)))
@@ -472,8 +499,8 @@ class RecordingBuilder:
             "start_time_s": float(t[0]),
             "n_samples": int(n),
         }
-        if shaft_speed_rpm is not None and np.isfinite(float(shaft_speed_rpm)):
-            attrs["shaft_speed_rpm"] = float(shaft_speed_rpm)
+        if rpm is not None:
+            attrs["shaft_speed_rpm"] = rpm
         for k, v in self.attrs.items():
             if v is not None and k not in attrs:
                 attrs[k] = _attr_value(v)

@@ -151,8 +151,12 @@ class CwruReader(RecordingReader):
                                               "BA": "base"}[c]})
         rpm = None
         if rpm_var and np.size(m.get(rpm_var, [])) >= 1:
-            rpm = float(np.ravel(m[rpm_var])[0])
-            b.attrs["shaft_speed_source"] = f"file variable {rpm_var}"
+            value = np.ravel(m[rpm_var])[0] if not isinstance(m[rpm_var], str) else m[rpm_var]
+            if isinstance(value, (str, bytes)) or np.iscomplexobj(value):
+                b.warn(f"variable {rpm_var} holds {value!r}, not a speed: shaft_speed_rpm unknown")
+            else:
+                rpm = float(value)
+                b.attrs["shaft_speed_source"] = f"file variable {rpm_var}"
         elif reg is not None and reg.rpm:
             rpm = reg.rpm
             b.attrs["shaft_speed_source"] = "registry bearing_lab/data/recordings.csv"

@@ -111,3 +111,88 @@ def test_uff_reader_does_not_map_the_file(write, sine, monkeypatch):
 
     monkeypatch.setattr(mmap, "mmap", no_map)
     np.testing.assert_array_equal(open_recording(p)["acc"].values, sine)
+
+
+# ------------------------------------------------------------------ netCDF attributes
+def _nc(tmp_path, name="r.nc", *, n=1200, fs=12000.0, reader="csv", **attrs):
+    """A small bearing_lab netCDF (a recording, or with reader=None a simulation-like output)."""
+    import xarray as xr
+    from bearing_lab.io import to_netcdf
+    t = np.arange(n) / fs
+    acc = np.sin(2 * np.pi * 157.0 * t)
+    base = {"sampling_rate_hz": fs, "bearing_lab_version": "0", "default_channel": "acc"}
+    if reader:
+        base.update(source_file="x", source_sha256="", reader=reader, warnings="")
+    else:
+        base.update(scene_toml="", fidelity="fast", scene_name="paper-slot")
+    base.update(attrs)
+    ds = xr.Dataset({"acc": ("time", acc, {"units": "m s-2", "quantity": "acceleration",
+                                           "original_units": "m/s2"})},
+                    coords={"time": ("time", t, {"units": "s"})}, attrs=base)
+    return to_netcdf(ds, tmp_path / name)
+
+
+def test_import_of_a_netcdf_without_reader_attribute(tmp_path, capsys):
+    """A simulation output has no `reader`: importing it is a copy, not a KeyError."""
+    src = _nc(tmp_path, "sim.nc", reader=None)
+    out = tmp_path / "copy.nc"
+    assert main(["import", str(src), "-o", str(out)]) == 0
+    assert "1200 samples at 12000 Hz (0.1 s), reader netcdf (simulation)" in capsys.readouterr().out
+    np.testing.assert_array_equal(open_recording(out)["acc"].values, open_recording(src)["acc"].values)
+
+
+@pytest.mark.parametrize("value, why", [
+    ("12 kHz", r"attribute sampling_rate_hz is '12 kHz', not a number of Hz"),
+    (float("nan"), r"attribute sampling_rate_hz = nan Hz is not a rate of a vibration recording"),
+    (1.0, r"attribute sampling_rate_hz = 1 Hz disagrees with the time coordinate \(12000 Hz\)"),
+    (12000.5, r"attribute sampling_rate_hz = 12000.5 Hz disagrees with the time coordinate"),
+])
+def test_netcdf_rate_must_be_a_number_that_matches_time(tmp_path, capsys, value, why):
+    p = _nc(tmp_path, sampling_rate_hz=value)
+    with pytest.raises(RecordingError, match=r"r.nc: " + why):
+        open_recording(p)
+    assert main(["info", str(p)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "sampling_rate_hz" in err
+
+
+@pytest.mark.parametrize("rpm, why", [(1e12, "is faster than any rolling bearing turns"),
+                                      (0.0, "is not positive"), (-1797.0, "is not positive"),
+                                      ("fast", "is not a number")])
+def test_netcdf_stored_speed_must_be_plausible(tmp_path, rpm, why):
+    with pytest.raises(RecordingError, match=rf"r.nc: attribute shaft_speed_rpm = .* {why}"):
+        open_recording(_nc(tmp_path, shaft_speed_rpm=rpm))
+
+
+def test_rig_file_with_absurd_speed_keeps_data_drops_speed(tmp_path):
+    """A reader that finds an absurd stored speed keeps the signal and says it dropped the speed."""
+    from bearing_lab.io import get_warnings
+    from bearing_lab.io._base import RecordingBuilder
+    from bearing_lab.io.csv import CsvReader
+    for rpm in (1e12, 0.0, -5.0, float("nan")):
+        b = RecordingBuilder(tmp_path / "f.csv", CsvReader(), checksum=False)
+        b.add_channel("acc", np.sin(np.arange(100.0)), "m/s2")
+        ds = b.build(fs=1000.0, shaft_speed_rpm=rpm)
+        assert "shaft_speed_rpm" not in ds.attrs
+        assert any("stored shaft speed" in w and "not used" in w for w in get_warnings(ds)), rpm
+
+
+def test_analysis_refuses_a_speed_above_nyquist_at_once(tmp_path, capsys):
+    """--rpm 1e12 used to allocate a candidate grid of hundreds of GiB."""
+    import time
+    p = _nc(tmp_path, n=24000)
+    t0 = time.perf_counter()
+    assert main(["analyze", str(p), "--bearing", "6205", "--rpm", "1e12"]) == 2
+    assert time.perf_counter() - t0 < 10
+    err = capsys.readouterr().err
+    assert "shaft speed of 1e+12 r/min" in err and "below 6000 Hz" in err
+    from bearing_lab.analysis import shaft_speed
+    from bearing_lab.errors import AnalysisError
+    with pytest.raises(AnalysisError, match="cannot be seen in a record sampled at 1000 Hz"):
+        shaft_speed(np.random.default_rng(0).normal(size=4000), 1000.0, bearing="6205", rpm=60 * 600)
+
+
+def test_import_rpm_option_is_bounded(tmp_path, capsys):
+    src = _nc(tmp_path)
+    assert main(["import", str(src), "--rpm", "1e12", "-o", str(tmp_path / "o.nc")]) == 2
+    assert "--rpm 1e+12 is faster than any rolling bearing turns" in capsys.readouterr().err
