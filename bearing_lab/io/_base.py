@@ -307,6 +307,8 @@ class RecordingBuilder:
         x = np.asarray(values)
         if x.ndim != 1:
             self.fail(f"channel {name!r} has shape {x.shape}; expected one dimension")
+        if x.dtype.kind == "c":
+            self.fail(f"channel {name!r} holds complex values; a recorded time signal is real")
         if x.dtype.kind not in "iuf":
             self.fail(f"channel {name!r} holds {x.dtype} values, not numbers")
         if x.dtype != np.float64:

@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from ._base import ENGINES, RecordingBuilder, RecordingReader
-from ._matlab import load_mat, mat_variables, mat_version
+from ._matlab import load_mat, mat_variables, mat_version, signal_vector
 
 _CHAN = re.compile(r"^X(\d+)_(DE|FE|BA)_time$")
 _RPM = re.compile(r"^X(\d+)RPM$")
@@ -145,7 +145,7 @@ class CwruReader(RecordingReader):
             b.attrs["sampling_rate_source"] = "user"
         order = [c for c in ("DE", "FE", "BA") if c in found[rec]]
         for c in order:
-            v = np.asarray(m[found[rec][c]], dtype=np.float64).ravel()
+            v = signal_vector(b, m[found[rec][c]], found[rec][c])
             b.add_channel(c, v, None, file_name=found[rec][c], inplace=True,
                           attrs={"location": {"DE": "drive end", "FE": "fan end",
                                               "BA": "base"}[c]})

@@ -196,3 +196,97 @@ def test_import_rpm_option_is_bounded(tmp_path, capsys):
     src = _nc(tmp_path)
     assert main(["import", str(src), "--rpm", "1e12", "-o", str(tmp_path / "o.nc")]) == 2
     assert "--rpm 1e+12 is faster than any rolling bearing turns" in capsys.readouterr().err
+
+
+# ------------------------------------------------------------------ MATLAB v5 / v7.3, hand-built
+def _savemat(path, variables, compress=True):
+    import scipy.io
+    scipy.io.savemat(path, variables, do_compression=compress, oned_as="column")
+    return path
+
+
+def _compressed_element(payload: bytes) -> bytes:
+    """A top-level miCOMPRESSED element around ``payload`` (already deflated)."""
+    return struct.pack("<II", 15, len(payload)) + payload
+
+
+def _matrix_bytes(path_of_one_var_file) -> bytes:
+    """The inflated miMATRIX element of the only variable of a compressed v5 file."""
+    raw = path_of_one_var_file.read_bytes()
+    typ, nb = struct.unpack_from("<II", raw, 128)
+    assert typ == 15
+    return zlib.decompress(raw[136:136 + nb])
+
+
+def test_mat5_two_zlib_streams_in_one_element_refused(tmp_path):
+    """The second stream (here the fan-end channel) used to vanish without a word."""
+    x = np.sin(np.arange(4000) / 7.0)
+    de = _matrix_bytes(_savemat(tmp_path / "de.mat", {"X130_DE_time": x}))
+    fe = _matrix_bytes(_savemat(tmp_path / "fe.mat", {"X130_FE_time": 2 * x}))
+    head = (tmp_path / "de.mat").read_bytes()[:128]
+    p = tmp_path / "130_two.mat"
+    p.write_bytes(head + _compressed_element(zlib.compress(de) + zlib.compress(fe)))
+    with pytest.raises(RecordingError, match=r"130_two.mat: .*compressed variable at byte 128: \d+ "
+                                             r"bytes follow the end of the compressed stream"):
+        open_recording(p, fs=12000)
+    junk = tmp_path / "130_junk.mat"
+    junk.write_bytes(head + _compressed_element(zlib.compress(de) + b"JUNK" * 8))
+    with pytest.raises(RecordingError, match=r"130_junk.mat: .*32 bytes follow the end"):
+        open_recording(junk, fs=12000)
+    ok = tmp_path / "130_ok.mat"  # one stream per element, as MATLAB writes: both channels read
+    ok.write_bytes(head + _compressed_element(zlib.compress(de)) + _compressed_element(zlib.compress(fe)))
+    ds = open_recording(ok, fs=12000)
+    np.testing.assert_array_equal(ds["FE"].values, 2 * x * 9.80665)
+
+
+@pytest.mark.parametrize("compress", [False, True])
+def test_cwru_n_by_2_matrix_refused_not_interleaved(tmp_path, compress):
+    x = np.stack([np.arange(3000.0), -np.arange(3000.0)], axis=1)  # N×2
+    p = _savemat(tmp_path / "130_m.mat", {"X130_DE_time": x}, compress)
+    with pytest.raises(RecordingError, match=r"130_m.mat: variable 'X130_DE_time' is a 3000×2 matrix, "
+                                             "not one channel"):
+        open_recording(p, fs=12000)
+
+
+def test_mfpt_n_by_2_matrix_refused(tmp_path):
+    gs = np.stack([np.arange(3000.0), -np.arange(3000.0)], axis=1)
+    p = _savemat(tmp_path / "mfpt.mat", {"bearing": {"gs": gs, "sr": 48828.0, "rate": 25.0}})
+    with pytest.raises(RecordingError, match=r"mfpt.mat: variable 'bearing.gs' is a 3000×2 matrix"):
+        open_recording(p)
+
+
+def test_v73_n_by_2_matrix_refused(tmp_path):
+    """v7.3 (HDF5): MATLAB's N×2 is stored as a 2×N dataset; still one clear refusal."""
+    h5py = pytest.importorskip("h5py")
+    p = tmp_path / "130_v73.mat"
+    with h5py.File(p, "w", userblock_size=512) as f:
+        d = f.create_dataset("X130_DE_time", data=np.stack([np.arange(3000.0), -np.arange(3000.0)]))
+        d.attrs["MATLAB_class"] = np.bytes_("double")
+    with open(p, "r+b") as fh:
+        fh.write(b"MATLAB 7.3 MAT-file, Platform: GLNXA64, Created on: test HDF5 schema 1.00 .")
+    with pytest.raises(RecordingError, match=r"130_v73.mat: variable 'X130_DE_time' is a 3000×2 matrix"):
+        open_recording(p, fs=12000)
+
+
+def test_complex_channel_refused_not_cut_to_real(tmp_path):
+    z = np.exp(1j * np.arange(3000) / 5.0)
+    p = _savemat(tmp_path / "130_c.mat", {"X130_DE_time": z})
+    with pytest.raises(RecordingError, match=r"130_c.mat: variable 'X130_DE_time' holds complex values"):
+        open_recording(p, fs=12000)
+
+
+def test_mat5_inflate_bomb_refused_before_allocating(tmp_path, monkeypatch):
+    """A few kB that inflate to 80 MB of zeros: refused from the declared size, in milliseconds."""
+    import time
+    zeros = np.zeros((10_000_000, 1))
+    p = _savemat(tmp_path / "130_bomb.mat", {"X130_DE_time": zeros})
+    size = p.stat().st_size
+    assert size < 200_000
+    t0 = time.perf_counter()
+    with pytest.raises(RecordingError, match=r"130_bomb.mat: .*declares 80000\d+ bytes inside \(inflate "
+                                             r"ratio \d+, more than the 100 .*BEARING_LAB_MAX_INFLATE_RATIO"):
+        open_recording(p, fs=12000)
+    assert time.perf_counter() - t0 < 1.0
+    monkeypatch.setenv("BEARING_LAB_MAX_INFLATE_RATIO", "1e6")  # the user says it is genuine
+    ds = open_recording(p, fs=12000)
+    assert ds.sizes["time"] == 10_000_000 and not ds["DE"].values.any()
