@@ -290,3 +290,40 @@ def test_mat5_inflate_bomb_refused_before_allocating(tmp_path, monkeypatch):
     monkeypatch.setenv("BEARING_LAB_MAX_INFLATE_RATIO", "1e6")  # the user says it is genuine
     ds = open_recording(p, fs=12000)
     assert ds.sizes["time"] == 10_000_000 and not ds["DE"].values.any()
+
+
+# ------------------------------------------------------------------ WAV format fields
+def wav_bytes(samples, *, channels=None, bits=16, align=None, tag=1, rate=12000, fmt_first=True):
+    """A RIFF/WAVE file with format fields as given (independent of scipy's writer)."""
+    samples = np.asarray(samples)
+    channels = samples.shape[1] if channels is None else channels
+    align = channels * ((bits + 7) // 8) if align is None else align
+    payload = samples.astype("<i2" if bits == 16 else "<f4").tobytes()
+    fmt = b"fmt " + struct.pack("<IHHIIHH", 16, tag, channels, rate, rate * align, align, bits)
+    data = b"data" + struct.pack("<I", len(payload)) + payload + b"\0" * (len(payload) & 1)
+    body = b"WAVE" + (fmt + data if fmt_first else data + fmt)
+    return b"RIFF" + struct.pack("<I", len(body)) + body
+
+
+@pytest.mark.parametrize("fields, why", [
+    ({"align": 1}, r"block_align is 1 bytes but 2 channel\(s\) × 2 bytes \(16-bit samples\) make 4"),
+    ({"align": 8}, r"block_align is 8 bytes but 2 channel\(s\) × 2 bytes"),
+    ({"channels": 0, "align": 4}, r"the fmt chunk declares 0 channels"),
+    ({"bits": 0, "align": 4}, r"the fmt chunk declares 0 bits per sample"),
+    ({"tag": 2}, r"format tag 2 is not PCM \(1\) or IEEE float \(3\)"),
+    ({"rate": 0}, r"the fmt chunk declares a sampling rate of 0 Hz"),
+    ({"fmt_first": False}, r"the data chunk comes before the fmt chunk"),
+])
+def test_wav_format_fields_checked_before_decoding(write, fields, why):
+    """scipy picks the sample type from block_align: a wrong one read int16 data as int8/int32."""
+    x = (np.arange(400).reshape(200, 2) - 200) * 50
+    p = write("f.wav", wav_bytes(x, **fields))
+    with pytest.raises(RecordingError, match=r"f.wav: not a valid WAV file: " + why):
+        open_recording(p, full_scale="10 g")
+
+
+def test_wav_with_consistent_fields_reads_the_samples(write):
+    x = (np.arange(400).reshape(200, 2) - 200) * 50
+    ds = open_recording(write("ok.wav", wav_bytes(x)), full_scale="10 g")
+    np.testing.assert_allclose(ds["ch2"].values, x[:, 1] / 32768 * 10 * 9.80665, rtol=1e-12)
+    assert ds.attrs["wav_dtype"] == "int16"
