@@ -31,11 +31,12 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import RecordingError, check_choice
-from ._base import ENGINES, RecordingBuilder, RecordingReader, clean_name, read_file
+from ._base import ENGINES, MAX_RATE_HZ, MIN_RATE_HZ, RecordingBuilder, RecordingReader, clean_name, read_file
 
 _DELIM = re.compile(rb"^[ \t]*-1[ \t]*\r?$", re.M)
 _MAX_PAD = 64  # bytes of blanks/NULs a writer may leave after a binary payload
 # Universal File dataset numbers seen in test and modal files (others are refused as damage)
+_MIN_164_FACTOR = 1e-12   # dataset 164 factors scale by 1e±3 (mm), 39.37 (in): 1e±12 is no unit
 _KNOWN_DATASETS = {15, 18, 55, 58, 82, 151, 164, 773, 780, 781, 1710, 1858, 2400, 2411, 2412,
                    2414, 2420, 2429, 2430, 2431, 2432, 2435, 2437, 2467, 2477}
 _DIRS = {1: "+X", 2: "+Y", 3: "+Z", -1: "-X", -2: "-Y", -3: "-Z", 4: "+RX", 5: "+RY", 6: "+RZ",
@@ -447,7 +448,7 @@ class Uff58Reader(RecordingReader):
             return f"{node}{_DIRS.get(d, '')}" if d else f"node{node}"
         return f"ch{k}"
 
-    def _unit_from_164(self, st, units164):
+    def _unit_from_164(self, st, units164, b):
         """Unit label from the ordinate's spec data type and exponents when the label is empty."""
         h = st.header
         q = _SPEC_QUANTITY.get(h["ordinate_spec_data_type"])
@@ -457,7 +458,17 @@ class Uff58Reader(RecordingReader):
         factor = 1.0
         if units164 is not None:
             lf, ff = units164
-            factor = 1.0 / (lf ** h["ordinate_len_unit_exp"] * ff ** h["ordinate_force_unit_exp"])
+            e_len, e_force = h["ordinate_len_unit_exp"], h["ordinate_force_unit_exp"]
+            try:
+                with np.errstate(all="ignore"):
+                    factor = float(1.0 / (np.float64(lf) ** e_len * np.float64(ff) ** e_force))
+            except (OverflowError, ZeroDivisionError):
+                factor = math.inf
+            if not (math.isfinite(factor) and _MIN_164_FACTOR <= factor <= 1.0 / _MIN_164_FACTOR):
+                b.fail(f"set {st.index}: the unit factors of dataset 164 (length {lf:g}, force {ff:g}) "
+                       f"with the ordinate's unit exponents (length {e_len}, force {e_force}) would "
+                       f"scale every value by {factor:.3g}: not a unit conversion, the units set is "
+                       "damaged; give the channels' unit with units='m/s2' (CLI --units)")
         return label, factor
 
     def _read(self, mm, b, channels, allow_truncated, fs_override, snap_rate):
@@ -559,7 +570,7 @@ class Uff58Reader(RecordingReader):
             factor164 = None
             if (not label or label.upper() == "NONE") and b.units is None:
                 # no label: the spec data type, unit exponents and dataset 164 say it
-                label, factor164 = self._unit_from_164(st, units164)
+                label, factor164 = self._unit_from_164(st, units164, b)
                 if factor164 not in (None, 1.0):
                     vals = np.asarray(vals, dtype=np.float64) * factor164
             attrs = {k: h[k] for k in ("id1", "id2", "id3", "id4", "id5", "rsp_ent_name")
@@ -586,7 +597,12 @@ class Uff58Reader(RecordingReader):
         else:
             if not inc > 0:
                 b.fail(f"abscissa increment {h0['abscissa_inc_text']!r} is not positive; pass fs=<Hz>")
-            fs = 1.0 / inc
+            with np.errstate(over="ignore"):
+                fs = float(np.float64(1.0) / np.float64(inc))
+            if not MIN_RATE_HZ <= fs <= MAX_RATE_HZ:
+                b.fail(f"abscissa increment {h0['abscissa_inc_text'].strip()!r} s means a sampling "
+                       f"rate of {fs:.6g} Hz, outside {MIN_RATE_HZ:g} Hz .. {MAX_RATE_HZ:.0e} Hz: a "
+                       "damaged header; pass fs=<Hz>")
             if snap_rate:
                 fs = self._snap(fs, h0["abscissa_inc_text"], b)
         for k in ("id1", "id2", "id3", "id4", "id5"):
@@ -626,9 +642,11 @@ class Uff58Reader(RecordingReader):
         except (IndexError, ValueError):
             b.warn(f"set {st.index} (dataset 164, units) is unreadable and was ignored")
             return None
-        if not (length > 0 and force > 0):
-            b.warn(f"set {st.index} (dataset 164) has factors {length}, {force}; ignored")
-            return None
+        if not (0 < length < math.inf and 0 < force < math.inf):  # also NaN
+            # used, these would turn every value into 0, inf or NaN: a channel that needs them
+            # is refused (_unit_from_164); channels with their own unit labels do not need them
+            b.warn(f"set {st.index} (dataset 164) has factors {length}, {force}, which are not unit "
+                   "factors")
         return (length, force)
 
 

@@ -327,3 +327,43 @@ def test_wav_with_consistent_fields_reads_the_samples(write):
     ds = open_recording(write("ok.wav", wav_bytes(x)), full_scale="10 g")
     np.testing.assert_allclose(ds["ch2"].values, x[:, 1] / 32768 * 10 * 9.80665, rtol=1e-12)
     assert ds.attrs["wav_dtype"] == "int16"
+
+
+# ------------------------------------------------------------------ UFF header fields
+def _u164(length: str, force: str = "1.00000000000000000D+00") -> bytes:
+    return (b"    -1\n   164\n         2mm (milli newton)         2\n"
+            + f"  {length:>25s}  {force:>25s}  1.00000000000000000D+00\n".encode()
+            + b"  2.73150000000000000D+02\n    -1\n")
+
+
+@pytest.mark.parametrize("length, scale", [("Infinity", "0"), ("1.0D-300", "1e+300"),
+                                           ("1.0D+200", "1e-200"), ("NaN", "nan")])
+def test_uff_164_factor_that_is_no_unit_refused(write, sine, length, scale):
+    """An infinite length factor multiplied every sample by 0; 1e-300 scaled them by 1e300."""
+    from bearing_lab.io._testing import uff58_block
+    import re
+    p = write("u.uff", _u164(length) + uff58_block(sine, unit="NONE", binary=True))
+    with pytest.raises(RecordingError, match=rf"u.uff: set \d+: the unit factors of dataset 164 .* "
+                                             rf"would scale every value by {re.escape(scale)}: not a unit "
+                                             "conversion.*units="):
+        open_recording(p)
+    ds = open_recording(p, units="m/s2")  # the user's unit replaces the damaged units set
+    np.testing.assert_array_equal(ds["acc"].values, sine)
+
+
+def test_uff_164_ignored_when_every_channel_has_a_label(write, sine):
+    from bearing_lab.io import get_warnings
+    from bearing_lab.io._testing import uff58_block
+    ds = open_recording(write("u.uff", _u164("Infinity") + uff58_block(sine, unit="m/s2", binary=True)))
+    np.testing.assert_array_equal(ds["acc"].values, sine)
+    assert any("which are not unit factors" in w for w in get_warnings(ds))
+
+
+@pytest.mark.parametrize("inc", ["1.00000E-320", "1.00000E-12"])
+def test_uff_increment_that_means_no_rate_refused(write, sine, inc):
+    """1e-320 made round(fs) raise OverflowError inside the rate snapping."""
+    from bearing_lab.io._testing import uff58_block
+    p = write("inc.uff", uff58_block(sine, inc=inc))
+    with pytest.raises(RecordingError, match=rf"inc.uff: abscissa increment '{inc}' s means a sampling "
+                                             r"rate of .* Hz, outside 0.001 Hz .. 1e\+09 Hz"):
+        open_recording(p)
