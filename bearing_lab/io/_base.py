@@ -176,11 +176,17 @@ def read_file(path) -> bytes:
 
 
 _NAME_BAD = re.compile(r"[^A-Za-z0-9_+\-.]+")
+_NAME_OK = re.compile(r"[A-Za-z0-9][A-Za-z0-9_+\-.]*")
 
 
 def clean_name(name, fallback: str) -> str:
-    """Clean a channel name to letters, digits and ``_ + - .``; ``fallback`` if empty."""
-    s = _NAME_BAD.sub("_", str(name).strip()).strip("_")
+    """Clean a channel name to letters, digits and ``_ + - .``; ``fallback`` if empty.
+
+    The name starts with a letter or digit: netCDF refuses variable names that start with
+    ``.``, ``+`` or ``-`` (a column ``../../etc [g]`` becomes ``etc``), and the refusal would
+    only come when the recording is written, naming the output instead of the input.
+    """
+    s = _NAME_BAD.sub("_", str(name).strip()).strip("_").lstrip("_+-.")
     if not s or s.upper() == "NONE":
         return fallback
     return s
@@ -302,6 +308,8 @@ class RecordingBuilder:
         file_name : the channel's name in the file, for ``units``/``sensitivity`` dicts.
         inplace : the reader no longer needs ``values``: scale it in place (saves a copy).
         """
+        if not _NAME_OK.fullmatch(str(name)):  # a reader's own name (UFF node "-5+Z"): netCDF-safe
+            name = clean_name(name, f"ch{len(self.channels) + 1}")
         name = self.unique_name(name)
         original = file_name if file_name is not None else name
         x = np.asarray(values)

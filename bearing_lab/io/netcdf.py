@@ -31,11 +31,28 @@ def _load(path: str):
     """Read the whole file (runs in the guarded child)."""
     import xarray as xr
     try:
+        path.encode("utf-8")
+    except UnicodeEncodeError:  # a name in another locale's bytes: netCDF-C takes UTF-8 names
+        return _load_through_link(path)
+    try:
         return xr.load_dataset(path, engine="netcdf4")
     except (OSError, ValueError, RuntimeError, KeyError, IndexError, TypeError, AttributeError,
             UnicodeDecodeError) as exc:
         raise RecordingError(f"{path}: not a readable netCDF4 file ({type(exc).__name__}: "
                              f"{exc})") from None
+
+
+def _load_through_link(path: str):
+    """Read a file whose name is not UTF-8 through a symbolic link with a plain name."""
+    import os
+    import tempfile
+    with tempfile.TemporaryDirectory(prefix="bearing_lab_nc_") as d:
+        link = os.path.join(d, "file.nc")
+        os.symlink(os.path.abspath(path), link)
+        try:
+            return _load(link)
+        except RecordingError as exc:
+            raise RecordingError(str(exc).replace(link, path)) from None
 
 
 def _check_values(ds, path):

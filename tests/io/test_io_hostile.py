@@ -367,3 +367,69 @@ def test_uff_increment_that_means_no_rate_refused(write, sine, inc):
     with pytest.raises(RecordingError, match=rf"inc.uff: abscissa increment '{inc}' s means a sampling "
                                              r"rate of .* Hz, outside 0.001 Hz .. 1e\+09 Hz"):
         open_recording(p)
+
+
+# ------------------------------------------------------------------ outputs: names and disks
+def test_long_output_name_up_to_the_limit(tmp_path, datafile, capsys):
+    """A 240-byte -o name failed: the temporary name added ~22 bytes past the 255-byte limit."""
+    src = datafile("lms/binary8byte_g.uff")
+    for length in (233, 240, 255):
+        out = tmp_path / ("a" * (length - 3) + ".nc")
+        assert main(["import", str(src), "-o", str(out)]) == 0, capsys.readouterr().err
+        assert out.is_file() and len(os.listdir(tmp_path)) == 1  # no temporary left
+        out.unlink()
+    too_long = tmp_path / ("a" * 253 + ".nc")
+    assert main(["import", str(src), "-o", str(too_long)]) == 2
+    assert "the file name has 256 bytes; a file name has at most 255" in capsys.readouterr().err
+
+
+def test_stale_temporaries_of_long_names_are_found(tmp_path):
+    """The cut-and-hashed temporary prefix is the same in every process, so a killed writer's
+    temporary of a long name is removed by the next write."""
+    from bearing_lab import _files
+    name = "b" * 250 + ".nc"
+    stale = tmp_path / (_files._tmp_prefix(name, ".nc").replace(f"-{os.getpid()}.", "-4194303.")
+                        + "zzzzzzzz.nc")
+    assert len(os.fsencode(stale.name)) <= 255
+    stale.write_bytes(b"half")
+    _files.write_text(tmp_path / name, "x")
+    assert sorted(os.listdir(tmp_path)) == [name]
+
+
+def test_output_name_that_is_not_utf8(tmp_path, datafile, capsys):
+    """An -o name in another locale's bytes raised UnicodeEncodeError inside netCDF-C."""
+    src = datafile("lms/binary8byte_g.uff")
+    out = os.path.join(os.fsdecode(bytes(tmp_path)), os.fsdecode(b"caf\xe9.nc"))
+    assert main(["import", str(src), "-o", out]) == 0, capsys.readouterr().err
+    assert os.listdir(bytes(tmp_path)) == [b"caf\xe9.nc"]
+    assert open_recording(out)["sine_5_Hz"].size == 250
+
+
+def test_full_disk_is_named_as_such(tmp_path, monkeypatch):
+    """netCDF-C reports a full disk as 'Permission denied' or 'HDF error'."""
+    import shutil
+    import xarray as xr
+    from bearing_lab.errors import BearingLabError
+    from bearing_lab.io_netcdf import write_netcdf
+
+    def denied(self, path, **kw):
+        raise PermissionError(13, "Permission denied", str(path))
+
+    monkeypatch.setattr(xr.Dataset, "to_netcdf", denied)
+    ds = xr.Dataset({"a": ("time", np.zeros(100_000))}, coords={"time": np.arange(100_000.0)})
+    real = shutil.disk_usage
+    monkeypatch.setattr(shutil, "disk_usage", lambda p: real(p)._replace(free=4096))
+    with pytest.raises(BearingLabError, match=r"o.nc: cannot write netCDF4 \(no space left on the "
+                                              r"device: 0.0041 MB free in .*, the data take up to 1.6 MB\)"):
+        write_netcdf(ds, tmp_path / "o.nc")
+    monkeypatch.setattr(shutil, "disk_usage", real)  # space enough: the library's own words
+    with pytest.raises(BearingLabError, match=r"PermissionError: \[Errno 13\] Permission denied"):
+        write_netcdf(ds, tmp_path / "o.nc")
+
+
+def test_column_name_that_netcdf_refuses_is_cleaned_at_read(write, tmp_path, capsys):
+    """'../../etc [g]' failed at write time, naming the output file, not the input column."""
+    p = write("c.csv", "time [s],../../etc [g],.hidden [g],-x [g]\n0,1,2,3\n0.001,2,3,1\n0.002,3,1,2\n")
+    ds = open_recording(p)
+    assert list(ds.data_vars) == ["etc", "hidden", "x"]
+    assert main(["import", str(p), "-o", str(tmp_path / "c.nc")]) == 0, capsys.readouterr().err
