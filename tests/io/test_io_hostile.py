@@ -433,3 +433,26 @@ def test_column_name_that_netcdf_refuses_is_cleaned_at_read(write, tmp_path, cap
     ds = open_recording(p)
     assert list(ds.data_vars) == ["etc", "hidden", "x"]
     assert main(["import", str(p), "-o", str(tmp_path / "c.nc")]) == 0, capsys.readouterr().err
+
+
+# ------------------------------------------------------------------ the guarded child
+def test_script_without_main_guard_reads_a_netcdf(tmp_path):
+    """The fork-server child re-ran a script that has no `if __name__ == "__main__":`, which
+    opened the file again and was reported as netCDF-C crashing on a damaged file."""
+    import subprocess
+    import sys
+    nc = _nc(tmp_path)
+    script = tmp_path / "user_script.py"
+    script.write_text("import sys\nfrom bearing_lab.io import open_recording\nprint('RUN')\n"
+                      "print('OK', open_recording(sys.argv[1]).sizes['time'])\n")
+    r = subprocess.run([sys.executable, str(script), str(nc)], capture_output=True, text=True,
+                       timeout=120, env={**os.environ, "BEARING_LAB_NO_GUARD": ""})
+    assert r.returncode == 0, r.stderr[-2000:]
+    assert r.stdout.split() == ["RUN", "OK", "1200"]  # the script ran once
+
+
+def test_child_that_exits_is_not_blamed_on_the_file(tmp_path):
+    from bearing_lab.io._guard import guarded
+    with pytest.raises(RecordingError, match=r"x.nc: the process reading the file with netCDF-C ended "
+                                             r"with exit status 3 before it answered \(not a crash"):
+        guarded(tmp_path / "x.nc", "netCDF-C", os._exit, 3)
