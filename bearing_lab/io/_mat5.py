@@ -173,6 +173,12 @@ def _numeric(r, cls, flags, dims, pos, end, where):
     elif flags & 0x200:  # logical
         arr = real != 0
     else:
+        if dtype.kind in "iu" and real.size and real.dtype != dtype:
+            info = np.iinfo(dtype)
+            lo, hi = real.min(), real.max()
+            if lo < info.min or hi > info.max or (real.dtype.kind == "f" and not np.all(real == np.round(real))):
+                _fail(f"{where}: values {lo:g} .. {hi:g} do not fit the array's class {dtype} "
+                      "(they would wrap around): corrupt")
         if r.owned and real.dtype == dtype:
             arr = real  # a view of the inflated buffer (ours): no second copy of a large signal
         else:

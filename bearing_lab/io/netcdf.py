@@ -95,7 +95,8 @@ def _check_attrs(ds, path):
         problem = "is not a number" if isinstance(rpm, (str, bytes)) or np.ndim(rpm) != 0 \
             else speed_problem(rpm)
         if problem is not None:
-            raise RecordingError(f"{path}: attribute shaft_speed_rpm = {rpm!r} {problem}: damaged or "
+            shown = rpm if isinstance(rpm, (str, bytes)) or np.ndim(rpm) != 0 else float(rpm)
+            raise RecordingError(f"{path}: attribute shaft_speed_rpm = {shown!r} {problem}: damaged or "
                                  "edited file")
 
 

@@ -456,3 +456,17 @@ def test_child_that_exits_is_not_blamed_on_the_file(tmp_path):
     with pytest.raises(RecordingError, match=r"x.nc: the process reading the file with netCDF-C ended "
                                              r"with exit status 3 before it answered \(not a crash"):
         guarded(tmp_path / "x.nc", "netCDF-C", os._exit, 3)
+
+
+def test_mat5_values_that_do_not_fit_their_class_refused(tmp_path):
+    """A uint8 array stored as int16 with negative values wrapped around without a word."""
+    from bearing_lab.io._fuzz import _mat5_array, _mat5_file
+    v = np.arange(-50, 250).astype("<i2")
+    p = tmp_path / "130_wrap.mat"
+    p.write_bytes(_mat5_file([_mat5_array("X130_DE_time", 9, (300, 1), 3, v.tobytes())]))
+    with pytest.raises(RecordingError, match=r"130_wrap.mat: .*values -50 .. 249 do not fit the array's "
+                                             r"class uint8 \(they would wrap around\)"):
+        open_recording(p, fs=12000)
+    ok = tmp_path / "130_fits.mat"
+    ok.write_bytes(_mat5_file([_mat5_array("X130_DE_time", 9, (300, 1), 3, np.abs(v).tobytes())]))
+    np.testing.assert_array_equal(open_recording(ok, fs=12000)["DE"].values, np.abs(v) * 9.80665)
