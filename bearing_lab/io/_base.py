@@ -425,6 +425,19 @@ class RecordingBuilder:
             self.fail(f"no channel {missing[0]!r}; the file has {', '.join(self.channels)}")
         self.channels = {c: self.channels[c] for c in wanted}
 
+    def _plausible_speed(self, rpm):
+        """The stored speed if plausible; else None, a warning and ``file_shaft_speed_rpm``
+        (the vibration data are fine: they are kept, only the speed is dropped)."""
+        if rpm is None:
+            return None
+        problem = speed_problem(rpm)
+        if problem is None:
+            return float(rpm)
+        self.warn(f"the stored shaft speed {rpm!r} r/min {problem}: not used (give the speed with "
+                  "--rpm)")
+        self.attrs["file_shaft_speed_rpm"] = str(rpm)
+        return None
+
     def build(self, *, fs, t0=0.0, time=None, shaft_speed_rpm=None, default_channel=None,
               data=None, channels=None):
         """Assemble and check the Dataset.
@@ -485,15 +498,7 @@ class RecordingBuilder:
         if self.sha256 is None:
             # after parsing, so the bytes come from the page cache (or the reader's map)
             self.sha256 = file_sha256(self.path, data) if self.checksum else ""
-        rpm = None
-        if shaft_speed_rpm is not None:
-            problem = speed_problem(shaft_speed_rpm)
-            if problem is None:
-                rpm = float(shaft_speed_rpm)
-            else:  # the vibration data are fine: keep them, drop the speed, and say so
-                self.warn(f"the stored shaft speed {shaft_speed_rpm!r} r/min {problem}: not used "
-                          "(give the speed with --rpm)")
-                self.attrs["file_shaft_speed_rpm"] = str(shaft_speed_rpm)
+        rpm = self._plausible_speed(shaft_speed_rpm)
         q_acc = [k for k, (_, a) in self.channels.items() if a.get("quantity") == "acceleration"]
         default = default_channel if default_channel in self.channels else \
             (q_acc[0] if q_acc else next(iter(self.channels)))

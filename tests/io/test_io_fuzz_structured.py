@@ -9,7 +9,7 @@ equal, refused).  ``benchmarks/hostile_inputs.py --structured`` runs the full se
 """
 import pytest
 
-from bearing_lab.io import _fuzz
+from bearing_lab.io import _fuzz, _fuzz_struct
 
 SEED = 2026
 PLAN = {"mat5": 120, "v73": 30, "netcdf": 24, "wav": 120, "uff": 120, "special": 40}
@@ -25,7 +25,7 @@ def _report(res):
 
 @pytest.mark.parametrize("kind", sorted(PLAN))
 def test_structured_mutants(kind):
-    res = _fuzz.fuzz_structured(kind, PLAN[kind], seed=SEED, timeout=60.0)
+    res = _fuzz_struct.fuzz_structured(kind, PLAN[kind], seed=SEED, timeout=60.0)
     c = res["counts"]
     assert not any(c[v] for v in BAD), _report(res)
     assert c["refused"] > 0, _report(res)
@@ -35,9 +35,9 @@ def test_structured_mutants(kind):
 
 def test_verdict_catches_a_silent_change(tmp_path, monkeypatch):
     """The comparison with the independent decoder sees a value the reader changed."""
-    index = next(i for i in range(200) if "[none]" in _fuzz.structured_case("wav", SEED, i, tmp_path)[2])
-    p, options, _ = _fuzz.structured_case("wav", SEED, index, tmp_path)  # every field nominal
-    assert _fuzz.structured_verdict(p, options, "wav") == ("ok", "")
+    index = next(i for i in range(200) if "[none]" in _fuzz_struct.structured_case("wav", SEED, i, tmp_path)[2])
+    p, options, _ = _fuzz_struct.structured_case("wav", SEED, index, tmp_path)  # every field nominal
+    assert _fuzz_struct.structured_verdict(p, options, "wav") == ("ok", "")
     real = _fuzz._open_quietly
 
     def changed(path, opts):
@@ -46,15 +46,15 @@ def test_verdict_catches_a_silent_change(tmp_path, monkeypatch):
         return ds
 
     monkeypatch.setattr(_fuzz, "_open_quietly", changed)
-    verdict, detail = _fuzz.structured_verdict(p, options, "wav")
+    verdict, detail = _fuzz_struct.structured_verdict(p, options, "wav")
     assert verdict == "silent" and "ch2" in detail
 
 
 def test_structured_cases_are_reproducible(tmp_path):
     (tmp_path / "a").mkdir()
     (tmp_path / "b").mkdir()
-    a = _fuzz.structured_case("mat5", SEED, 7, tmp_path / "a")
-    b = _fuzz.structured_case("mat5", SEED, 7, tmp_path / "b")
+    a = _fuzz_struct.structured_case("mat5", SEED, 7, tmp_path / "a")
+    b = _fuzz_struct.structured_case("mat5", SEED, 7, tmp_path / "b")
     assert a[0].read_bytes() == b[0].read_bytes() and a[2] == b[2]
-    c = _fuzz.structured_case("mat5", SEED, 8, tmp_path / "b")
+    c = _fuzz_struct.structured_case("mat5", SEED, 8, tmp_path / "b")
     assert (c[0].read_bytes(), c[2]) != (a[0].read_bytes(), a[2])

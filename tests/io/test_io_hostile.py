@@ -460,7 +460,7 @@ def test_child_that_exits_is_not_blamed_on_the_file(tmp_path):
 
 def test_mat5_values_that_do_not_fit_their_class_refused(tmp_path):
     """A uint8 array stored as int16 with negative values wrapped around without a word."""
-    from bearing_lab.io._fuzz import _mat5_array, _mat5_file
+    from bearing_lab.io._fuzz_struct import _mat5_array, _mat5_file
     v = np.arange(-50, 250).astype("<i2")
     p = tmp_path / "130_wrap.mat"
     p.write_bytes(_mat5_file([_mat5_array("X130_DE_time", 9, (300, 1), 3, v.tobytes())]))
