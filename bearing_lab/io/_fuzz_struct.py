@@ -284,58 +284,118 @@ def structured_case(kind: str, seed: int, index: int, tmp: Path):
     return _STRUCT_BUILDERS[kind](rng, tmp, n)
 
 
+class NotOneChannel(Exception):
+    """The independent decoder finds content no recording channel can hold as read (a matrix,
+    complex values, a second zlib stream, format fields that disagree): a reader that accepts
+    the file has changed or dropped something."""
+
+
+def _one_channel(v, name):
+    v = np.asarray(v)
+    if v.dtype.kind == "c" or v.dtype.names:
+        raise NotOneChannel(f"{name} holds complex values")
+    if v.ndim > 1 and sorted(v.shape)[-2] > 1:
+        raise NotOneChannel(f"{name} is a {'x'.join(map(str, v.shape))} matrix")
+    return v
+
+
+def _mat5_streams(path: Path) -> None:
+    """Inflate every compressed element with zlib alone: anything after its first stream is
+    content (a second stream, appended bytes) that one stream's reader would drop."""
+    import struct
+    import zlib
+    data = path.read_bytes()
+    pos = 128
+    while pos + 8 <= len(data):
+        typ, nb = struct.unpack_from("<II", data, pos)
+        if typ == 15:
+            d = zlib.decompressobj()
+            d.decompress(data[pos + 8:pos + 8 + nb])
+            if d.unused_data.strip(b"\0"):
+                raise NotOneChannel(f"element at byte {pos}: {len(d.unused_data)} bytes after its "
+                                    "zlib stream")
+        pos += 8 + nb  # top-level elements follow each other without padding
+
+
 def reference_values(path: Path, kind: str) -> dict | None:
-    """What the file holds, decoded without bearing_lab: channel -> values in SI units, or None
-    when the independent decoder refuses the file too (nothing to compare with)."""
+    """What the file holds, decoded without bearing_lab: channel -> values in SI units; None
+    when the independent decoder cannot decode the file (nothing to compare with).
+
+    Raises
+    ------
+    NotOneChannel
+        The file holds something no channel can be read as without a change.
+    """
     import struct
     if kind == "mat5":
         import scipy.io
+        _mat5_streams(path)
         m = scipy.io.loadmat(path)  # only reached for files bearing_lab accepted
         out = {}
         for c in ("DE", "FE"):
             v = m.get(f"X130_{c}_time")
             if v is not None:
-                if v.ndim > 1 and sorted(v.shape)[-2] > 1:
-                    return None  # a matrix: no one channel to compare
+                v = _one_channel(v, f"X130_{c}_time")
                 out[c] = np.asarray(v, dtype=np.float64).ravel(order="F") * G
         return out
     if kind == "v73":
         import h5py
         with h5py.File(path, "r") as f:
             d = f["X130_DE_time"]
-            if d.dtype.names or d.attrs.get("MATLAB_class", b"") in (b"char",):
-                return None
-            v = np.asarray(d[()], dtype=np.float64).T
-        if v.ndim > 1 and sorted(v.shape)[-2] > 1:
-            return None
+            cls = d.attrs.get("MATLAB_class", b"")
+            if cls in (b"char", b"logical"):
+                raise NotOneChannel(f"X130_DE_time is of class {cls.decode()}, not numbers")
+            v = _one_channel(d[()], "X130_DE_time")
+            v = np.asarray(v, dtype=np.float64).T
         return {"DE": v.ravel(order="F") * G}
     if kind == "netcdf":
         import netCDF4
         with netCDF4.Dataset(path) as f:
-            return {k: np.asarray(v[:], dtype=np.float64) for k, v in f.variables.items()
-                    if k != "time" and v.dimensions == ("time",)}
+            out = {k: np.asarray(v[:], dtype=np.float64) for k, v in f.variables.items()
+                   if k != "time" and v.dimensions == ("time",)}
+            out["__rate__"] = 1.0 / float(np.median(np.diff(np.asarray(f["time"][:], float))))
+            stored = getattr(f, "sampling_rate_hz", None)
+        if not (isinstance(stored, (int, float, np.number)) and abs(stored / out["__rate__"] - 1) < 1e-6):
+            raise NotOneChannel(f"sampling_rate_hz {stored!r} against a {out['__rate__']:g} Hz time axis")
+        return out
     if kind == "wav":  # the fmt fields, validated, decide the layout: decode the data chunk
         data = path.read_bytes()
         tag, ch, rate, _, align, bits = struct.unpack_from("<HHIIHH", data, 20)
         width = (bits + 7) // 8
-        if tag != 1 or ch == 0 or align != ch * width or width not in (1, 2, 4) or bits == 0:
-            return None
+        if ch == 0 or bits == 0 or align != ch * width:
+            raise NotOneChannel(f"fmt fields disagree: {ch} channel(s) of {bits} bits in "
+                                f"{align}-byte frames")
+        if tag != 1 or width not in (1, 2, 4):
+            return None  # float, 24-bit, extensible: not decoded here
         size = struct.unpack_from("<I", data, 40)[0]
         if size % align:
-            return None
+            raise NotOneChannel(f"a data chunk of {size} bytes in {align}-byte frames")
         code = {1: "<u1", 2: "<i2", 4: "<i4"}[width]
         raw = np.frombuffer(data, code, count=size // width, offset=44).reshape(-1, ch)
         scale = 2.0 ** (8 * width - 1)
         off = scale if width == 1 else 0.0
-        return {f"ch{j + 1}": (raw[:, j].astype(np.float64) - off) / scale * 10.0 * G
-                for j in range(ch)}
+        out = {f"ch{j + 1}": (raw[:, j].astype(np.float64) - off) / scale * 10.0 * G
+               for j in range(ch)}
+        out["__rate__"] = float(rate)
+        return out
     if kind == "uff":
         import pyuff
         found = pyuff.UFF(str(path)).read_sets()
-        sets = [s for s in (found if isinstance(found, list) else [found]) if s.get("type") == 58]
+        found = found if isinstance(found, list) else [found]
+        sets = [s for s in found if s.get("type") == 58]
         if len(sets) != 1:
             return None
-        return {"acc": np.asarray(sets[0]["data"], dtype=np.float64)}
+        h, factor = sets[0], 1.0
+        label = str(h.get("ordinate_axis_units_lab", "")).strip()
+        units = [s for s in found if s.get("type") == 164]
+        if (not label or label.upper() == "NONE") and units:  # SI = file value / length factor
+            length = float(units[0].get("length", 1.0))
+            factor = 1.0 / length if length else np.inf
+            if not (np.isfinite(factor) and 1e-12 <= factor <= 1e12):
+                raise NotOneChannel(f"a units set whose length factor {length!r} scales by {factor:g}")
+        factor *= G if label == "g" else 1.0
+        return {"acc": np.asarray(h["data"], dtype=np.float64) * factor,
+                "__rate__": 1.0 / float(h["abscissa_inc"])}
     return None
 
 
@@ -357,15 +417,18 @@ def structured_verdict(path: Path, options: dict, kind: str) -> tuple[str, str]:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             ref = reference_values(path, kind)
+    except NotOneChannel as exc:
+        return "silent", f"read, but the file holds {exc}"[:200]
     except Exception as exc:  # noqa: BLE001 - the independent decoder refuses it
         return "unverified", f"independent decoder: {type(exc).__name__}: {exc}"[:200]
     if ref is None:
         return "unverified", "the independent decoder sees no single channel to compare"
+    rate = ref.pop("__rate__", None)
+    if rate is not None and not abs(float(ds.attrs["sampling_rate_hz"]) / rate - 1.0) < 1e-6:
+        return "silent", f"sampling rate {ds.attrs['sampling_rate_hz']!r} Hz, the file's is {rate:g} Hz"
     for name, want in ref.items():
         if kind == "uff":
             name = next(iter(ds.data_vars))
-            want = want * float(ds[name].attrs.get("uff_164_factor", 1.0)) * \
-                (G if ds[name].attrs.get("original_units") == "g" else 1.0)
         if name not in ds:
             return "silent", f"channel {name} of the file is missing from the recording"
         got = ds[name].values
