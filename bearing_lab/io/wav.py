@@ -103,7 +103,7 @@ def _format_problem(data: bytes):
             if rate == 0:
                 return "the fmt chunk declares a sampling rate of 0 Hz"
         pos += 8 + size + (size & 1)
-    return "no fmt chunk" if align is None else None
+    return "no fmt chunk" if align is None else "no data chunk"
 
 
 class WavReader(RecordingReader):
@@ -162,6 +162,9 @@ class WavReader(RecordingReader):
                 rate, data = wavfile.read(path)
             except (ValueError, EOFError, OSError, IndexError) as exc:
                 b.fail(f"not a readable WAV file ({exc})")
+            except UnboundLocalError:  # scipy walked the chunks without meeting fmt or data
+                b.fail("not a readable WAV file: scipy finds no fmt or no data chunk inside the "
+                       "size the RIFF header declares")
         data = np.asarray(data)
         if data.ndim == 1:
             data = data[:, None]

@@ -470,3 +470,18 @@ def test_mat5_values_that_do_not_fit_their_class_refused(tmp_path):
     ok = tmp_path / "130_fits.mat"
     ok.write_bytes(_mat5_file([_mat5_array("X130_DE_time", 9, (300, 1), 3, np.abs(v).tobytes())]))
     np.testing.assert_array_equal(open_recording(ok, fs=12000)["DE"].values, np.abs(v) * 9.80665)
+
+
+def test_wav_without_data_chunk(write):
+    """scipy raised UnboundLocalError (caught only by the catch-all) for a WAV with no data chunk."""
+    x = (np.arange(400).reshape(200, 2) - 200) * 50
+    full = wav_bytes(x)
+    body = full[12:12 + 24]  # the fmt chunk only
+    p = write("nodata.wav", b"RIFF" + struct.pack("<I", 4 + len(body)) + b"WAVE" + body)
+    with pytest.raises(RecordingError, match=r"nodata.wav: not a valid WAV file: no data chunk"):
+        open_recording(p, full_scale="10 g")
+    short = bytearray(full)  # a RIFF size that ends before the data chunk: scipy never sees it
+    short[4:8] = struct.pack("<I", 4 + 24)
+    with pytest.raises(RecordingError, match=r"f.wav: not a (valid|readable) WAV file") as exc:
+        open_recording(write("f.wav", bytes(short)), full_scale="10 g")
+    assert "UnboundLocalError" not in str(exc.value)
