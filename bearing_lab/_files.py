@@ -68,6 +68,34 @@ def _fsync_dir(directory: Path) -> None:
         os.close(fd)
 
 
+_NAME_MAX = 255  # bytes in one file name (ext4, xfs, btrfs, APFS, NTFS in UTF-16 units)
+
+
+def _tmp_prefix(name: str, suffix: str) -> str:
+    """``.<name>.<host>-<pid>.`` for the temporary of ``name``, short enough that the whole
+    temporary name (with mkstemp's 8 random characters and ``suffix``) fits in one file name.
+
+    A long ``name`` (up to the 255-byte limit itself) is cut and given a hash of the whole,
+    so two long names that share a beginning never share temporaries; a name that is not
+    valid UTF-8 (bytes from another locale) gets the same treatment, so a writer that needs
+    UTF-8 names writes the temporary, and the rename gives the file its own name.
+    """
+    tail = f".{_HOST}-{os.getpid()}."
+    # the same cut for every process (pids have at most 7 digits), so _remove_stale finds it
+    room = _NAME_MAX - len(os.fsencode(f".{_HOST}-1234567." + suffix)) - 8 - 1
+    raw = os.fsencode(name)
+    try:
+        name.encode("utf-8")
+        readable = True
+    except UnicodeEncodeError:  # undecodable bytes: libraries such as netCDF-C take UTF-8 names
+        readable = False
+    if len(raw) > room or not readable:
+        digest = hashlib.sha256(raw).hexdigest()[:12]
+        cut = raw[:max(room - 13, 0)].decode("utf-8", "ignore")
+        name = f"{cut}~{digest}"
+    return f".{name}{tail}"
+
+
 @contextmanager
 def atomic_path(path, *, suffix: str | None = None):
     """Yield a temporary path beside ``path``; on normal exit it replaces ``path`` atomically.
@@ -87,8 +115,9 @@ def atomic_path(path, *, suffix: str | None = None):
     """
     path = Path(path)
     directory = path.parent if str(path.parent) else Path(".")
-    fd, tmp_name = tempfile.mkstemp(prefix=f".{path.name}.{_HOST}-{os.getpid()}.",
-                                    suffix=suffix or path.suffix or ".tmp", dir=directory)
+    suffix = suffix or path.suffix or ".tmp"
+    fd, tmp_name = tempfile.mkstemp(prefix=_tmp_prefix(path.name, suffix), suffix=suffix,
+                                    dir=directory)
     try:
         os.fchmod(fd, _new_file_mode(path))
     except (OSError, AttributeError):  # no fchmod (Windows): keep mkstemp's mode
@@ -108,16 +137,17 @@ def atomic_path(path, *, suffix: str | None = None):
             pass
         raise
     _fsync_dir(directory)
-    _remove_stale(directory, path.name)
+    _remove_stale(directory, path.name, suffix)
 
 
-def _remove_stale(directory: Path, name: str) -> None:
+def _remove_stale(directory: Path, name: str, suffix: str) -> None:
     """Delete temporaries of ``name`` left by killed writers of this host (their process is gone).
 
     A writer killed by SIGKILL cannot remove its temporary; the next successful write of the
     same file does, when the temporary's process id no longer runs here.
     """
-    prefix = f".{name}.{_HOST}-"
+    own = _tmp_prefix(name, suffix)
+    prefix = own[:own.rindex(f".{_HOST}-") + len(_HOST) + 2]
     try:
         entries = [e for e in os.scandir(directory) if e.name.startswith(prefix)]
     except OSError:

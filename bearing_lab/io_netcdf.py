@@ -8,6 +8,7 @@ read as data), and must read back bit for bit.
 """
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import numpy as np
@@ -64,9 +65,29 @@ def write_netcdf(ds, path, *, complevel: int = 4, error=BearingLabError) -> Path
         with atomic_path(path) as tmp:
             out.to_netcdf(tmp, engine="netcdf4", format="NETCDF4", encoding=enc)
     except (OSError, ValueError, TypeError, RuntimeError, UnicodeError) as exc:
-        raise error(f"{path}: cannot write netCDF4 ({type(exc).__name__}: {exc}); an existing "
+        raise error(f"{path}: cannot write netCDF4 ({_write_failure(path, exc, out)}); an existing "
                     "file of that name is left as it was") from exc
     return path
+
+
+def _write_failure(path: Path, exc, ds) -> str:
+    """The true cause of a failed write.  netCDF-C/HDF5 report a full disk as "HDF error" or
+    as "Permission denied"; the free space and the directory's permissions tell them apart."""
+    import errno
+    import shutil
+    directory = path.parent if str(path.parent) else Path(".")
+    needed = sum(int(v.nbytes) for v in ds.variables.values())
+    try:
+        free = shutil.disk_usage(directory).free
+    except OSError:
+        free = None
+    full = getattr(exc, "errno", None) in (errno.ENOSPC, errno.EDQUOT)
+    if full or (free is not None and free < needed):
+        return (f"no space left on the device: {free / 1e6:.3g} MB free in {directory}, the data "
+                f"take up to {needed / 1e6:.3g} MB" if free is not None else "no space left on the device")
+    if isinstance(exc, PermissionError) and not os.access(directory, os.W_OK):
+        return f"no permission to write in {directory}"
+    return f"{type(exc).__name__}: {exc}"
 
 
 def check_output_path(text: str) -> Path:
@@ -76,6 +97,10 @@ def check_output_path(text: str) -> Path:
         raise BearingLabError(f"-o {text}: the output must be a netCDF file ending in .nc")
     if not out.parent.exists():
         raise BearingLabError(f"-o {text}: directory {out.parent} does not exist")
+    size = len(os.fsencode(out.name))
+    if size > 255:
+        raise BearingLabError(f"-o {text}: the file name has {size} bytes; a file name has at most "
+                              "255")
     if out.is_dir():
         raise BearingLabError(f"-o {text}: is a directory; give a file name ending in .nc")
     return out

@@ -1,6 +1,8 @@
-"""Hostile scenes, killed writers and `data fetch` through links: what a user gets, measured.
+"""Hostile scenes, killed writers, `data fetch` through links, structure-aware file mutants,
+files cut while read and a decompression bomb: what a user gets, measured.
 
 Run:  BEARING_LAB_MIRROR=../shared/data .venv/bin/python benchmarks/hostile_inputs.py [--kills 20]
+      [--structured 300] [--truncations 5] [--only structured]
 
 1. Hostile scenes: each `bearing-lab simulate` below used to hang, crash with a traceback or
    silently simulate something else.  Printed: wall time (the goal: under 10 s), exit status,
@@ -11,6 +13,13 @@ Run:  BEARING_LAB_MIRROR=../shared/data .venv/bin/python benchmarks/hostile_inpu
    version.  Printed: intact / destroyed / never written, and temporary files left behind.
 3. `data fetch` into a --dest holding a dangling link and a link to another directory: nothing
    may be written outside --dest.
+4. Structure-aware mutants (``bearing_lab.io._fuzz_struct.fuzz_structured``): per kind (MAT v5, v7.3,
+   foreign netCDF, WAV, UFF, non-regular files) ``--structured`` cases that each change one
+   header field or element on purpose; every file that reads is compared with an independent
+   decoder.  Printed: verdicts per kind and per field changed.
+5. A 64 MB UFF 58b cut to 100 kB while `bearing-lab info` reads it: refused, or read before the
+   cut; never a crash.
+6. A 1 MB MAT v5 element inflating to 1 GB of zeros: time and peak memory of the refusal.
 """
 from __future__ import annotations
 
@@ -138,18 +147,98 @@ def fetch_links(tmp: Path, mirror: Path) -> int:
     return len(written)
 
 
+def structured(cases: int, seed: int) -> int:
+    """Structure-aware mutants of every kind, each accepted file checked against an independent
+    decoder (bearing_lab.io._fuzz_struct); printed: the verdicts per kind and per changed field."""
+    from bearing_lab.io import _fuzz_struct as _fuzz
+    print("\n| kind | cases | " + " | ".join(_fuzz.STRUCT_VERDICTS) + " | wall s | slowest case s |")
+    print("|---|---|" + "---|" * len(_fuzz.STRUCT_VERDICTS) + "---|---|")
+    bad, fields = 0, {}
+    for kind in _fuzz.STRUCT_KINDS:
+        r = _fuzz.fuzz_structured(kind, cases, seed=seed)
+        c = r["counts"]
+        bad += sum(c[v] for v in ("uncaught", "silent", "invalid", "crash", "hang"))
+        print(f"| {kind} | {cases} | " + " | ".join(str(c[v]) for v in _fuzz.STRUCT_VERDICTS)
+              + f" | {r['wall_s']:.0f} | {r['slowest_s']:.2f} |")
+        for op, verdicts in r["by_case"].items():
+            field = op.split("]")[0].lstrip("[") if op.startswith("[") else op
+            agg = fields.setdefault((kind, field), {})
+            for v, k in verdicts.items():
+                agg[v] = agg.get(v, 0) + k
+        for v, examples in r["examples"].items():
+            for e in examples:
+                print(f"  {kind} {v} #{e['i']} ({e['op']}): {e['detail']}")
+    print("\n| kind | field changed | verdicts |")
+    print("|---|---|---|")
+    for (kind, field), verdicts in sorted(fields.items()):
+        print(f"| {kind} | {field} | {', '.join(f'{v} {k}' for v, k in sorted(verdicts.items()))} |")
+    print(f"\nstructured cases with a bad verdict: {bad} of {cases * len(_fuzz.STRUCT_KINDS)}")
+    return bad
+
+
+def changing_files(tmp: Path, trials: int, seed: int) -> int:
+    """A 64 MB UFF 58b cut to 100 kB while `bearing-lab info` reads it (a mapped file: SIGBUS)."""
+    from bearing_lab.io._fuzz_struct import truncate_while_reading
+    r = truncate_while_reading(tmp / "big.uff", trials=trials, seed=seed)
+    print(f"\nUFF 58b truncated while read, {r['trials']} trials: refused {r['refused']}, read before the "
+          f"cut {r['ok']}, crash {r['crash']}, other {r['other']}")
+    for e in r["examples"][:3]:
+        print(f"  {e}")
+    return r["crash"] + r["other"]
+
+
+def inflate_bomb(tmp: Path) -> int:
+    """A 1 MB MAT v5 element inflating to 1 GB of zeros: time and peak memory of the refusal."""
+    import resource
+    import zlib
+    from bearing_lab.io._fuzz_struct import _compressed, _mat5_array, _mat5_file
+    n = 125_000_000
+    import struct
+    z = zlib.compressobj(9)
+    empty = _mat5_array("X130_DE_time", 6, (n, 1), 9, b"")  # ends with the (miDOUBLE, 0) tag
+    # the array's header with a 1 GB data element, then 1 GB of zeros streamed through deflate
+    body = empty[8:-8] + struct.pack("<II", 9, 8 * n)
+    tag = struct.pack("<II", 14, len(body) + 8 * n)
+    stream = z.compress(tag + body)
+    block = bytes(1 << 24)
+    for _ in range(8 * n // len(block)):
+        stream += z.compress(block)
+    stream += z.compress(bytes(8 * n % len(block))) + z.flush()
+    p = tmp / "130_bomb.mat"
+    p.write_bytes(_mat5_file([_compressed(stream)]))
+    code = ("import resource, time, sys\nfrom bearing_lab import open_recording\nt = time.perf_counter()\n"
+            "try:\n    open_recording(sys.argv[1], fs=12000)\n    out = 'read'\n"
+            "except Exception as e:\n    out = str(e)[-120:]\n"
+            "print(f'{time.perf_counter() - t:.2f} s, peak {resource.getrusage(resource.RUSAGE_SELF)"
+            ".ru_maxrss / 1024:.0f} MB: {out}')")
+    r = subprocess.run([sys.executable, "-c", code, str(p)], capture_output=True, text=True, timeout=600)
+    print(f"\nMAT v5 element of {p.stat().st_size / 1e6:.2f} MB inflating to {8 * n / 1e9:.1f} GB: "
+          f"{r.stdout.strip() or r.stderr.strip()[-300:]}")
+    return 0 if "inflate ratio" in r.stdout else 1
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--kills", type=int, default=20)
     ap.add_argument("--seed", type=int, default=11)
+    ap.add_argument("--structured", type=int, default=300, help="structure-aware cases per kind")
+    ap.add_argument("--truncations", type=int, default=5, help="UFF files cut while read")
+    ap.add_argument("--only", default=None, help="run one part: scenes, kills, fetch, structured, "
+                    "changing, bomb")
     args = ap.parse_args(argv)
     mirror = Path(os.environ.get("BEARING_LAB_MIRROR") or
                   Path(__file__).resolve().parents[2] / "shared" / "data")
-    with tempfile.TemporaryDirectory() as d:
-        tmp = Path(d)
-        bad = hostile_scenes(tmp)
-        bad += killed_writers(tmp, args.kills, mirror, args.seed)
-        bad += fetch_links(tmp, mirror)
+    parts = {"scenes": lambda tmp: hostile_scenes(tmp),
+             "kills": lambda tmp: killed_writers(tmp, args.kills, mirror, args.seed),
+             "fetch": lambda tmp: fetch_links(tmp, mirror),
+             "structured": lambda tmp: structured(args.structured, args.seed),
+             "changing": lambda tmp: changing_files(tmp, args.truncations, args.seed),
+             "bomb": lambda tmp: inflate_bomb(tmp)}
+    bad = 0
+    for name, part in parts.items():
+        if args.only in (None, name):
+            with tempfile.TemporaryDirectory() as d:
+                bad += part(Path(d))
     print(f"\nmachine: {os.cpu_count()} cores, shared with other jobs (wall times scatter)")
     return 1 if bad else 0
 

@@ -500,6 +500,12 @@ def resolve_speed(x, fs, geometry, *, rpm=None, rpm_source="given", cs=None, tol
     """
     lo_b, hi_b = (float(v) for v in blind_range_hz)
     prior = None if rpm is None else float(rpm) / 60.0
+    if prior is not None and not (np.isfinite(prior) and 0.0 < prior * (1 + PRIOR_TOLERANCE) < 0.5 * fs):
+        # the 1x line must lie below the Nyquist frequency; a wrong speed of 1e12 r/min would
+        # otherwise ask the family scan for a candidate grid of hundreds of GiB
+        raise AnalysisError(f"a shaft speed of {float(rpm):.6g} r/min ({prior:.6g} Hz) cannot be seen in a "
+                            f"record sampled at {fs:.6g} Hz (its lines must lie below {0.5 * fs:.6g} Hz): "
+                            "the stored or given speed is wrong; give the speed with --rpm, or --rpm none")
     hi_all = max(hi_b, prior * (1 + PRIOR_TOLERANCE) if prior else 0.0)
     raw = RawLines(x, fs, top_hz=min(0.45 * fs, N_SHAFT_HARMONICS * hi_all * 1.03))
     raw.min_rms = min_family_rms

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import io
 import sys
 
 from ..errors import BearingLabError
@@ -55,6 +56,11 @@ def _warning_line(message, category, filename, lineno, file=None, line=None):
 def main(argv=None) -> int:
     import warnings
     warnings.showwarning = _warning_line
+    for stream in (sys.stdout, sys.stderr):  # a file name in another locale's bytes is printed
+        try:                                 # with escapes, never a UnicodeEncodeError
+            stream.reconfigure(errors="backslashreplace")
+        except (AttributeError, ValueError, io.UnsupportedOperation):
+            pass
     parser = build_parser()
     args = parser.parse_args(argv)
     if not getattr(args, "func", None):

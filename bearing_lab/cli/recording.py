@@ -78,10 +78,12 @@ def _cmd_import(args) -> int:
     check_output_path(args.output)  # before reading: a bad -o is said at once
     ds = _open(args)
     if args.rpm is not None:
-        import math
         from ..errors import RecordingError
-        if not (math.isfinite(args.rpm) and args.rpm > 0):
-            raise RecordingError(f"--rpm {args.rpm:g}: give the shaft speed as a positive number of r/min")
+        from ..io._base import speed_problem
+        problem = speed_problem(args.rpm)
+        if problem is not None:
+            raise RecordingError(f"--rpm {args.rpm:g} {problem}: give the shaft speed as a positive "
+                                 "number of r/min")
         old = ds.attrs.get("shaft_speed_rpm")
         ds.attrs["shaft_speed_rpm"] = float(args.rpm)
         ds.attrs["shaft_speed_source"] = "given at import (--rpm)" + (f"; the file stored {old:g}" if old else "")
@@ -91,7 +93,7 @@ def _cmd_import(args) -> int:
     n = ds.sizes["time"]
     fs = ds.attrs["sampling_rate_hz"]
     print(f"{args.output}: {len(ds.data_vars)} channel(s) {', '.join(ds.data_vars)}, {n} samples "
-          f"at {fs:g} Hz ({n / fs:.4g} s), reader {ds.attrs['reader']}")
+          f"at {fs:g} Hz ({n / fs:.4g} s), reader {ds.attrs.get('reader') or 'netcdf (' + _kind(ds) + ')'}")
     return 0
 
 

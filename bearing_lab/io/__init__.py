@@ -20,7 +20,10 @@ An option a reader does not know is refused with the list of those it knows.
 """
 from __future__ import annotations
 
+import errno
+import os
 from pathlib import Path
+import stat
 
 from ..errors import BearingLabError, RecordingError, check_choice
 from ._base import ENGINES, RecordingReader, RecordingWarning, get_warnings  # noqa: F401
@@ -133,6 +136,56 @@ def guess_format(path) -> str:
     raise RecordingError(msg)
 
 
+_NOT_REGULAR = ((stat.S_ISFIFO, "a named pipe (FIFO)"), (stat.S_ISCHR, "a character device"),
+                (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket"))
+
+
+def check_input_file(path) -> int:
+    """Return the size of ``path`` after checking it is a regular, readable file.
+
+    Checked with ``stat`` before anything opens the file: opening a named pipe blocks until
+    another program writes to it, and a device or a ``/proc`` file reports no size (or an
+    endless one).  Each case is its own message: a missing file, a dangling link, a loop of
+    symbolic links, a directory, a pipe or a device, a pseudo-file, a file without read
+    permission.
+
+    Raises
+    ------
+    RecordingError
+        Naming the path and what it is instead of a recording file.
+    """
+    path = Path(path)
+    try:
+        st = os.stat(path)
+    except OSError as exc:
+        if exc.errno == errno.ELOOP:
+            raise RecordingError(f"{path}: symbolic links form a loop (or a chain too long to "
+                                 "follow); point the link at the recording file") from None
+        if exc.errno == errno.ENOENT:
+            if os.path.islink(path):
+                raise RecordingError(f"{path}: symbolic link to {os.readlink(path)}, which does "
+                                     "not exist") from None
+            raise RecordingError(f"{path}: file not found") from None
+        if exc.errno == errno.ENAMETOOLONG:
+            raise RecordingError(f"{path}: file name too long") from None
+        raise RecordingError(f"{path}: cannot read the file ({exc.strerror or exc})") from None
+    if stat.S_ISDIR(st.st_mode):
+        raise RecordingError(f"{path}: is a directory, not a recording file")
+    if not stat.S_ISREG(st.st_mode):
+        kind = next((k for test, k in _NOT_REGULAR if test(st.st_mode)), "not a regular file")
+        raise RecordingError(f"{path}: is {kind}, not a regular file; a recording is read from a "
+                             "file (save the stream to a file first)")
+    try:
+        with open(path, "rb") as fh:  # unreadable (permissions): one clear line, here
+            first = fh.read(1) if st.st_size == 0 else b""
+    except OSError as exc:
+        raise RecordingError(f"{path}: cannot read the file ({exc.strerror or exc})") from None
+    if first:
+        raise RecordingError(f"{path}: reports a size of 0 bytes but has content: a pseudo-file "
+                             "(such as those under /proc or /sys), not a recording file")
+    return st.st_size
+
+
 def open_recording(path, format=None, **options):
     """Open a recording file as a Dataset in SI units with provenance.
 
@@ -174,16 +227,7 @@ def open_recording(path, format=None, **options):
         if format is not None and engine != format:
             raise RecordingError(f"{path}: format={format!r} and engine={engine!r} disagree")
         format = engine
-    if not path.exists():
-        raise RecordingError(f"{path}: file not found")
-    if path.is_dir():
-        raise RecordingError(f"{path}: is a directory, not a recording file")
-    try:
-        size = path.stat().st_size
-        with open(path, "rb"):  # unreadable (permissions, a device): one clear line, here
-            pass
-    except OSError as exc:
-        raise RecordingError(f"{path}: cannot read the file ({exc.strerror or exc})") from None
+    size = check_input_file(path)
     if size == 0:
         raise RecordingError(f"{path}: file is empty (0 bytes)")
     if format is None:

@@ -39,7 +39,7 @@ import hashlib
 import importlib
 import inspect
 import json
-import mmap
+import os
 import re
 import warnings
 from abc import ABC, abstractmethod
@@ -52,6 +52,24 @@ from .. import units as _units
 
 MIN_RATE_HZ = 1e-3   # slower than a sample every 17 minutes: not a vibration recording
 MAX_RATE_HZ = 1e9    # faster than any vibration data-acquisition front end
+
+MAX_RPM = 1e6        # faster than any rolling bearing turns (dental turbines: about 4e5 r/min)
+
+
+def speed_problem(rpm) -> str | None:
+    """None if ``rpm`` is a plausible shaft speed in r/min, else what is wrong with it."""
+    try:
+        rpm = float(rpm)
+    except (TypeError, ValueError):
+        return "is not a number"
+    if not np.isfinite(rpm):
+        return "is not finite"
+    if rpm <= 0:
+        return "is not positive"
+    if rpm > MAX_RPM:
+        return f"is faster than any rolling bearing turns (more than {MAX_RPM:.0e} r/min)"
+    return None
+
 
 ENGINES: dict[str, type["RecordingReader"]] = {}
 """Format name -> reader class, in sniffing order (registered by each format module)."""
@@ -131,18 +149,44 @@ def file_sha256(path, data=None) -> str:
     return h.hexdigest()
 
 
-def map_file(path):
-    """Return a read-only mmap of a non-empty file (the caller closes it)."""
+def read_file(path) -> bytes:
+    """Return the whole content of a regular file, refusing a file that changes while read.
+
+    Why not ``mmap``: a mapped file that another program truncates while it is read takes
+    the process down with SIGBUS the moment numpy or the checksum touch a page that no
+    longer exists; no Python code can catch that.  A plain read of the size ``fstat``
+    reports costs the same page-cache copy and turns the same event into a short read,
+    refused here with a message.
+
+    Raises
+    ------
+    RecordingError
+        If the file grew, shrank or was rewritten while it was read.
+    """
     with open(path, "rb") as fh:
-        return mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ)
+        before = os.fstat(fh.fileno())
+        data = fh.read(before.st_size + 1)
+        after = os.fstat(fh.fileno())
+    if (len(data) != before.st_size or after.st_size != before.st_size
+            or after.st_mtime_ns != before.st_mtime_ns):
+        raise RecordingError(f"{path}: the file changed while it was read ({before.st_size} bytes "
+                             f"when opened, {len(data)} read, {after.st_size} now): another program "
+                             "is writing or truncating it; read it again once it is complete")
+    return data
 
 
 _NAME_BAD = re.compile(r"[^A-Za-z0-9_+\-.]+")
+_NAME_OK = re.compile(r"[A-Za-z0-9][A-Za-z0-9_+\-.]*")
 
 
 def clean_name(name, fallback: str) -> str:
-    """Clean a channel name to letters, digits and ``_ + - .``; ``fallback`` if empty."""
-    s = _NAME_BAD.sub("_", str(name).strip()).strip("_")
+    """Clean a channel name to letters, digits and ``_ + - .``; ``fallback`` if empty.
+
+    The name starts with a letter or digit: netCDF refuses variable names that start with
+    ``.``, ``+`` or ``-`` (a column ``../../etc [g]`` becomes ``etc``), and the refusal would
+    only come when the recording is written, naming the output instead of the input.
+    """
+    s = _NAME_BAD.sub("_", str(name).strip()).strip("_").lstrip("_+-.")
     if not s or s.upper() == "NONE":
         return fallback
     return s
@@ -264,11 +308,15 @@ class RecordingBuilder:
         file_name : the channel's name in the file, for ``units``/``sensitivity`` dicts.
         inplace : the reader no longer needs ``values``: scale it in place (saves a copy).
         """
+        if not _NAME_OK.fullmatch(str(name)):  # a reader's own name (UFF node "-5+Z"): netCDF-safe
+            name = clean_name(name, f"ch{len(self.channels) + 1}")
         name = self.unique_name(name)
         original = file_name if file_name is not None else name
         x = np.asarray(values)
         if x.ndim != 1:
             self.fail(f"channel {name!r} has shape {x.shape}; expected one dimension")
+        if x.dtype.kind == "c":
+            self.fail(f"channel {name!r} holds complex values; a recorded time signal is real")
         if x.dtype.kind not in "iuf":
             self.fail(f"channel {name!r} holds {x.dtype} values, not numbers")
         if x.dtype != np.float64:
@@ -377,6 +425,19 @@ class RecordingBuilder:
             self.fail(f"no channel {missing[0]!r}; the file has {', '.join(self.channels)}")
         self.channels = {c: self.channels[c] for c in wanted}
 
+    def _plausible_speed(self, rpm):
+        """The stored speed if plausible; else None, a warning and ``file_shaft_speed_rpm``
+        (the vibration data are fine: they are kept, only the speed is dropped)."""
+        if rpm is None:
+            return None
+        problem = speed_problem(rpm)
+        if problem is None:
+            return float(rpm)
+        self.warn(f"the stored shaft speed {rpm!r} r/min {problem}: not used (give the speed with "
+                  "--rpm)")
+        self.attrs["file_shaft_speed_rpm"] = str(rpm)
+        return None
+
     def build(self, *, fs, t0=0.0, time=None, shaft_speed_rpm=None, default_channel=None,
               data=None, channels=None):
         """Assemble and check the Dataset.
@@ -437,6 +498,7 @@ class RecordingBuilder:
         if self.sha256 is None:
             # after parsing, so the bytes come from the page cache (or the reader's map)
             self.sha256 = file_sha256(self.path, data) if self.checksum else ""
+        rpm = self._plausible_speed(shaft_speed_rpm)
         q_acc = [k for k, (_, a) in self.channels.items() if a.get("quantity") == "acceleration"]
         default = default_channel if default_channel in self.channels else \
             (q_acc[0] if q_acc else next(iter(self.channels)))
@@ -452,8 +514,8 @@ class RecordingBuilder:
             "start_time_s": float(t[0]),
             "n_samples": int(n),
         }
-        if shaft_speed_rpm is not None and np.isfinite(float(shaft_speed_rpm)):
-            attrs["shaft_speed_rpm"] = float(shaft_speed_rpm)
+        if rpm is not None:
+            attrs["shaft_speed_rpm"] = rpm
         for k, v in self.attrs.items():
             if v is not None and k not in attrs:
                 attrs[k] = _attr_value(v)

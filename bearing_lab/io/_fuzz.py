@@ -1,6 +1,7 @@
 """Fuzzing the readers with seeded mutants of real recordings, each read in a guarded subprocess.
 
-(And :func:`kill_writes`: writers killed at random moments must leave a whole file.)
+(And :func:`kill_writes`: writers killed at random moments must leave a whole file.  The
+structure-aware cases, whose header fields are set on purpose, are in :mod:`._fuzz_struct`.)
 
 Why in the package: the CI test (``tests/io/test_io_fuzz.py``) and the long run
 (``benchmarks/fuzz_readers.py``) use the same corpus, mutations and verdicts, and a
@@ -430,9 +431,12 @@ def _inject(kind: str, path: Path) -> tuple[str, str]:
 # ------------------------------------------------------------------ the parent
 class _Worker:
     def __init__(self, name, seed, mem_mb, startup_s=120.0):
+        cmd = [sys.executable, "-m", "bearing_lab.io._fuzz", "worker", name, str(seed), str(mem_mb)]
+        self._boot(cmd, name, startup_s)
+
+    def _boot(self, cmd, name, startup_s=120.0):
         import select
         self._select = select.select
-        cmd = [sys.executable, "-m", "bearing_lab.io._fuzz", "worker", name, str(seed), str(mem_mb)]
         self.proc = subprocess.Popen(cmd, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
                                      stderr=subprocess.DEVNULL, text=True, bufsize=1)
         first = self.answer(startup_s)
@@ -440,6 +444,7 @@ class _Worker:
             self.stop()
             raise RuntimeError(f"fuzz worker for {name!r} did not start (is the mirror set?)")
         self.ready = first
+        return self
 
     def answer(self, timeout):
         ready, _, _ = self._select([self.proc.stdout], [], [], timeout)
@@ -601,6 +606,9 @@ def main(argv=None) -> int:
     w.add_argument("name")
     w.add_argument("seed", type=int)
     w.add_argument("mem_mb", type=int)
+    st = sub.add_parser("structured")
+    st.add_argument("kind")
+    st.add_argument("seed", type=int)
     r = sub.add_parser("repro", help="write one mutant and say what reading it gives")
     r.add_argument("name", choices=sorted(SOURCES))
     r.add_argument("seed", type=int)
@@ -609,6 +617,10 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     if args.cmd == "worker":
         worker(args.name, args.seed, args.mem_mb)
+        return 0
+    if args.cmd == "structured":
+        from ._fuzz_struct import structured_worker
+        structured_worker(args.kind, args.seed)
         return 0
     p = _save(args.name, args.seed, args.index, Path(args.out))
     print(f"{p}: {_describe(args.name, args.seed, args.index)}")

@@ -17,7 +17,9 @@ single-threaded child in milliseconds; elsewhere each read spawns an interpreter
 """
 from __future__ import annotations
 
+import contextlib
 import os
+import threading
 
 from ..errors import BearingLabError, RecordingError
 
@@ -58,6 +60,37 @@ def _context():
     return multiprocessing.get_context("spawn")
 
 
+_START_LOCK = threading.Lock()
+
+
+@contextlib.contextmanager
+def _without_main():
+    """Start children that do not import the caller's ``__main__``.
+
+    multiprocessing tells a fork-server or spawned child to run the parent's main script
+    again (as ``__mp_main__``) so that functions defined there can be unpickled.  The
+    function run here lives in bearing_lab, so the child never needs the script; and a
+    script without ``if __name__ == "__main__":`` would run itself once more in the child,
+    open its file again, and make the read look like a crash of the C library.  The
+    preparation data therefore leave the main module out (for this start only, under a lock).
+    """
+    from multiprocessing import spawn
+    with _START_LOCK:
+        original = spawn.get_preparation_data
+
+        def prepared(name):
+            data = original(name)
+            data.pop("init_main_from_path", None)
+            data.pop("init_main_from_name", None)
+            return data
+
+        spawn.get_preparation_data = prepared
+        try:
+            yield
+        finally:
+            spawn.get_preparation_data = original
+
+
 def guarded(path, what: str, func, *args, timeout: float | None = None):
     """Return ``func(*args)`` computed in a child process; errors name ``path``.
 
@@ -80,7 +113,8 @@ def guarded(path, what: str, func, *args, timeout: float | None = None):
     ctx = _context()
     parent, child = ctx.Pipe(duplex=False)
     proc = ctx.Process(target=_child, args=(child, func, args), daemon=True)
-    proc.start()
+    with _without_main():
+        proc.start()
     child.close()
     try:
         if not parent.poll(timeout):
@@ -92,9 +126,13 @@ def guarded(path, what: str, func, *args, timeout: float | None = None):
         except (EOFError, OSError):
             proc.join(5)
             code = proc.exitcode
-            how = f"signal {-code}" if code is not None and code < 0 else f"exit status {code}"
-            raise RecordingError(f"{path}: {what} crashed while reading the file ({how}): the file "
-                                 "is damaged") from None
+            if code is not None and code < 0:
+                raise RecordingError(f"{path}: {what} crashed while reading the file (signal "
+                                     f"{-code}): the file is damaged") from None
+            raise RecordingError(f"{path}: the process reading the file with {what} ended with exit "
+                                 f"status {code} before it answered (not a crash on the file); if "
+                                 "a script of yours runs this, put its top-level code under "
+                                 "if __name__ == '__main__':") from None
     finally:
         parent.close()
         if proc.is_alive():

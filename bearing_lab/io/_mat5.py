@@ -15,8 +15,11 @@ checked against the bytes that are really there *before* numpy looks at them:
   data element's size exactly (a shortened or lengthened array is refused, never
   silently cut or padded);
 - compressed (miCOMPRESSED) variables are inflated with a ceiling taken from the
-  size their inner tag declares (itself bounded by zlib's largest ratio), and the
-  stream must end with its checksum;
+  size their inner tag declares (itself bounded by zlib's largest ratio, and above
+  64 MiB by :data:`MAX_INFLATE_RATIO`, a ratio no recording's samples reach: a 1 MB
+  element of zeros that inflates to 1 GB is refused before anything is allocated), the
+  stream must end with its checksum, and nothing may follow it in its element (a
+  second stream would be dropped);
 - nesting depth and element counts are bounded by the bytes available.
 
 Only native Python and ``numpy.frombuffer`` on checked ranges touch the bytes.
@@ -51,6 +54,8 @@ _MAX_DEPTH = 32
 _ZLIB_MAX_RATIO = 1032          # deflate cannot expand data more than this
 _NAME_PREFIX = 1 << 16          # inflated bytes enough to hold a variable's tag, flags, dims, name
 _MAX_EMPTY_STRUCTS = 1 << 16    # a struct array without fields takes no bytes: bound it
+MAX_INFLATE_RATIO = 100.0       # recorded samples deflate by 1-2 (CWRU, MFPT); zeros by 1000
+INFLATE_FREE_BYTES = 64 << 20   # a variable this large may inflate by any ratio deflate allows
 
 
 class Mat5Error(ValueError):
@@ -83,8 +88,9 @@ def header_endian(buf) -> str:
 class _Reader:
     """Checked access to one buffer (the file, or one inflated variable)."""
 
-    def __init__(self, buf, endian, where):
+    def __init__(self, buf, endian, where, owned=False):
         self.buf, self.e, self.where = buf, endian, where
+        self.owned = owned  # an inflated buffer of our own: arrays may be views of it
 
     def tag(self, pos, end):
         """Return (type, nbytes, data start, next element) of the element at ``pos``."""
@@ -167,8 +173,17 @@ def _numeric(r, cls, flags, dims, pos, end, where):
     elif flags & 0x200:  # logical
         arr = real != 0
     else:
-        with np.errstate(invalid="ignore", over="ignore"):
-            arr = real.astype(dtype)  # a copy: nothing keeps a view of the file's bytes
+        if dtype.kind in "iu" and real.size and real.dtype != dtype:
+            info = np.iinfo(dtype)
+            lo, hi = real.min(), real.max()
+            if lo < info.min or hi > info.max or (real.dtype.kind == "f" and not np.all(real == np.round(real))):
+                _fail(f"{where}: values {lo:g} .. {hi:g} do not fit the array's class {dtype} "
+                      "(they would wrap around): corrupt")
+        if r.owned and real.dtype == dtype:
+            arr = real  # a view of the inflated buffer (ours): no second copy of a large signal
+        else:
+            with np.errstate(invalid="ignore", over="ignore"):
+                arr = real.astype(dtype)  # a copy: nothing keeps a view of the file's bytes
     return _squeeze(arr.reshape(dims, order="F"))
 
 
@@ -282,8 +297,25 @@ def _element(r: _Reader, pos, end, where, depth):
     return value, name, nxt
 
 
+def max_inflate_ratio() -> float:
+    """The largest inflate ratio accepted for a variable above :data:`INFLATE_FREE_BYTES`
+    (``BEARING_LAB_MAX_INFLATE_RATIO`` overrides :data:`MAX_INFLATE_RATIO`)."""
+    import os
+    text = os.environ.get("BEARING_LAB_MAX_INFLATE_RATIO", "")
+    try:
+        value = float(text) if text else MAX_INFLATE_RATIO
+    except ValueError:
+        _fail(f"BEARING_LAB_MAX_INFLATE_RATIO={text!r} is not a number")
+    return value if value > 0 else MAX_INFLATE_RATIO
+
+
 def _inflate(buf, start, nbytes, endian, where, *, prefix=False):
-    """Inflate one miCOMPRESSED payload with a ceiling; ``prefix``: only its first bytes."""
+    """Inflate one miCOMPRESSED payload with a ceiling; ``prefix``: only its first bytes.
+
+    The output goes into one buffer of the declared size, filled in blocks (no second copy).
+    The stream must end exactly where the element ends: a second zlib stream or junk after
+    the first would otherwise be dropped without a word.
+    """
     d = zlib.decompressobj()
     data = memoryview(buf)[start:start + nbytes]
     try:
@@ -298,10 +330,23 @@ def _inflate(buf, start, nbytes, endian, where, *, prefix=False):
     if declared > _ZLIB_MAX_RATIO * nbytes + 64:
         _fail(f"{where}: compressed variable of {nbytes} bytes declares {declared} bytes inside, "
               "more than deflate can produce: corrupt")
+    ratio = max_inflate_ratio()
+    if not prefix and declared > INFLATE_FREE_BYTES and declared > ratio * nbytes:
+        _fail(f"{where}: compressed variable of {nbytes} bytes declares {declared} bytes inside "
+              f"(inflate ratio {declared / nbytes:.0f}, more than the {ratio:g} a recording's "
+              "samples compress by): a decompression bomb or damaged sizes; if the file is "
+              "genuine, raise the limit with BEARING_LAB_MAX_INFLATE_RATIO")
     want = min(declared, _NAME_PREFIX) if prefix else declared
+    out = bytearray(want)
+    out[:len(head)] = head
+    filled = len(head)
     try:
-        rest = d.decompress(d.unconsumed_tail, want - len(head)) if want > len(head) else b""
-        out = head + rest
+        while filled < want:
+            chunk = d.decompress(d.unconsumed_tail, min(want - filled, 1 << 24))
+            if not chunk:
+                break
+            out[filled:filled + len(chunk)] = chunk
+            filled += len(chunk)
         if not prefix:
             extra = d.decompress(d.unconsumed_tail, 8) if not d.eof else b""
             if extra:
@@ -311,11 +356,15 @@ def _inflate(buf, start, nbytes, endian, where, *, prefix=False):
                 d.flush()
     except zlib.error as exc:
         _fail(f"{where}: compressed variable is corrupt ({exc})")
-    if len(out) < want:
-        _fail(f"{where}: compressed variable inflates to {len(out)} of the {want} bytes its tag "
+    if filled < want:
+        _fail(f"{where}: compressed variable inflates to {filled} of the {want} bytes its tag "
               "declares: truncated or corrupt")
     if not prefix and not d.eof:
         _fail(f"{where}: compressed variable ends before its checksum: truncated or corrupt")
+    if not prefix and d.unused_data and (len(d.unused_data) > 7 or d.unused_data.strip(b"\0")):
+        _fail(f"{where}: {len(d.unused_data)} bytes follow the end of the compressed stream inside "
+              "its element (a second zlib stream or appended data, which MATLAB never writes); "
+              "they would be dropped: refused")
     return out
 
 
@@ -344,7 +393,7 @@ def _variable(buf, r, typ, nb, start, pos, *, name_only):
         value, name, _ = _element(r, pos, start + nb, "", 0)
         return name, value
     inner = _inflate(buf, start, nb, r.e, f"compressed variable at byte {pos}", prefix=name_only)
-    ri = _Reader(inner, r.e, f"compressed variable at byte {pos}")
+    ri = _Reader(inner, r.e, f"compressed variable at byte {pos}", owned=not name_only)
     if name_only:  # ``inner`` holds only the first bytes of the array
         typ2, nb2 = struct.unpack_from(r.e + "II", inner, 0)
         if typ2 != _MI_MATRIX:

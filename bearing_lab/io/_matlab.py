@@ -156,3 +156,25 @@ def _load_mat(path, variable_names):
         return guarded(path, "HDF5", _h5_load, str(path), names)
     from . import _mat5
     return _mat5.load(Path(path).read_bytes(), variable_names=variable_names)
+
+
+def signal_vector(builder, value, name: str) -> np.ndarray:
+    """One channel from a MATLAB variable: a real numeric vector, as float64.
+
+    A matrix is refused, not flattened: MATLAB stores an N×2 matrix column by column, and
+    ``ravel`` (row-major) would silently interleave its two columns into one channel of 2N
+    samples.  Complex values are refused, not cut to their real part.  ``builder`` names
+    the file in the message (:meth:`RecordingBuilder.fail`).
+    """
+    arr = np.asarray(value)
+    if arr.dtype.kind == "c":
+        builder.fail(f"variable {name!r} holds complex values ({arr.dtype}); a recorded time "
+                     "signal is real: not a recording channel")
+    if arr.dtype.kind not in "iuf":
+        what = "text" if isinstance(value, str) else f"{arr.dtype} values"
+        builder.fail(f"variable {name!r} holds {what}, not numbers")
+    if arr.ndim > 1:
+        dims = "×".join(map(str, arr.shape))
+        builder.fail(f"variable {name!r} is a {dims} matrix, not one channel: read as one it "
+                     "would interleave its columns; save each channel as a vector of its own")
+    return arr.astype(np.float64, copy=False).reshape(-1)

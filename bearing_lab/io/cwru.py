@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from ._base import ENGINES, RecordingBuilder, RecordingReader
-from ._matlab import load_mat, mat_variables, mat_version
+from ._matlab import load_mat, mat_variables, mat_version, signal_vector
 
 _CHAN = re.compile(r"^X(\d+)_(DE|FE|BA)_time$")
 _RPM = re.compile(r"^X(\d+)RPM$")
@@ -145,14 +145,18 @@ class CwruReader(RecordingReader):
             b.attrs["sampling_rate_source"] = "user"
         order = [c for c in ("DE", "FE", "BA") if c in found[rec]]
         for c in order:
-            v = np.asarray(m[found[rec][c]], dtype=np.float64).ravel()
+            v = signal_vector(b, m[found[rec][c]], found[rec][c])
             b.add_channel(c, v, None, file_name=found[rec][c], inplace=True,
                           attrs={"location": {"DE": "drive end", "FE": "fan end",
                                               "BA": "base"}[c]})
         rpm = None
         if rpm_var and np.size(m.get(rpm_var, [])) >= 1:
-            rpm = float(np.ravel(m[rpm_var])[0])
-            b.attrs["shaft_speed_source"] = f"file variable {rpm_var}"
+            value = np.ravel(m[rpm_var])[0] if not isinstance(m[rpm_var], str) else m[rpm_var]
+            if isinstance(value, (str, bytes)) or np.iscomplexobj(value):
+                b.warn(f"variable {rpm_var} holds {value!r}, not a speed: shaft_speed_rpm unknown")
+            else:
+                rpm = float(value)
+                b.attrs["shaft_speed_source"] = f"file variable {rpm_var}"
         elif reg is not None and reg.rpm:
             rpm = reg.rpm
             b.attrs["shaft_speed_source"] = "registry bearing_lab/data/recordings.csv"

@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from ._base import ENGINES, RecordingBuilder, RecordingReader
-from ._matlab import load_mat, mat_variables, mat_version
+from ._matlab import load_mat, mat_variables, mat_version, signal_vector
 
 
 class MfptReader(RecordingReader):
@@ -53,9 +53,7 @@ class MfptReader(RecordingReader):
         if not isinstance(s, dict) or "gs" not in s:
             b.fail(f"no struct 'bearing' with field 'gs' (variables: {', '.join(m) or 'none'}); "
                    "not an MFPT file")
-        gs = np.asarray(s["gs"])
-        if gs.dtype.kind not in "iuf":
-            b.fail("bearing.gs is not numeric")
+        gs = signal_vector(b, s["gs"], "bearing.gs")
         if fs is None:
             try:
                 fs = float(np.ravel(s.get("sr"))[0])
@@ -78,7 +76,7 @@ class MfptReader(RecordingReader):
                     b.attrs[f"mfpt_{k.lower()}_hz"] = float(np.ravel(m[k])[0])
                 except (TypeError, ValueError):
                     pass
-        b.add_channel("acc", gs.ravel(), None, file_name="bearing.gs", inplace=True)
+        b.add_channel("acc", gs, None, file_name="bearing.gs", inplace=True)
         return b.build(fs=fs, shaft_speed_rpm=rpm, default_channel="acc", channels=channels)
 
 

@@ -31,11 +31,28 @@ def _load(path: str):
     """Read the whole file (runs in the guarded child)."""
     import xarray as xr
     try:
+        path.encode("utf-8")
+    except UnicodeEncodeError:  # a name in another locale's bytes: netCDF-C takes UTF-8 names
+        return _load_through_link(path)
+    try:
         return xr.load_dataset(path, engine="netcdf4")
     except (OSError, ValueError, RuntimeError, KeyError, IndexError, TypeError, AttributeError,
             UnicodeDecodeError) as exc:
         raise RecordingError(f"{path}: not a readable netCDF4 file ({type(exc).__name__}: "
                              f"{exc})") from None
+
+
+def _load_through_link(path: str):
+    """Read a file whose name is not UTF-8 through a symbolic link with a plain name."""
+    import os
+    import tempfile
+    with tempfile.TemporaryDirectory(prefix="bearing_lab_nc_") as d:
+        link = os.path.join(d, "file.nc")
+        os.symlink(os.path.abspath(path), link)
+        try:
+            return _load(link)
+        except RecordingError as exc:
+            raise RecordingError(str(exc).replace(link, path)) from None
 
 
 def _check_values(ds, path):
@@ -53,6 +70,34 @@ def _check_values(ds, path):
         if bad.any():
             raise RecordingError(f"{path}: variable {name!r} holds {int(bad.sum())} NaN/Inf "
                                  "values: damaged or not a bearing_lab file")
+
+
+def _check_attrs(ds, path):
+    """The rate must be a number that matches the time axis, a stored speed a plausible one."""
+    from ._base import MAX_RATE_HZ, MIN_RATE_HZ, speed_problem
+    if "sampling_rate_hz" in ds.attrs:
+        fs = ds.attrs["sampling_rate_hz"]
+        if isinstance(fs, (str, bytes)) or np.ndim(fs) != 0 or np.iscomplexobj(fs):
+            raise RecordingError(f"{path}: attribute sampling_rate_hz is {fs!r}, not a number of Hz: "
+                                 "damaged or not a bearing_lab file")
+        fs = float(fs)
+        if not MIN_RATE_HZ <= fs <= MAX_RATE_HZ:  # also NaN
+            raise RecordingError(f"{path}: attribute sampling_rate_hz = {fs!r} Hz is not a rate of a "
+                                 "vibration recording: damaged or not a bearing_lab file")
+        if "time" in ds.coords and ds.sizes.get("time", 0) > 1:
+            t = np.asarray(ds["time"].values, dtype=np.float64)
+            axis = 1.0 / float(np.median(np.diff(t))) if np.all(np.diff(t) > 0) else float("nan")
+            if not abs(axis / fs - 1.0) <= 1e-6:
+                raise RecordingError(f"{path}: attribute sampling_rate_hz = {fs:.9g} Hz disagrees with "
+                                     f"the time coordinate ({axis:.9g} Hz): damaged or edited file")
+    if "shaft_speed_rpm" in ds.attrs:
+        rpm = ds.attrs["shaft_speed_rpm"]
+        problem = "is not a number" if isinstance(rpm, (str, bytes)) or np.ndim(rpm) != 0 \
+            else speed_problem(rpm)
+        if problem is not None:
+            shown = rpm if isinstance(rpm, (str, bytes)) or np.ndim(rpm) != 0 else float(rpm)
+            raise RecordingError(f"{path}: attribute shaft_speed_rpm = {shown!r} {problem}: damaged or "
+                                 "edited file")
 
 
 class NetcdfReader(RecordingReader):
@@ -79,6 +124,7 @@ class NetcdfReader(RecordingReader):
         path = Path(path)
         ds = guarded(path, "netCDF-C", _load, str(path))
         _check_values(ds, path)
+        _check_attrs(ds, path)
         kind = "recording" if "reader" in ds.attrs else None
         try:
             schema.check_dataset(ds, kind=kind)

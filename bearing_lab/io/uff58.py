@@ -5,7 +5,8 @@ truncated last set silently, returns 42 values for a header that promises
 2 508 876, lets NaN tokens through, reports 0 from ``get_set_formats()`` for
 binary sets and reads the whole file twice (once to find the blocks, once to
 parse them) with a per-value ``struct.unpack``.  This module reads the fixed
-headers itself (the same field widths as pyuff), maps the file once, seeks past
+headers itself (the same field widths as pyuff), reads the file once (a plain read, not a
+memory map: a map of a file truncated while it is read kills the process), seeks past
 each binary payload while scanning (so a 1 GB 58b is scanned header by header)
 and converts each payload with one ``numpy.frombuffer``.  pyuff stays the
 reference: the tests compare our values with pyuff's on every real file, the
@@ -30,11 +31,12 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import RecordingError, check_choice
-from ._base import ENGINES, RecordingBuilder, RecordingReader, clean_name, map_file
+from ._base import ENGINES, MAX_RATE_HZ, MIN_RATE_HZ, RecordingBuilder, RecordingReader, clean_name, read_file
 
 _DELIM = re.compile(rb"^[ \t]*-1[ \t]*\r?$", re.M)
 _MAX_PAD = 64  # bytes of blanks/NULs a writer may leave after a binary payload
 # Universal File dataset numbers seen in test and modal files (others are refused as damage)
+_MIN_164_FACTOR = 1e-12   # dataset 164 factors scale by 1e±3 (mm), 39.37 (in): 1e±12 is no unit
 _KNOWN_DATASETS = {15, 18, 55, 58, 82, 151, 164, 773, 780, 781, 1710, 1858, 2400, 2411, 2412,
                    2414, 2420, 2429, 2430, 2431, 2432, 2435, 2437, 2467, 2477}
 _DIRS = {1: "+X", 2: "+Y", 3: "+Z", -1: "-X", -2: "-Y", -3: "-Z", 4: "+RX", 5: "+RY", 6: "+RZ",
@@ -127,14 +129,8 @@ class Uff58Reader(RecordingReader):
         b = RecordingBuilder(path, self, units=units, sensitivity=sensitivity, checksum=checksum)
         check_choice(byte_order, (None, "little", "big"), f"{path}: byte_order", RecordingError)
         self._force_bo = {None: None, "little": 1, "big": 2}[byte_order]
-        mm = map_file(path)
-        try:
-            return self._read(mm, b, channels, allow_truncated, fs, snap_rate)
-        finally:
-            try:
-                mm.close()
-            except BufferError:  # a view is still referenced by a traceback; GC closes it
-                pass
+        data = read_file(path)
+        return self._read(data, b, channels, allow_truncated, fs, snap_rate)
 
     # -- scanning -------------------------------------------------------------------
     def _line(self, mm, pos):
@@ -359,7 +355,7 @@ class Uff58Reader(RecordingReader):
                        f"only make sense {other}-endian: the byte order in the file is wrong; "
                        f"pass byte_order='{other}' to read it anyway")
             vals = raw.astype(np.float64)
-            del raw  # no view of the map may outlive it
+            del raw
         else:
             text = mm[st.data_start:st.data_end]
             if b"D" in text or b"d" in text:
@@ -452,7 +448,7 @@ class Uff58Reader(RecordingReader):
             return f"{node}{_DIRS.get(d, '')}" if d else f"node{node}"
         return f"ch{k}"
 
-    def _unit_from_164(self, st, units164):
+    def _unit_from_164(self, st, units164, b):
         """Unit label from the ordinate's spec data type and exponents when the label is empty."""
         h = st.header
         q = _SPEC_QUANTITY.get(h["ordinate_spec_data_type"])
@@ -462,11 +458,21 @@ class Uff58Reader(RecordingReader):
         factor = 1.0
         if units164 is not None:
             lf, ff = units164
-            factor = 1.0 / (lf ** h["ordinate_len_unit_exp"] * ff ** h["ordinate_force_unit_exp"])
+            e_len, e_force = h["ordinate_len_unit_exp"], h["ordinate_force_unit_exp"]
+            try:
+                with np.errstate(all="ignore"):
+                    factor = float(1.0 / (np.float64(lf) ** e_len * np.float64(ff) ** e_force))
+            except (OverflowError, ZeroDivisionError):
+                factor = math.inf
+            if not (math.isfinite(factor) and _MIN_164_FACTOR <= factor <= 1.0 / _MIN_164_FACTOR):
+                b.fail(f"set {st.index}: the unit factors of dataset 164 (length {lf:g}, force {ff:g}) "
+                       f"with the ordinate's unit exponents (length {e_len}, force {e_force}) would "
+                       f"scale every value by {factor:.3g}: not a unit conversion, the units set is "
+                       "damaged; give the channels' unit with units='m/s2' (CLI --units)")
         return label, factor
 
     def _read(self, mm, b, channels, allow_truncated, fs_override, snap_rate):
-        if len(mm) == 0:  # pragma: no cover - mmap refuses empty files earlier
+        if len(mm) == 0:  # pragma: no cover - open_recording refuses empty files earlier
             b.fail("file is empty")
         sets = self._scan(mm, b, allow_truncated)
         if not sets:
@@ -564,7 +570,7 @@ class Uff58Reader(RecordingReader):
             factor164 = None
             if (not label or label.upper() == "NONE") and b.units is None:
                 # no label: the spec data type, unit exponents and dataset 164 say it
-                label, factor164 = self._unit_from_164(st, units164)
+                label, factor164 = self._unit_from_164(st, units164, b)
                 if factor164 not in (None, 1.0):
                     vals = np.asarray(vals, dtype=np.float64) * factor164
             attrs = {k: h[k] for k in ("id1", "id2", "id3", "id4", "id5", "rsp_ent_name")
@@ -591,7 +597,12 @@ class Uff58Reader(RecordingReader):
         else:
             if not inc > 0:
                 b.fail(f"abscissa increment {h0['abscissa_inc_text']!r} is not positive; pass fs=<Hz>")
-            fs = 1.0 / inc
+            with np.errstate(over="ignore"):
+                fs = float(np.float64(1.0) / np.float64(inc))
+            if not MIN_RATE_HZ <= fs <= MAX_RATE_HZ:
+                b.fail(f"abscissa increment {h0['abscissa_inc_text'].strip()!r} s means a sampling "
+                       f"rate of {fs:.6g} Hz, outside {MIN_RATE_HZ:g} Hz .. {MAX_RATE_HZ:.0e} Hz: a "
+                       "damaged header; pass fs=<Hz>")
             if snap_rate:
                 fs = self._snap(fs, h0["abscissa_inc_text"], b)
         for k in ("id1", "id2", "id3", "id4", "id5"):
@@ -631,9 +642,11 @@ class Uff58Reader(RecordingReader):
         except (IndexError, ValueError):
             b.warn(f"set {st.index} (dataset 164, units) is unreadable and was ignored")
             return None
-        if not (length > 0 and force > 0):
-            b.warn(f"set {st.index} (dataset 164) has factors {length}, {force}; ignored")
-            return None
+        if not (0 < length < math.inf and 0 < force < math.inf):  # also NaN
+            # used, these would turn every value into 0, inf or NaN: a channel that needs them
+            # is refused (_unit_from_164); channels with their own unit labels do not need them
+            b.warn(f"set {st.index} (dataset 164) has factors {length}, {force}, which are not unit "
+                   "factors")
         return (length, force)
 
 

@@ -54,6 +54,58 @@ def _declared_frames(data: bytes):
     return frames, problem
 
 
+_FORMAT_TAGS = {1: "PCM", 3: "IEEE float", 0xFFFE: "extensible"}
+
+
+def _format_problem(data: bytes):
+    """Check the ``fmt `` chunk's fields against each other; return the problem or None.
+
+    scipy.io.wavfile picks the sample type from ``block_align`` and the channel count, so a
+    ``block_align`` that disagrees with channels × bytes per sample used to read int16 data as
+    int8 or int32 garbage without a word, and 0 channels ended in a ZeroDivisionError.
+    """
+    if data[:4] not in (b"RIFF", b"RIFX") or len(data) < 12:
+        return None  # RF64 and non-WAV content: left to scipy
+    order = ">" if data[:4] == b"RIFX" else "<"
+    pos, align = 12, None
+    while pos + 8 <= len(data):
+        cid, size = data[pos:pos + 4], struct.unpack_from(order + "I", data, pos + 4)[0]
+        if cid == b"data":
+            if align is None:
+                return "the data chunk comes before the fmt chunk (or there is no fmt chunk)"
+            if size % align:
+                return f"the data chunk's {size} bytes are not a whole number of {align}-byte frames"
+            return None
+        if cid == b"fmt " and align is None:
+            if size < 16 or pos + 24 > len(data):
+                return f"the fmt chunk has {size} bytes, fewer than the 16 of its fields"
+            tag, channels, rate, byte_rate, align, bits = struct.unpack_from(order + "HHIIHH", data,
+                                                                             pos + 8)
+            if tag == 0xFFFE and size >= 40 and pos + 34 <= len(data):
+                tag = struct.unpack_from(order + "H", data, pos + 32)[0]  # the sub-format's tag
+            if tag not in _FORMAT_TAGS:
+                return (f"format tag {tag} is not PCM (1) or IEEE float (3): compressed WAV "
+                        "(ADPCM, µ-law ...) is not supported; convert it to PCM")
+            if channels == 0:
+                return "the fmt chunk declares 0 channels"
+            if bits == 0:
+                return "the fmt chunk declares 0 bits per sample"
+            width = (bits + 7) // 8
+            if tag == 3 and bits not in (32, 64):
+                return f"{bits}-bit floating-point samples are not supported (32 or 64)"
+            if width not in (1, 2, 3, 4, 8):
+                return f"{bits} bits per sample ({width}-byte samples) is not a PCM sample size"
+            if align != channels * width:
+                return (f"block_align is {align} bytes but {channels} channel(s) × {width} bytes "
+                        f"({bits}-bit samples) make {channels * width}: the header is damaged "
+                        "and the samples would be read with the wrong type")
+            align = channels * width
+            if rate == 0:
+                return "the fmt chunk declares a sampling rate of 0 Hz"
+        pos += 8 + size + (size & 1)
+    return "no fmt chunk" if align is None else "no data chunk"
+
+
 class WavReader(RecordingReader):
     """Read PCM/float WAV files with a user calibration."""
 
@@ -100,16 +152,23 @@ class WavReader(RecordingReader):
             b.fail(str(exc))
         if not fs_value > 0:
             b.fail(f"full_scale {full_scale!r} must be positive")
+        raw_bytes = path.read_bytes()
+        problem = _format_problem(raw_bytes)
+        if problem is not None:
+            b.fail(f"not a valid WAV file: {problem}")
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             try:
                 rate, data = wavfile.read(path)
             except (ValueError, EOFError, OSError, IndexError) as exc:
                 b.fail(f"not a readable WAV file ({exc})")
+            except UnboundLocalError:  # scipy walked the chunks without meeting fmt or data
+                b.fail("not a readable WAV file: scipy finds no fmt or no data chunk inside the "
+                       "size the RIFF header declares")
         data = np.asarray(data)
         if data.ndim == 1:
             data = data[:, None]
-        declared, problem = _declared_frames(path.read_bytes())
+        declared, problem = _declared_frames(raw_bytes)
         if declared is not None and data.shape[0] < declared:
             b.shortfall("WAV data chunk", declared, data.shape[0], allow_truncated, unit="frames")
         elif problem is not None:

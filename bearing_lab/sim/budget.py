@@ -9,8 +9,9 @@ running anything:
 
 - integration steps >= simulated time / largest allowed step, where the largest step
   is the fixed rk4 step, or the adaptive methods' ceiling, or the explicit stability
-  limit of the sensor resonator (|h·ω| <= 2.8 for the Runge-Kutta methods used:
-  Hairer, Nørsett & Wanner, *Solving ODEs I*, 1993, fig. IV.2.1), whichever is
+  limit of the sensor resonator (|h·λ| <= 2.8 for the Runge-Kutta methods used:
+  Hairer, Nørsett & Wanner, *Solving ODEs I*, 1993, fig. IV.2.1; λ the resonator's fastest
+  eigenvalue, ω below critical damping and ω(ζ + √(ζ²-1)) above it), whichever is
   smallest; plus ``defect_steps`` per ball crossing of every defect (BPFO crossings a
   second for an outer-race defect, BPFI for an inner-race one, 2·BSF for a ball defect);
 - interpolated samples on the fine anti-aliasing grid: oversample × rate × simulated time;
@@ -41,9 +42,14 @@ def _max_step(scene, method: str, step, max_step) -> tuple[float, str]:
         h, key = float(max_step if max_step is not None else (d["solver"]["max_step_s"] or 2.5e-5)), \
             "solver.max_step_s"
     if d["sensor"]["enabled"]:
-        h_stable = RK_STABILITY / (2 * math.pi * d["sensor"]["frequency_hz"])
+        zeta = d["sensor"]["damping_ratio"]
+        # fastest eigenvalue of the resonator: |λ| = ω below critical damping, ω(ζ + √(ζ²-1))
+        # (about 2ζω) above it: a damping ratio of 1e6 is as stiff as a resonance 2e6 times higher
+        stiff = 1.0 if zeta <= 1.0 else zeta + math.sqrt(zeta * zeta - 1.0)
+        h_stable = RK_STABILITY / (2 * math.pi * d["sensor"]["frequency_hz"] * stiff)
         if h_stable < h:
-            h, key = h_stable, "sensor.frequency_hz"
+            h, key = h_stable, "sensor.frequency_hz" if stiff == 1.0 else \
+                "sensor.damping_ratio (with sensor.frequency_hz)"
     return h, key
 
 

@@ -114,6 +114,11 @@ def _convert(value, key: str, where: str):
     return number * table[unit] / own_scale
 
 
+MAX_MAGNITUDE = 1e15
+"""Largest magnitude of a number key in the key's own unit (mm, N/m, Hz ...): far beyond any
+bearing, yet small enough that the physics (squares, products of keys) stays finite."""
+
+
 def _check(value, key, spec, where):
     default, typ, check, _ = spec
     value = _convert(value, key, where)
@@ -131,6 +136,9 @@ def _check(value, key, spec, where):
         value = float(value) if typ is _NUM else int(value)
         if not math.isfinite(value):
             raise SceneError(f"{where}: {value!r} must be finite")
+        if abs(value) > MAX_MAGNITUDE:  # 1e308 would overflow the first square taken of it
+            raise SceneError(f"{where}: {float(value):.6g} is beyond any physical value of this key "
+                             f"(magnitude above {MAX_MAGNITUDE:.0e} in its unit)")
         if check == "pos" and not value > 0:
             raise SceneError(f"{where}: {value!r} must be positive")
         if check == "nonneg" and value < 0:
@@ -367,10 +375,31 @@ _ALIASES = {"speed_rpm": "speed.rpm", "rpm": "speed.rpm", "duration": "output.du
             "fs": "output.sample_rate_hz"}
 
 
-def _parse_value(text):
+def _key_type(parts):
+    """The schema type of a ``--set`` key (None if unknown: the scene check names the key)."""
+    if parts[0] in ("defect", "defects"):
+        return list if parts[-1] == "vertices_mm" else None
+    spec = SCHEMA[""].get(parts[0]) if len(parts) == 1 else SCHEMA.get(parts[0], {}).get(parts[1])
+    return spec[1] if spec else None
+
+
+def _parse_value(text, typ=None, key=""):
+    """A ``--set`` value: the text itself for a text key (``bearing=6205``), a TOML array for a
+    list key (``speed.profile=[[0, 1000], [0.05, 1800]]``), else a bool, int, float or text."""
     if not isinstance(text, str):
         return text
-    low = text.strip().lower()
+    stripped = text.strip()
+    if typ is str:
+        if len(stripped) >= 2 and stripped[0] == stripped[-1] and stripped[0] in "'\"":
+            return stripped[1:-1]
+        return stripped
+    if stripped.startswith("["):
+        try:
+            return tomllib.loads(f"v = {stripped}")["v"]
+        except tomllib.TOMLDecodeError as exc:
+            raise SceneError(f"--set {key}: {stripped!r} is not a list in TOML syntax ({exc}); write "
+                             "e.g. [[0, 1000], [0.05, 1800]]") from None
+    low = stripped.lower()
     if low in ("true", "false"):
         return low == "true"
     try:
@@ -385,8 +414,8 @@ def _parse_value(text):
 
 def _apply_override(raw: dict, key: str, value):
     key = _ALIASES.get(key, key)
-    value = _parse_value(value)
     parts = key.split(".")
+    value = _parse_value(value, _key_type(parts), key)
     if parts[0] in ("defect", "defects"):
         if len(parts) != 2:
             raise SceneError(f"--set {key}: use defect.<key>, e.g. defect.length_mm=1")

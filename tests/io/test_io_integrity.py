@@ -250,13 +250,14 @@ def test_unreadable_file_is_a_recording_error(tmp_path, monkeypatch, datafile):
         open_recording(p)
 
 
-@pytest.mark.parametrize("inc, needle", [("1.00000E-300", "1e+300 Hz is outside"),
-                                         ("1.00000E+300", "1e-300 Hz is outside")])
+@pytest.mark.parametrize("inc, needle", [("1.00000E-300", "a sampling rate of 1e+300 Hz, outside"),
+                                         ("1.00000E+300", "a sampling rate of 1e-300 Hz, outside")])
 def test_absurd_sampling_rates_refused(write, sine, inc, needle):
     from bearing_lab.io._testing import uff58_block
     p = write("rate.uff", uff58_block(sine, binary=True, inc=inc))
     import re
-    with pytest.raises(RecordingError, match=re.escape(f"rate.uff: sampling rate {needle}")):
+    with pytest.raises(RecordingError, match=re.escape(f"rate.uff: abscissa increment '{inc}' s means "
+                                                       f"{needle}")):
         open_recording(p)
 
 

@@ -27,7 +27,8 @@ HOSTILE = [
     (["shaft.stiffness_y_n_m=1e-10", "load.on=outer"], "shaft.stiffness_y_n_m=1e-10"),
     (["mount.stiffness_x_n_m=1e-10"], "mount.stiffness_x_n_m=1e-10"),
     (["output.oversample=1"], "output.oversample=1"),
-    (["fs=1e300"], "budget.max_fine_samples"),
+    (["fs=1e300"], "output.sample_rate_hz: 1e+300 is beyond any physical value"),
+    (["sensor.enabled=true", "sensor.damping_ratio=1e6"], "set by sensor.damping_ratio"),
     (["fs=1e-300"], "below 1 kHz"),
     (["output.duration_s=1e-9"], "0 sample(s)"),
     (["fs=1e9"], "budget.max_"),
@@ -131,3 +132,41 @@ def test_dask_cluster_that_fails_to_start(monkeypatch):
     with pytest.raises(BearingLabError, match=r"local Dask cluster .* did not start .*serial"):
         sweep("paper-healthy", {"speed_rpm": [900, 1800]}, cache_dir=False, progress=False,
               duration=0.005)
+
+
+def test_overdamped_sensor_counts_the_stiffness_it_implies():
+    """sensor.damping_ratio=1e6 ran for 15+ minutes on 0.01 s: the budget saw only the frequency."""
+    sc = load_scene("paper-O1", **{"sensor.enabled": True, "sensor.damping_ratio": 1e6,
+                                   "output.duration_s": 0.01})
+    with pytest.raises(SceneError, match=r"set by sensor.damping_ratio \(with sensor.frequency_hz\)"):
+        check_budget(sc)
+    light = load_scene("paper-O1", **{"sensor.enabled": True, "output.duration_s": 0.01})
+    assert work_estimate(light)["step_key"] == "solver.max_step_s"  # ζ = 0.05: unchanged
+    heavy = load_scene("paper-O1", **{"sensor.enabled": True, "sensor.damping_ratio": 1e3,
+                                      "output.duration_s": 0.01})
+    w = work_estimate(heavy)
+    assert w["step_key"].startswith("sensor.damping_ratio")
+    assert w["max_step_s"] == pytest.approx(2.8 / (2 * 3.141592653589793 * 5000 * (1e3 + (1e6 - 1) ** 0.5)))
+
+
+@pytest.mark.parametrize("key", ["bearing_geometry.outer_diameter_mm", "output.oversample",
+                                 "material.youngs_modulus_gpa"])
+def test_huge_numbers_are_refused_by_key(key):
+    """1e308 raised OverflowError deep in the mass or memory estimate."""
+    with pytest.raises(SceneError, match=rf"{key}: 1e\+308 is beyond any physical value of this key"):
+        load_scene("paper-healthy", **parse_set([f"{key}=1e308"]))
+
+
+def test_text_and_list_keys_can_be_set():
+    """bearing=6205, speed.profile=[[...]] and defect.vertices_mm=[[...]] as the scene keys say."""
+    sc = load_scene("paper-healthy", **parse_set(["bearing=6205"]))
+    assert sc.data["bearing"] == "6205" and sc.bearing.n_balls == 9
+    sc = load_scene("paper-healthy", **parse_set(["speed.profile=[[0, 1000], [0.05, 1800]]"]))
+    assert sc.data["speed"]["profile"] == [[0, 1000], [0.05, 1800]]
+    sc = load_scene("paper-healthy", **parse_set(["defect.shape=polygon", "defect.depth_mm=0.1",
+                                                  "defect.vertices_mm=[[0,0],[1,1],[1,0]]"]))
+    assert sc.data["defect"][0]["vertices_mm"] == [[0, 0], [1, 1], [1, 0]]
+    with pytest.raises(SceneError, match=r"--set speed.profile: '\[\[0,1000\],' is not a list in TOML"):
+        load_scene("paper-healthy", **parse_set(["speed.profile=[[0,1000],"]))
+    with pytest.raises(SceneError, match="bearing"):
+        load_scene("paper-healthy", **parse_set(["bearing=9999"]))
