@@ -19,7 +19,7 @@ Examples
 """
 from __future__ import annotations
 
-import xarray as xr
+from ._xarray import xr  # xarray, dask imported only once the process uses dask
 
 _FORWARDED = {  # accessor method -> function of bearing_lab.analysis.xr
     "amplitude_spectrum": "amplitude_spectrum", "welch_psd": "welch_psd", "bandpass": "bandpass",

@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
+from . import _xarray  # noqa: F401  (xarray writes without importing dask)
 from ._files import atomic_path
 from .errors import BearingLabError
 

@@ -48,8 +48,8 @@ def _add_read_options(p):
     p.add_argument("--record", type=int, default=None, help="CWRU record number in a multi-record file")
 
 
-def _open(args):
-    from ..io import open_recording
+def _open(args, arrays_only=False):
+    from ..io import open_recording, read_arrays
     opts = _options(args)
     fmt = args.format
     if fmt is None:
@@ -69,7 +69,7 @@ def _open(args):
                 raise RecordingError(f"{args.file}: the {fmt!r} reader does not use {flags}")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # they are in ds.attrs['warnings'] and printed below
-        return open_recording(args.file, format=fmt, **opts)
+        return (read_arrays if arrays_only else open_recording)(args.file, format=fmt, **opts)
 
 
 def _cmd_import(args) -> int:
@@ -172,7 +172,7 @@ def _cmd_info(args) -> int:
     if not args.file:
         from ..errors import RecordingError
         raise RecordingError("info: give a FILE (or --formats)")
-    ds = _open(args)
+    ds = _open(args, arrays_only=True)  # no Dataset: info prints without importing xarray
     d = describe(ds, args.file)
     if args.json:
         from .._json import dumps

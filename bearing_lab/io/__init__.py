@@ -26,7 +26,8 @@ from pathlib import Path
 import stat
 
 from ..errors import BearingLabError, RecordingError, check_choice
-from ._base import ENGINES, RecordingReader, RecordingWarning, get_warnings  # noqa: F401
+from ._base import (_ARRAYS_ONLY, ENGINES, RecordingArrays, RecordingReader,  # noqa: F401
+                    RecordingWarning, get_warnings)
 
 #: The built-in readers (one module each, named like the format), in sniffing order: the first
 #: reader whose ``guess_can_open`` says yes reads the file.
@@ -77,7 +78,7 @@ def _register_readers():
 _register_readers()
 from .export import to_netcdf, to_uff58b  # noqa: E402
 
-__all__ = ["open_recording", "list_engines", "to_netcdf", "to_uff58b", "get_warnings",
+__all__ = ["open_recording", "read_arrays", "list_engines", "to_netcdf", "to_uff58b", "get_warnings",
            "ENGINES", "RecordingReader", "RecordingWarning"]
 
 
@@ -236,7 +237,8 @@ def open_recording(path, format=None, **options):
         except OSError as exc:
             raise RecordingError(f"{path}: cannot read the file ({exc.strerror or exc})") from None
     check_choice(format, ENGINES, f"{path}: format", RecordingError)
-    from .. import _accessor  # noqa: F401  (registers da.bearing on the recordings; imports xarray)
+    if not _ARRAYS_ONLY.get():
+        from .. import _accessor  # noqa: F401  (registers da.bearing on the recordings; imports xarray)
     reader = ENGINES[format]()
     missing = reader.available()
     if missing:
@@ -264,3 +266,18 @@ def open_recording(path, format=None, **options):
         msg = (f"{path}: the {format!r} reader failed on unexpected or corrupt content "
                f"({type(exc).__name__}: {exc})")
         raise RecordingError(msg) from exc
+
+
+def read_arrays(path, format=None, **options):
+    """Read a recording like :func:`open_recording`, without making the Dataset.
+
+    Returns a :class:`RecordingArrays` (time, channels and attributes, every check made;
+    ``.to_dataset()`` gives what :func:`open_recording` gives) for the readers that assemble
+    their channels (all but ``netcdf``, which returns its Dataset).  For a quick summary
+    (``bearing-lab info``): xarray and pandas are not imported.
+    """
+    token = _ARRAYS_ONLY.set(True)
+    try:
+        return open_recording(path, format=format, **options)
+    finally:
+        _ARRAYS_ONLY.reset(token)

@@ -35,12 +35,15 @@ Channel naming rule (all readers):
 """
 from __future__ import annotations
 
+import contextvars
 import hashlib
 import importlib
+import importlib.util
 import inspect
 import json
 import os
 import re
+import sys
 import warnings
 from abc import ABC, abstractmethod
 from pathlib import Path
@@ -102,10 +105,8 @@ class RecordingReader(ABC):
 
     def available(self) -> str | None:
         """Return None when the reader can run, else what to install."""
-        for lib in self.libraries:
-            try:
-                importlib.import_module(lib)
-            except ImportError:
+        for lib in self.libraries:  # found, not imported: the reader imports what it uses
+            if lib not in sys.modules and importlib.util.find_spec(lib) is None:
                 return f"needs the optional package {lib!r}: pip install bearing_lab[formats]"
         return None
 
@@ -125,13 +126,20 @@ class RecordingReader(ABC):
 
 def library_versions(libraries) -> str:
     """Return ``"numpy 2.1.0, pyuff 2.5.8"`` for the given module names."""
+    from importlib import metadata
     out = []
     for lib in libraries:
-        try:
-            mod = importlib.import_module(lib)
-            out.append(f"{lib} {getattr(mod, '__version__', '?')}")
-        except ImportError:
-            out.append(f"{lib} missing")
+        mod = sys.modules.get(lib)
+        version = getattr(mod, "__version__", None)
+        if version is None:  # from the installed distribution's metadata: no import
+            try:
+                version = metadata.version(lib)
+            except metadata.PackageNotFoundError:
+                try:
+                    version = getattr(importlib.import_module(lib), "__version__", "?")
+                except ImportError:
+                    version = "missing"
+        out.append(f"{lib} {version}")
     return ", ".join(out)
 
 
@@ -452,8 +460,7 @@ class RecordingBuilder:
         data : an mmap/bytes of the whole file to hash (avoids reading it again).
         channels : channel selection (see :meth:`select`).
         """
-        import xarray as xr
-        from .. import __version__, schema
+        from .. import __version__
 
         if isinstance(self.units, dict):
             extra = set(self.units) - self._used_units
@@ -519,11 +526,61 @@ class RecordingBuilder:
         for k, v in self.attrs.items():
             if v is not None and k not in attrs:
                 attrs[k] = _attr_value(v)
-        tvar = xr.Variable("time", t, {"units": "s", "long_name": "time", "standard_name": "time"})
-        data_vars = {k: xr.Variable("time", v, a) for k, (v, a) in self.channels.items()}
-        ds = xr.Dataset(data_vars, coords={"time": tvar}, attrs=attrs)
+        rec = RecordingArrays(t, self.channels, attrs)
+        if _ARRAYS_ONLY.get():
+            return rec
         try:
-            schema.check_dataset(ds, kind="recording")
+            return rec.to_dataset()
         except BearingLabError as exc:  # pragma: no cover - a reader bug
             self.fail(str(exc))
+
+
+#: Set by :func:`bearing_lab.io.read_arrays`: :meth:`RecordingBuilder.build` then returns the
+#: :class:`RecordingArrays` instead of the Dataset (no xarray import, for ``bearing-lab info``).
+_ARRAYS_ONLY = contextvars.ContextVar("bearing_lab_io_arrays_only", default=False)
+
+
+class _Channel:
+    """One channel of :class:`RecordingArrays`: the few Variable attributes ``info`` reads."""
+    __slots__ = ("values", "attrs", "dims")
+
+    def __init__(self, values, attrs):
+        self.values, self.attrs, self.dims = values, attrs, ("time",)
+
+    @property
+    def dtype(self):
+        return self.values.dtype
+
+
+class RecordingArrays:
+    """A checked recording as plain numpy arrays and attributes, before it becomes a Dataset.
+
+    Everything :meth:`RecordingBuilder.build` checks has been checked; :meth:`to_dataset` makes
+    the contract Dataset.  It answers the read-only part of the Dataset interface that a summary
+    needs (``attrs``, ``sizes``, ``data_vars``, ``ds["time"].values``), so ``bearing-lab info``
+    prints a recording without importing xarray and pandas (a third of a second).
+    """
+
+    def __init__(self, time, channels, attrs):
+        self.time = time
+        self.data_vars = {k: _Channel(v, a) for k, (v, a) in channels.items()}
+        self.attrs = attrs
+        self.sizes = {"time": int(time.size)}
+
+    def __getitem__(self, name):
+        if name == "time":
+            return _Channel(self.time, dict(_TIME_ATTRS))
+        return self.data_vars[name]
+
+    def to_dataset(self):
+        """The recording Dataset of :mod:`bearing_lab.schema` (checked against it)."""
+        import xarray as xr
+        from .. import schema
+        tvar = xr.Variable("time", self.time, dict(_TIME_ATTRS))
+        data_vars = {k: xr.Variable("time", c.values, c.attrs) for k, c in self.data_vars.items()}
+        ds = xr.Dataset(data_vars, coords={"time": tvar}, attrs=self.attrs)
+        schema.check_dataset(ds, kind="recording")
         return ds
+
+
+_TIME_ATTRS = {"units": "s", "long_name": "time", "standard_name": "time"}

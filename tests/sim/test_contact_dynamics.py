@@ -94,7 +94,8 @@ def test_ball_loads_balance_the_load_at_3600_rpm():
     assert abs(fx.mean()) < 1e-3 * abs(applied[1])
 
 
-def test_table_time_reported_apart_from_the_time_loop():
+def test_table_time_reported_apart_from_the_time_loop(private_table_cache):
+    """Cold: the table is built here; warm: the same table comes from the cache."""
     ds = simulate("paper-O1", duration=0.02, progress=False, **{"defect.length_mm": 1.7})
     assert ds.attrs["table_time_s"] > 0 and ds.attrs["wall_time_s"] > 0
     again = simulate("paper-O1", duration=0.02, progress=False, **{"defect.length_mm": 1.7})

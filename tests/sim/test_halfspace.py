@@ -155,7 +155,7 @@ def test_share_follows_a_small_skew_change_in_proportion():
     assert np.abs(d1b - d1).max() < 0.2 * np.abs(d1).max()
 
 
-def test_cache_round_trip_and_key():
+def test_cache_round_trip_and_key(private_table_cache):
     d = Defect(length=1e-3, width=1e-3, offset=0.2e-3)
     T1 = _fresh(d)
     assert T1.info["source"] == "built"
@@ -175,7 +175,7 @@ def test_cache_round_trip_and_key():
 
 
 @pytest.mark.parametrize("damage", ["truncate", "flip", "nan", "garbage"])
-def test_damaged_cache_entry_is_reported_and_rebuilt(damage):
+def test_damaged_cache_entry_is_reported_and_rebuilt(damage, private_table_cache):
     d = Defect(length=2e-3, width=0.8e-3)
     T1 = _fresh(d)
     key = table_key(d, B6308, model="halfspace", clearance=0.0, delta_max=DMAX, n_psi=None,

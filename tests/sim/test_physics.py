@@ -141,6 +141,19 @@ def test_no_aliasing_of_ball_resonance():
     assert e_c == pytest.approx(e_f, rel=0.05)
 
 
+@pytest.mark.parametrize("fs_out,oversample", [(20000.0, 8), (12000.0, 4), (48000.0, 16), (25600.0, 6)])
+def test_anti_alias_taps_are_scipys_kaiser_firwin(fs_out, oversample):
+    """The numpy-written anti-alias filter is scipy.signal's kaiserord + firwin design."""
+    from scipy import signal
+    from bearing_lab.sim.integrate import anti_alias_taps
+    fs_fine = fs_out * oversample
+    numtaps, beta = signal.kaiserord(80.0, 0.1 * fs_out / (fs_fine / 2))
+    ref = signal.firwin(numtaps | 1, fs_out / 2, window=("kaiser", beta), fs=fs_fine)
+    taps = anti_alias_taps(fs_out, oversample)
+    assert taps.shape == ref.shape
+    np.testing.assert_allclose(taps, ref, rtol=0, atol=1e-15)
+
+
 def test_streaming_output_equals_whole_record_and_scipy():
     """The chunked, streaming anti-alias stage gives what the whole-record pipeline gives, and
     an independent integrator (scipy's LSODA on the same right-hand side) lands on the same

@@ -1,0 +1,76 @@
+"""What a command imports: the lazy public face (lazy_loader.attach) and xarray kept away from
+dask until dask is used (bearing_lab._xarray).  Each check runs in a fresh interpreter."""
+import json
+import os
+import subprocess
+import sys
+
+import pytest
+
+HEAVY = ("numpy", "xarray", "pandas", "scipy", "numba", "matplotlib", "netCDF4", "h5py", "dask")
+
+
+def _modules_after(code, env=None):
+    """The heavy modules loaded after running ``code`` in a fresh interpreter."""
+    probe = code + f"\nimport json, sys; print(json.dumps([m for m in {HEAVY!r} if m in sys.modules]))"
+    out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, check=True,
+                         env={**os.environ, **(env or {})})
+    return set(json.loads(out.stdout.strip().splitlines()[-1]))
+
+
+def test_import_and_help_load_no_heavy_library():
+    assert _modules_after("import bearing_lab") == set()
+    code = ("from bearing_lab.cli import main\ntry:\n    main(['--help'])\nexcept SystemExit:\n    pass")
+    assert _modules_after(code) == set()
+
+
+def test_every_public_name_resolves_and_stays_importable():
+    """EAGER_IMPORT=1 (lazy_loader) resolves every lazily served name at import."""
+    assert "numpy" in _modules_after("import bearing_lab", env={"EAGER_IMPORT": "1"})
+    import bearing_lab
+    for name in bearing_lab.__all__:
+        assert getattr(bearing_lab, name) is not None, name
+    for name in ("analysis", "io", "sim", "validation", "datasets", "report"):
+        assert name in dir(bearing_lab)
+    from bearing_lab import (AnalysisError, BearingGeometry, BearingLabError, CATALOG,  # noqa: F401
+                             RecordingError, Scene, analyze, check_dataset, get_bearing, identify,
+                             list_engines, list_scenes, load_scene, open_recording, simulate, sweep,
+                             to_netcdf, to_uff58b)
+    assert bearing_lab.simulate is bearing_lab.sim.simulate
+    assert bearing_lab.identify.__module__ == "bearing_lab.validation.identify"
+
+
+def test_info_reads_without_xarray(datafile):
+    path = datafile("cwru/12k_FE/IR014_1.mat")
+    code = ("import contextlib, io\nfrom bearing_lab.cli import main\n"
+            f"with contextlib.redirect_stdout(io.StringIO()):\n    assert main(['info', {str(path)!r}]) == 0")
+    loaded = _modules_after(code)
+    assert not loaded & {"xarray", "pandas", "dask", "numba", "matplotlib"}, loaded
+
+
+def test_a_dataset_is_made_and_written_without_dask(tmp_path):
+    """A simulation made and written (the ``simulate -o`` path) imports no dask.array, no
+    distributed: 0.6 s of CPU that xarray would spend only to learn that nothing is dask."""
+    code = ("import bearing_lab\nfrom bearing_lab.io_netcdf import write_netcdf\n"
+            "ds = bearing_lab.simulate('paper-healthy', duration=0.005, progress=False)\n"
+            f"write_netcdf(ds, {str(tmp_path / 'a.nc')!r})\n")
+    # xarray imports dask's core (0.1 s) to ask dask.base; not dask.array, not distributed
+    out = subprocess.run([sys.executable, "-c", code + "import sys\n"
+                          "print('dask.array' in sys.modules, 'distributed' in sys.modules)"],
+                         capture_output=True, text=True, check=True)
+    assert out.stdout.split() == ["False", "False"]
+
+
+def test_dask_still_works_through_xarray_after_the_hooks(tmp_path):
+    pytest.importorskip("dask.array")
+    import numpy as np
+    import xarray as xr
+    from bearing_lab import _xarray  # noqa: F401  (the hooks)
+    from bearing_lab.io_netcdf import write_netcdf
+    from xarray.namedarray.pycompat import array_type
+    ds = xr.Dataset({"a": ("time", np.arange(1000.0))}, coords={"time": np.arange(1000) / 1e3},
+                    attrs={"sampling_rate_hz": 1000.0}).chunk({"time": 250})
+    assert ds["a"].chunks is not None and isinstance(ds["a"].data, array_type("dask"))
+    p = write_netcdf(ds, tmp_path / "chunked.nc")
+    back = xr.load_dataset(p)
+    np.testing.assert_array_equal(back["a"].values, np.arange(1000.0))
