@@ -70,6 +70,37 @@ def _impact_quantities(x, fs, period, level, out, notes):
     return band, times
 
 
+def _fault_families(res, out, notes) -> dict:
+    """BPFO and BPFI into ``out`` (Hz, NaN without a detected family, the reason in ``notes``).
+
+    A family's frequency only where a route of the analysis detects the family (noise rule and
+    decoys): the best line of a slip window always exists in a dense spectrum, and comparing two
+    such picks compares chance.  The routes that decided the diagnosis are asked first.  Returns,
+    per family, ``detected``, the ``route`` and ``evidence_margin_db`` (the best route's evidence
+    over its decoy threshold)."""
+    ev = res.get("evidence", {})
+    routes = ev.get("routes", {})
+    order = [r for r in [*(ev.get("decided_by") or []), ev.get("reported_route")] + sorted(routes) if r in routes]
+    families = {}
+    for k in ("bpfo", "bpfi"):
+        found = next(((r, routes[r]["families"][k]) for r in dict.fromkeys(order)
+                      if routes[r]["families"][k]["detected"] and not routes[r]["families"][k]["explained_by"]),
+                     None)
+        fk = res["fault_frequencies"][k]
+        margins = [f["evidence_db"] - f["decoy_threshold_db"] for f in (routes[r]["families"][k] for r in routes)
+                   if f.get("decoy_threshold_db") is not None]
+        families[k] = {"detected": found is not None, "route": None if found is None else found[0],
+                       "evidence_margin_db": max(margins) if margins else None}
+        out[k] = _num(found[1]["measured_hz"]) if found is not None else float("nan")
+        if found is None:
+            best = ("no line in the slip window" if fk["measured_hz"] is None else
+                    f"best candidate {fk['measured_hz']:.2f} Hz, {fk['snr_db']:.1f} dB, "
+                    f"{fk['harmonics']} harmonic(s)")
+            notes[k] = (f"no {k.upper()} line family in the squared envelope spectrum (expected "
+                        f"{fk['expected_hz']:.2f} Hz; {best}: below the detection rule)")
+    return families
+
+
 def measure(x, fs, *, bearing, rpm=None, shaft_hz=None, fault=None, duration_level=0.1):
     """The quantities of a validation table for one signal, measured the same way for recording
     and simulation.
@@ -123,29 +154,7 @@ def measure(x, fs, *, bearing, rpm=None, shaft_hz=None, fault=None, duration_lev
     out["shaft_hz"] = _num(fi)
     if fi is None:
         notes["shaft_hz"] = f"no shaft line in the amplitude spectrum (best candidate {snr:.1f} dB above the floor)"
-    routes = res.get("evidence", {}).get("routes", {})
-    first = res.get("evidence", {}).get("decided_by") or []
-    order = [r for r in [*first, res.get("evidence", {}).get("reported_route")] + sorted(routes) if r in routes]
-    families = {}
-    for k in ("bpfo", "bpfi"):
-        # a family's frequency only where a route of the analysis detects the family (noise rule and
-        # decoys): the best line of a slip window always exists in a dense spectrum, and comparing
-        # two such picks compares chance.  The routes that decided the diagnosis are asked first.
-        found = next(((r, routes[r]["families"][k]) for r in dict.fromkeys(order)
-                      if routes[r]["families"][k]["detected"] and not routes[r]["families"][k]["explained_by"]),
-                     None)
-        fk = ff[k]
-        margins = [f["evidence_db"] - f["decoy_threshold_db"] for f in (routes[r]["families"][k] for r in routes)
-                   if f.get("decoy_threshold_db") is not None]
-        families[k] = {"detected": found is not None, "route": None if found is None else found[0],
-                       "evidence_margin_db": max(margins) if margins else None}
-        out[k] = _num(found[1]["measured_hz"]) if found is not None else float("nan")
-        if found is None:
-            best = ("no line in the slip window" if fk["measured_hz"] is None else
-                    f"best candidate {fk['measured_hz']:.2f} Hz, {fk['snr_db']:.1f} dB, "
-                    f"{fk['harmonics']} harmonic(s)")
-            notes[k] = (f"no {k.upper()} line family in the squared envelope spectrum (expected "
-                        f"{fk['expected_hz']:.2f} Hz; {best}: below the detection rule)")
+    families = _fault_families(res, out, notes)
     key = fault or {"outer_race": "bpfo", "inner_race": "bpfi"}.get(res["diagnosis"])
     period = res["excitation_period_s"]
     if period is None and key is not None and ff[key]["measured_hz"]:
