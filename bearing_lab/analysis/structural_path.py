@@ -256,6 +256,12 @@ class _PathProblem:
         level = np.array([self.p_e[b].mean() for b in bins])
         self.bins = [b for b, lv in zip(bins, level) if lv >= 0.01 * level.max()]
         self.peak_e = self.impact_peak(self.e, self.te)
+        # the part of the recording's floor the model does not hold, fixed before the fit: the
+        # model's own floor at the gain that matches the impact peaks (a floor that followed the
+        # fitted gain would let the gain trade impact level for floor, and bias it)
+        peak_s = self.impact_peak(self.s, self.ts) if self.ts.size else 0.0
+        g0 = self.peak_e / peak_s if peak_s > 0 else 0.0
+        self.floor_add2 = max(self.floor ** 2 - (g0 * _floor(self.s)) ** 2, 0.0)
 
     def impact_peak(self, y, times):
         return float(np.percentile(impact_peaks(y, self.fs, times, self.period), 90))
@@ -282,7 +288,7 @@ class _PathProblem:
         if shift:
             moved = mean_envelope(y, self.fs, self.ts + shift / self.fs, pre=self.pre, post=self.post)
             env = moved if moved is not None and moved.size == env.size else np.roll(env, -shift)
-        return np.sqrt(env ** 2 + max(self.floor ** 2 - _floor(y) ** 2, 0.0))
+        return np.sqrt(env ** 2 + self.floor_add2)
 
     def residuals(self, params):
         return self.residuals_of(self.path_of(params).apply(self.s, self.fs))
