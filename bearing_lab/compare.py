@@ -33,8 +33,8 @@ __all__ = ["compare", "ComparisonResult", "align_by_impulse_phase", "shift", "ta
 
 G0 = 9.80665
 
-_TEXT_KEYS = ("quantity", "label", "units", "tolerance", "rule", "reason", "known_limitation", "note",
-              "reference_label", "simulated_signal", "experiment_span", "status")
+_TEXT_KEYS = ("quantity", "label", "units", "tolerance", "rule", "reason", "known_limitation", "declared_by",
+              "note", "reference_label", "simulated_signal", "experiment_span", "status")
 _FLOAT_KEYS = ("simulation", "experiment", "reference_value", "difference", "difference_pct", "tolerance_pct",
                "paper_simulation")
 _BOOL_KEYS = ("pass", "independent")

@@ -122,23 +122,35 @@ def rows_table(rows: list, *, show_reference=False, show_paper=False, intro="") 
         rows="\n".join(lines))
 
 
+_VERDICT_LABEL = {"pass": "PASS", "known limitations": "KNOWN LIMITATIONS", "fail": "FAIL", "skip": "skipped",
+                  "error": "error"}
+_VERDICT_CLASS = {"pass": "pass", "known limitations": "known", "fail": "fail", "skip": "skip", "error": "error"}
+
+
 def index_rows(entries: list) -> str:
+    """The index table's rows: per case its verdict in words, counts, and the failing rows by kind."""
     out = []
     for e in entries:
         st = e["status"]
+        verdict = e.get("verdict") or ({"pass": "pass"}.get(st) or ("fail" if st == "fail" else st))
         link = f'<a href="{esc(e["link"])}">{esc(e["case"])}</a>' if e.get("link") else esc(e["case"])
         what = esc(e.get("title", ""))
         if e.get("reason"):
             what += f'<br><span class="note">{esc(e["reason"])}</span>'
-        failing = ", ".join(esc(f) for f in e.get("failing", []))
-        known = ", ".join(esc(f) for f in e.get("known", []))
-        if known:
-            failing = (failing + " " if failing else "") + f"({known})"
+        parts = []
+        if e.get("failing"):
+            parts.append("<b>unexplained:</b> " + ", ".join(esc(f) for f in e["failing"]))
+        if e.get("known"):
+            who = ", ".join(e.get("declared_by") or []) or "the case"
+            parts.append(f"<b>declared limitations</b> (by {esc(who)}): " + ", ".join(esc(f) for f in e["known"]))
+        failing = "<br>".join(parts)
         wall = fmt(e.get("wall_time_s"), 3) if e.get("wall_time_s") is not None else "—"
         counts = f"{e.get('n_pass', 0)} / {e.get('n_rows', 0)}" if st in ("pass", "fail") else "—"
-        label = {"pass": "pass", "fail": "FAIL", "skip": "skipped", "error": "error"}[st]
-        out.append(template("index_row.html").substitute(status=st, link=link, what=what, label=label,
-                                                         counts=counts, wall=wall, failing=failing))
+        label = _VERDICT_LABEL[verdict]
+        if e.get("verdict_text") and st in ("pass", "fail"):
+            label += f'<br><span class="note">{esc(e["verdict_text"])}</span>'
+        out.append(template("index_row.html").substitute(status=_VERDICT_CLASS[verdict], link=link, what=what,
+                                                         label=label, counts=counts, wall=wall, failing=failing))
     return "\n".join(out)
 
 
