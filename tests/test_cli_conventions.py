@@ -117,3 +117,20 @@ def test_import_and_standin_keep_an_existing_output(tmp_path, capsys):
     assert capsys.readouterr() == ("", "")
     assert main(["case", "standin", "paper-O2", "-o", str(src)]) == 2      # refused before any simulation
     assert "exists; pass --force" in capsys.readouterr().err
+
+
+def test_analyze_states_evidence_in_lines_and_db_not_summed_db(datafile, capsys):
+    """No '282 dB' for a sum of line SNRs: lines and their mean line-to-floor ratio; the sum is a score."""
+    import re
+    rec = datafile("cwru/130_OR007@6_0.mat")
+    assert main(["analyze", str(rec), "--bearing", "6205", "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    ev = d["evidence"]
+    lead = ev["routes"][ev["reported_route"]]["families"]["bpfo"]
+    assert lead["n_lines"] * lead["mean_line_snr_db"] == pytest.approx(lead["evidence_score"])
+    assert ev["leader_lines"] == {"n_lines": lead["n_lines"], "mean_line_snr_db": lead["mean_line_snr_db"]}
+    assert not any(k.endswith("_db") and "evidence" in k for k in lead)
+    assert main(["analyze", str(rec), "--bearing", "6205"]) == 0
+    text = capsys.readouterr().out
+    assert "runner-up: inner_race (envelope-spectrum lines over the floor:" in text
+    assert max(float(v) for v in re.findall(r"([\d.]+) dB", text)) <= 60.0, text   # a line SNR is capped at 60 dB

@@ -98,7 +98,7 @@ def measure(x, fs, *, bearing, rpm=None, shaft_hz=None, fault=None, duration_lev
         ``analysis`` (the :func:`bearing_lab.analysis.analyze` result), ``band``,
         ``impact_times``, ``notes`` (why a value is NaN), ``fault``, ``shaft_hz_used``,
         ``families`` (per BPFO/BPFI: ``detected``, the ``route`` that detected it, and
-        ``evidence_margin_db``, the best route's evidence above its decoy threshold: how far the
+        ``evidence_margin_score``, the best route's evidence above its decoy threshold: how far the
         detection is from flipping).  BPFO and BPFI carry a value only where a route of the
         analysis *detects* the family; the best line of a slip window alone is no measurement.
 
@@ -135,10 +135,10 @@ def measure(x, fs, *, bearing, rpm=None, shaft_hz=None, fault=None, duration_lev
                       if routes[r]["families"][k]["detected"] and not routes[r]["families"][k]["explained_by"]),
                      None)
         fk = ff[k]
-        margins = [f["evidence_db"] - f["decoy_threshold_db"] for f in (routes[r]["families"][k] for r in routes)
-                   if f.get("decoy_threshold_db") is not None]
+        margins = [f["evidence_score"] - f["decoy_threshold_score"] for f in (routes[r]["families"][k] for r in routes)
+                   if f.get("decoy_threshold_score") is not None]
         families[k] = {"detected": found is not None, "route": None if found is None else found[0],
-                       "evidence_margin_db": max(margins) if margins else None}
+                       "evidence_margin_score": max(margins) if margins else None}
         out[k] = _num(found[1]["measured_hz"]) if found is not None else float("nan")
         if found is None:
             best = ("no line in the slip window" if fk["measured_hz"] is None else

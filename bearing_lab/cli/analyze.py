@@ -230,7 +230,12 @@ def _print(result, path, name, fs, bearing, units, tacho_name, note, plot):
     if ev.get("candidates") and result["verdict"] != "diagnosed":
         print(f"  candidates: {', '.join(ev['candidates'])}")
     if ev.get("runner_up"):
-        print(f"  runner-up: {ev['runner_up']} ({ev['margin_db']:.0f} dB less line evidence)")
+        a, b = ev.get("leader_lines") or {}, ev.get("runner_up_lines") or {}
+
+        def _lines(s):
+            return f"{s['n_lines']} at a mean {s['mean_line_snr_db']:.1f} dB" if s.get("n_lines") else "none"
+        print(f"  runner-up: {ev['runner_up']} (envelope-spectrum lines over the floor: {_lines(b)}; the "
+              f"leader's: {_lines(a)}; evidence score {ev['margin_score']:.0f} lower)")
     print(f"  why: {ev['reason']}")
     if ev.get("band") and ev["band"]["low_hz"] is not None:
         b = ev["band"]
