@@ -219,6 +219,24 @@ def _cmd_fetch(args) -> int:
     return 0
 
 
+def _cmd_sample(args) -> int:
+    import shutil
+    from importlib import resources
+    from ..io_netcdf import check_output_path
+    out = check_output_path(args.output, force=args.force, suffixes=(".uff",))
+    src = resources.files("bearing_lab").joinpath("data", "sample_recording.uff")
+    with resources.as_file(src) as p:
+        shutil.copyfile(p, out)
+    if args.json:
+        from .._json import dumps
+        from ..validation.standin import SAMPLE
+        print(dumps({"file": str(out), **SAMPLE}, indent=1))
+    elif not args.quiet:
+        print(f"{out}: the sample recording (made by bearing_lab: a simulated 6308 with an outer-race defect, "
+              f"1 s at 12.8 kHz, stored in volts at 9.91 mV/g; import it with --sensitivity 9.91mV/g)")
+    return 0
+
+
 def _cmd_list(args) -> int:
     from .. import datasets
     rows = []
@@ -265,7 +283,7 @@ def register(subparsers) -> None:
                    help="print nothing: exit status 0 when the file reads, 2 (and the reason) when not")
     p.set_defaults(func=_cmd_info)
 
-    p = subparsers.add_parser("data", help="registered public recordings (fetch, list)")
+    p = subparsers.add_parser("data", help="registered public recordings (fetch, list) and the sample recording")
     sub = p.add_subparsers(dest="data_command", metavar="ACTION")
     f = sub.add_parser("fetch", help="copy (mirror) or download registered recordings, hash-checked")
     f.add_argument("names", nargs="+", metavar="NAME", help="registry name, e.g. cwru/130_OR007@6_0.mat")
@@ -275,6 +293,17 @@ def register(subparsers) -> None:
     f.add_argument("--json", action="store_true", help="print {name: path} as JSON")
     f.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors")
     f.set_defaults(func=_cmd_fetch)
+    sm = sub.add_parser("sample", help="write the sample recording bearing_lab ships (a stand-in it made itself)",
+                        description="Copy the sample recording shipped with bearing_lab: a simulated 6308 with a "
+                                    "hidden 3 x 1 mm outer-race defect at 320 N and 1800 r/min (speed jitter, a "
+                                    "4.3 kHz housing resonance, machine tones, sensor noise), 1 s at 12.8 kHz, "
+                                    "stored as an accelerometer's voltage at 9.91 mV/g in UFF 58b. Made by "
+                                    "bearing_lab.validation.standin.make_sample_recording; no third-party data.")
+    sm.add_argument("-o", "--output", default="recording.uff", help="file to write (default recording.uff)")
+    sm.add_argument("--force", action="store_true", help="overwrite an existing file")
+    sm.add_argument("--json", action="store_true", help="print the file and how it was made as JSON")
+    sm.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors")
+    sm.set_defaults(func=_cmd_sample)
     ls = sub.add_parser("list", help="list the registry")
     ls.add_argument("--dataset", default=None, help="filter by dataset prefix (cwru, ims, mfpt, lms)")
     ls.add_argument("--json", action="store_true", help="print the registry entries as JSON")
