@@ -39,6 +39,10 @@ _FLOAT_KEYS = ("simulation", "experiment", "reference_value", "difference", "dif
                "paper_simulation")
 _BOOL_KEYS = ("pass", "independent")
 
+#: one colour per compared signal in every figure, none of them a fault marker's (BPFO red, BPFI green)
+SIGNAL_COLORS = {"experiment": "k", "recording": "k", "model": "tab:blue", "path": "tab:orange",
+                 "path+background": "tab:purple"}
+
 
 def _f(v) -> float:
     try:
@@ -190,7 +194,7 @@ class ComparisonResult:
             if normalize:
                 pos = y[sel & (f > 5)]
                 y = y / (np.nanmax(pos) if pos.size and np.nanmax(pos) > 0 else 1.0)
-            ax.plot(f[sel] / fscale, y[sel], lw=0.7, label=str(s).replace("_", " "))
+            ax.plot(f[sel] / fscale, y[sel], lw=0.7, label=str(s).replace("_", " "), color=SIGNAL_COLORS.get(str(s)))
         colors = {"bpfo": "tab:red", "bpfi": "tab:green", "shaft": "0.5"}
         for m in markers:
             fm = ds.attrs.get(f"{m}_hz")
