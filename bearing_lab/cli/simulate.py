@@ -11,6 +11,8 @@ def _scenes(args) -> int:
         from .._json import dumps
         print(dumps(scenes, indent=1))
         return 0
+    if args.quiet:
+        return 0
     width = max(len(n) for n in scenes)
     for name, desc in scenes.items():
         print(f"{name:<{width}}  {desc}")
@@ -56,7 +58,7 @@ def _simulate(args) -> int:
 def register(sub) -> None:
     p = sub.add_parser("scenes", help="list the built-in scenes")
     p.add_argument("--json", action="store_true", help="print {name: description} as JSON")
-    p.add_argument("-q", "--quiet", action="store_true", help="accepted for uniformity (the list is the output)")
+    p.add_argument("-q", "--quiet", action="store_true", help="print nothing (exit status 0: the scenes load)")
     p.set_defaults(func=_scenes)
     p = sub.add_parser("simulate", help="simulate a scene and write the Dataset (netCDF)")
     p.add_argument("scene", help="a TOML scene file or a built-in scene name (see `bearing-lab scenes`)")
