@@ -33,11 +33,15 @@ __all__ = ["compare", "ComparisonResult", "align_by_impulse_phase", "shift", "ta
 
 G0 = 9.80665
 
-_TEXT_KEYS = ("quantity", "label", "units", "tolerance", "rule", "reason", "known_limitation", "note",
-              "reference_label", "simulated_signal", "experiment_span", "status")
+_TEXT_KEYS = ("quantity", "label", "units", "tolerance", "rule", "reason", "known_limitation", "declared_by",
+              "note", "reference_label", "simulated_signal", "experiment_span", "status")
 _FLOAT_KEYS = ("simulation", "experiment", "reference_value", "difference", "difference_pct", "tolerance_pct",
                "paper_simulation")
 _BOOL_KEYS = ("pass", "independent")
+
+#: one colour per compared signal in every figure, none of them a fault marker's (BPFO red, BPFI green)
+SIGNAL_COLORS = {"experiment": "k", "recording": "k", "model": "tab:blue", "path": "tab:orange",
+                 "path+background": "tab:purple"}
 
 
 def _f(v) -> float:
@@ -190,7 +194,7 @@ class ComparisonResult:
             if normalize:
                 pos = y[sel & (f > 5)]
                 y = y / (np.nanmax(pos) if pos.size and np.nanmax(pos) > 0 else 1.0)
-            ax.plot(f[sel] / fscale, y[sel], lw=0.7, label=str(s).replace("_", " "))
+            ax.plot(f[sel] / fscale, y[sel], lw=0.7, label=str(s).replace("_", " "), color=SIGNAL_COLORS.get(str(s)))
         colors = {"bpfo": "tab:red", "bpfi": "tab:green", "shaft": "0.5"}
         for m in markers:
             fm = ds.attrs.get(f"{m}_hz")

@@ -275,9 +275,10 @@ def fetch(name: str, mirror=None, dest=None, *, download: bool = True, verify: b
                 return target
             return _install(src, target, rec, verify, f"mirror {m}")
     if not download or not rec.url:
-        where = f"mirror {m}" if m else "no mirror (pass --mirror DIR or set BEARING_LAB_MIRROR)"
+        where = (f"is not in the mirror {m}" if m else
+                 "is not cached and no mirror is set (pass --mirror DIR or set BEARING_LAB_MIRROR)")
         how = f"download it from {rec.page or rec.url}" if (rec.page or rec.url) else "get it"
-        msg = (f"recording {rec.name!r} is not in {where}"
+        msg = (f"recording {rec.name!r} {where}"
                + ("" if rec.url else " and has no direct download URL")
                + f"; {how} and place it under <mirror>/{rec.name}")
         if stale is not None:

@@ -91,11 +91,13 @@ def _write_failure(path: Path, exc, ds) -> str:
     return f"{type(exc).__name__}: {exc}"
 
 
-def check_output_path(text: str) -> Path:
-    """The CLI's ``-o OUT.nc``: refuse a non-.nc name or a missing directory before any work."""
+def check_output_path(text: str, *, force: bool = False, suffixes=(".nc", ".nc4")) -> Path:
+    """The CLI's ``-o FILE``: refuse a wrong suffix, a missing directory or (without ``force``) an
+    existing file before any work."""
     out = Path(text)
-    if out.suffix not in (".nc", ".nc4"):
-        raise BearingLabError(f"-o {text}: the output must be a netCDF file ending in .nc")
+    if out.suffix not in suffixes:
+        what = "a netCDF file ending in .nc" if ".nc" in suffixes else "a file ending in " + " or ".join(suffixes)
+        raise BearingLabError(f"-o {text}: the output must be {what}")
     if not out.parent.exists():
         raise BearingLabError(f"-o {text}: directory {out.parent} does not exist")
     size = len(os.fsencode(out.name))
@@ -103,5 +105,7 @@ def check_output_path(text: str) -> Path:
         raise BearingLabError(f"-o {text}: the file name has {size} bytes; a file name has at most "
                               "255")
     if out.is_dir():
-        raise BearingLabError(f"-o {text}: is a directory; give a file name ending in .nc")
+        raise BearingLabError(f"-o {text}: is a directory; give a file name ending in {suffixes[0]}")
+    if out.exists() and not force:
+        raise BearingLabError(f"-o {text}: exists; pass --force to overwrite it")
     return out

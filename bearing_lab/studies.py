@@ -326,7 +326,7 @@ def _findings(s, rs):
 
 def _write_html(out, names, rows, figs):
     parts = ["<!DOCTYPE html><html><head><meta charset='utf-8'><title>bearing_lab: the paper's "
-             "parametric studies</title><style>body{font-family:sans-serif;max-width:1000px;margin:auto}"
+             "parametric studies</title><style>body{font-family:sans-serif;max-width:1000px;margin:auto}img{max-width:100%;height:auto}"
              "table{border-collapse:collapse}td,th{border:1px solid #999;padding:3px 8px;text-align:right}"
              "</style></head><body><h1>The paper's section-5 studies on the 2-D defect model</h1>",
              "<p>Peak displacement is the largest deviation of the outer-ring Y displacement from its "

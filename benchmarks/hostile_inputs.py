@@ -65,7 +65,7 @@ def hostile_scenes(tmp: Path) -> int:
     late = 0
     for sets in HOSTILE:
         out = tmp / "h.nc"
-        r, wall = _cli("simulate", "paper-O1", "-q", "-o", str(out), *sets)
+        r, wall = _cli("simulate", "paper-O1", "-q", "--force", "-o", str(out), *sets)
         lines = r.stderr.strip().splitlines()
         late += wall >= 10.0
         first = lines[0].replace("|", "/") if lines else ""
@@ -86,7 +86,7 @@ def kill_import(tmp: Path, src: Path, kills: int, seed: int) -> dict:
     rng = np.random.default_rng(seed)
     res = {"kills": kills, "intact": 0, "destroyed": 0}
     for _ in range(kills):
-        p = subprocess.Popen([sys.executable, "-m", "bearing_lab", "import", str(src), "-o", str(out)],
+        p = subprocess.Popen([sys.executable, "-m", "bearing_lab", "import", str(src), "-o", str(out), "--force"],
                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         time.sleep(float(rng.uniform(0.2, full)))
         p.send_signal(signal.SIGKILL)

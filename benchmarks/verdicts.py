@@ -8,7 +8,8 @@ inside (+) or outside (-) its tolerance, as a share of the tolerance:
 - ``pct`` rule: ``1 - |sim - exp| / (tol |exp|)``;
 - ``factor`` rule: ``1 - |ln(sim / exp)| / ln(factor)``;
 - a line-family row where neither signal shows the family: no margin; its note gives each side's
-  family evidence over the decoy threshold in dB (the detection's own margin).
+  family evidence score over the decoy threshold (a sum of line SNRs in dB: a score; the detection's
+  own margin).
 
 Usage::
 

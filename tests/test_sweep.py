@@ -137,10 +137,10 @@ def test_cli_round_trip(serial, cache, tmp_path, capsys):
     from bearing_lab.cli import main
     out = tmp_path / "sweep.nc"
     rc = main(["sweep", SCENE, "--param", "defect.offset_mm=0,0.25", "--param", "speed_rpm=900,1800",
-               "--duration", str(DUR), "--scheduler", "serial", "--cache-dir", str(cache), "-q",
+               "--duration", str(DUR), "--scheduler", "serial", "--cache-dir", str(cache), "--json",
                "-o", str(out)])
     assert rc == 0
-    assert "4 scenes" in capsys.readouterr().err
+    assert json.loads(capsys.readouterr().out)["sweep_n_scenes"] == 4
     back = xr.load_dataset(out)
     assert back.attrs["sweep_dims"] == "defect_offset_mm speed_rpm"
     assert back["speed_rpm"].attrs["units"] == "rpm"

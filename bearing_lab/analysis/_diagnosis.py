@@ -293,6 +293,16 @@ def coincidences(fault_hz, shaft_hz, df, *, tolerance=0.02, n_harmonics=5, bins=
     return out
 
 
+def line_stats(ev) -> dict:
+    """The physical side of a family's evidence score: how many envelope-spectrum lines it counts
+    (``n_lines``: carrier harmonics and sidebands) and their mean line-to-floor ratio in dB (each
+    capped as in the score), so score = n_lines x mean_line_snr_db."""
+    lines = ev.get("lines") or []
+    n = len(lines) if lines else int(ev.get("harmonics", 0)) + int(ev.get("sidebands", 0) or 0)
+    score = float(ev.get("evidence_score") or 0.0)
+    return {"n_lines": n, "mean_line_snr_db": (score / n) if n else None}
+
+
 def family_summary(ev, *, bsf_scale=False):
     """JSON-ready summary of one family's evidence (BSF on the BSF scale when asked)."""
     scale = 0.5 if bsf_scale else 1.0
@@ -301,10 +311,11 @@ def family_summary(ev, *, bsf_scale=False):
             "snr_db": float(ev["snr_db"]), "harmonics": int(ev["harmonics"]), "groups": int(ev["groups"]),
             "sidebands": int(ev["sidebands"]),
             "sideband_spacing_hz": None if ev["modulator_hz"] is None else float(ev["modulator_hz"]),
-            "evidence_db": float(ev["evidence_db"]),
-            "decoy_max_db": None if ev["decoy_max_db"] is None else float(ev["decoy_max_db"]),
-            "decoy_threshold_db": (None if ev.get("decoy_threshold_db") is None
-                                   else float(ev["decoy_threshold_db"])),
+            "evidence_score": float(ev["evidence_score"]),
+            **line_stats(ev),
+            "decoy_max_score": None if ev["decoy_max_score"] is None else float(ev["decoy_max_score"]),
+            "decoy_threshold_score": (None if ev.get("decoy_threshold_score") is None
+                                   else float(ev["decoy_threshold_score"])),
             "detected": bool(ev["detected"]), "explained_by": ev.get("explained_by")}
 
 
@@ -314,15 +325,15 @@ def route_summary(route):
     return {"verdict": "abstained" if route["abstained"] else v["verdict"],
             "reason": route.get("abstain_reason", v["reason"]) if route["abstained"] else v["reason"],
             "candidates": list(v["candidates"]),
-            "margin_db": None if v["margin_db"] is None else float(v["margin_db"]),
+            "margin_score": None if v["margin_score"] is None else float(v["margin_score"]),
             "families": {k: family_summary(e, bsf_scale=(k == "bsf")) for k, e in route["families"].items()}}
 
 
 def runner_up(route):
-    """(leader key, runner-up key, margin dB) of a route, by evidence."""
+    """(leader key, runner-up key, score margin) of a route, by evidence score."""
     fams = route["families"]
-    order = sorted(LABELS, key=lambda k: -fams[k]["evidence_db"])
-    return order[0], order[1], float(fams[order[0]]["evidence_db"] - fams[order[1]]["evidence_db"])
+    order = sorted(LABELS, key=lambda k: -fams[k]["evidence_score"])
+    return order[0], order[1], float(fams[order[0]]["evidence_score"] - fams[order[1]]["evidence_score"])
 
 
 def deciding_route(routes):

@@ -22,7 +22,7 @@ One family (:func:`family_evidence`):
   measured to a quarter bin puts its k-th harmonic within k/4 bins, so the window
   grows with ``k`` but stays a few bins wide;
 - sidebands ``k F +- m f_mod`` (m = 1, 2) of the family's modulator count as
-  evidence (``evidence_db``: capped SNR summed over carrier and sideband lines);
+  evidence (``evidence_score``: capped SNR summed over carrier and sideband lines);
 - *detected* when the noise rule passes (the fundamental group, i.e. the carrier
   or one of its first sidebands, holds a line of at least ``FUNDAMENTAL_SNR_DB``;
   at least two carrier harmonics and ``MIN_HARMONICS`` harmonic groups are
@@ -289,7 +289,7 @@ def family_evidence(cs, expected_hz, *, modulator_hz=None, tolerance=0.02, n_har
         Harmonic groups examined.
     decoy_hz : array_like, optional
         Decoy carriers (Hz) searched the same way; without them the decoy test is
-        skipped (``decoy_max_db`` None).
+        skipped (``decoy_max_score`` None).
 
     Returns
     -------
@@ -298,7 +298,7 @@ def family_evidence(cs, expected_hz, *, modulator_hz=None, tolerance=0.02, n_har
         (fundamental carrier line, else the best line in the slip window),
         ``harmonics`` (carrier lines found), ``groups`` (harmonic groups with a
         carrier or sideband line), ``sidebands`` (sideband lines found),
-        ``modulator_hz``, ``evidence_db``, ``decoy_max_db``, ``decoy_threshold_db``,
+        ``modulator_hz``, ``evidence_score``, ``decoy_max_score``, ``decoy_threshold_score``,
         ``passes_noise_rule``, ``detected``, ``lines`` (list of ``(frequency Hz, snr
         dB, k, m)``).
     """
@@ -307,7 +307,7 @@ def family_evidence(cs, expected_hz, *, modulator_hz=None, tolerance=0.02, n_har
     b = _batch(cs, [expected_hz], modulator_hz, tolerance, n_harmonics)
     out = {"expected_hz": float(expected_hz), "measured_hz": None, "snr_db": 0.0, "harmonics": 0,
            "groups": 0, "sidebands": 0, "modulator_hz": None if modulator_hz is None else float(modulator_hz),
-           "evidence_db": 0.0, "decoy_max_db": None, "passes_noise_rule": False, "detected": False,
+           "evidence_score": 0.0, "decoy_max_score": None, "passes_noise_rule": False, "detected": False,
            "lines": []}
     if not b["has"][0]:
         w = (cs.f >= expected_hz * (1 - tolerance)) & (cs.f <= expected_hz * (1 + tolerance))
@@ -325,14 +325,14 @@ def family_evidence(cs, expected_hz, *, modulator_hz=None, tolerance=0.02, n_har
                 lines.append((float(cs.f[i]), float(b["ssnr"][0, o, kk]), kk + 1, int(m)))
     out.update(measured_hz=float(b["f1"][0]), snr_db=float(b["csnr"][0, 0]),
                harmonics=int(b["harmonics"][0]), groups=int(b["groups"][0]),
-               sidebands=int(sum(1 for ln in lines if ln[3] != 0)), evidence_db=float(b["evidence"][0]),
+               sidebands=int(sum(1 for ln in lines if ln[3] != 0)), evidence_score=float(b["evidence"][0]),
                passes_noise_rule=bool(_noise_rule(b)[0]), lines=sorted(lines))
     out["detected"] = out["passes_noise_rule"]
     if decoy_hz is not None and len(decoy_hz):
         d = _batch(cs, decoy_hz, modulator_hz, tolerance, n_harmonics)["evidence"]
-        out["decoy_max_db"] = float(d.max())
-        out["decoy_threshold_db"] = float(max(d.max(), d.mean() + DECOY_SIGMAS * d.std()))
-        out["detected"] = bool(out["passes_noise_rule"] and out["evidence_db"] > out["decoy_threshold_db"])
+        out["decoy_max_score"] = float(d.max())
+        out["decoy_threshold_score"] = float(max(d.max(), d.mean() + DECOY_SIGMAS * d.std()))
+        out["detected"] = bool(out["passes_noise_rule"] and out["evidence_score"] > out["decoy_threshold_score"])
     return out
 
 
@@ -433,9 +433,9 @@ def _exclusive(ev, leader, cs, *, shaft_hz, ftf_hz, n_harmonics):
     fund = max([ln[1] for ln in kept if ln[2] == 1 and abs(ln[3]) <= 1] or [0.0])
     evidence = float(sum(min(s, LINE_CAP_DB) for _, s, _, _ in kept))
     detected = fund >= FUNDAMENTAL_SNR_DB and len(carriers) >= 2 and len(groups) >= MIN_HARMONICS
-    if ev.get("decoy_threshold_db") is not None:
-        detected = detected and evidence > ev["decoy_threshold_db"]
-    return {"lines": kept, "detected": bool(detected), "evidence_db": evidence}
+    if ev.get("decoy_threshold_score") is not None:
+        detected = detected and evidence > ev["decoy_threshold_score"]
+    return {"lines": kept, "detected": bool(detected), "evidence_score": evidence}
 
 
 def route_verdict(families, cs, *, shaft_hz, ftf_hz, n_harmonics=5):
@@ -444,7 +444,7 @@ def route_verdict(families, cs, *, shaft_hz, ftf_hz, n_harmonics=5):
     Parameters
     ----------
     families : dict
-        :func:`search_families` result (modified: rivals get ``exclusive_evidence_db``).
+        :func:`search_families` result (modified: rivals get ``exclusive_evidence_score``).
     cs : CyclicSpectrum
         The spectrum they were found in.
     shaft_hz, ftf_hz : float
@@ -457,33 +457,33 @@ def route_verdict(families, cs, *, shaft_hz, ftf_hz, n_harmonics=5):
     dict
         ``verdict`` ("outer_race", "inner_race", "ball", "none" or "uncertain"),
         ``leader`` (family key or None), ``candidates`` (labels, strongest first),
-        ``margin_db`` (leader's evidence minus the next family's; None without a
+        ``margin_score`` (leader's evidence minus the next family's; None without a
         leader), ``reason``.
     """
     keys = [k for k in LABELS if families[k]["detected"]]
     if not keys:
         if families["ftf"]["detected"]:
-            return {"verdict": "uncertain", "leader": "ftf", "candidates": ["ball"], "margin_db": None,
+            return {"verdict": "uncertain", "leader": "ftf", "candidates": ["ball"], "margin_score": None,
                     "reason": "a cage-rate (FTF) line family without a 2 BSF family of its own"}
-        return {"verdict": "none", "leader": None, "candidates": [], "margin_db": None,
+        return {"verdict": "none", "leader": None, "candidates": [], "margin_score": None,
                 "reason": "no fault family passes the detection rule"}
-    leader = max(keys, key=lambda k: families[k]["evidence_db"])
-    runner = max((k for k in LABELS if k != leader), key=lambda k: families[k]["evidence_db"])
-    margin = families[leader]["evidence_db"] - families[runner]["evidence_db"]
+    leader = max(keys, key=lambda k: families[k]["evidence_score"])
+    runner = max((k for k in LABELS if k != leader), key=lambda k: families[k]["evidence_score"])
+    margin = families[leader]["evidence_score"] - families[runner]["evidence_score"]
     rivals = []
     for k in keys:
         if k == leader:
             continue
         ex = _exclusive(families[k], families[leader], cs, shaft_hz=shaft_hz, ftf_hz=ftf_hz,
                         n_harmonics=n_harmonics)
-        families[k]["exclusive_evidence_db"] = ex["evidence_db"]
+        families[k]["exclusive_evidence_score"] = ex["evidence_score"]
         if ex["detected"]:
             rivals.append(k)
         else:
             families[k]["explained_by"] = leader
-    rivals.sort(key=lambda k: -families[k]["evidence_db"])
+    rivals.sort(key=lambda k: -families[k]["evidence_score"])
     cands = [LABELS[leader]] + [LABELS[k] for k in rivals]
-    base = {"leader": leader, "candidates": cands, "margin_db": float(margin)}
+    base = {"leader": leader, "candidates": cands, "margin_score": float(margin)}
     if rivals:
         names = " and ".join(k.upper() if k != "bsf" else "2 BSF" for k in [leader] + rivals)
         return {"verdict": "uncertain", **base, "reason": f"{names} families are each detected on lines of their own"}

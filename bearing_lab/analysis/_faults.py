@@ -108,7 +108,7 @@ def fault_line(f, ses, expected_hz, *, shaft_hz=None, tolerance=0.02, n_harmonic
         ``expected_hz``, ``measured_hz`` (None when no fundamental passes),
         ``snr_db`` (of the best line in the window, even when it does not pass),
         ``harmonics`` (number of lines found, fundamental included; 0 if none),
-        ``sidebands`` (number of shaft sidebands found), ``evidence_db``,
+        ``sidebands`` (number of shaft sidebands found), ``evidence_score``,
         ``detected`` (bool), ``units`` ("Hz" for frequencies, "dB" for SNR).
 
     Examples
@@ -136,8 +136,8 @@ def fault_line(f, ses, expected_hz, *, shaft_hz=None, tolerance=0.02, n_harmonic
     usable = ~_shaft_mask(f, shaft_hz, df)
     usable[0] = False
     out = {"expected_hz": float(expected_hz), "measured_hz": None, "snr_db": 0.0, "harmonics": 0,
-           "sidebands": 0, "evidence_db": 0.0, "detected": False,
-           "units": {"expected_hz": "Hz", "measured_hz": "Hz", "snr_db": "dB", "evidence_db": "dB"}}
+           "sidebands": 0, "evidence_score": 0.0, "detected": False,
+           "units": {"expected_hz": "Hz", "measured_hz": "Hz", "snr_db": "dB", "evidence_score": "1 (sum of line SNRs in dB)"}}
     lo = int(np.floor(expected_hz * (1 - tolerance) / df))
     hi = int(np.ceil(expected_hz * (1 + tolerance) / df))
     if hi >= f.size - 1:
@@ -168,7 +168,7 @@ def fault_line(f, ses, expected_hz, *, shaft_hz=None, tolerance=0.02, n_harmonic
                                 int(np.ceil((centre + half) / df)), usable)
                 if ks is not None and snr_db[ks] >= HARMONIC_SNR_DB:
                     nsb += 1
-    out.update(harmonics=count, sidebands=nsb, evidence_db=evidence,
+    out.update(harmonics=count, sidebands=nsb, evidence_score=evidence,
                detected=bool(count >= MIN_HARMONICS))
     return out
 
@@ -202,7 +202,7 @@ def diagnose_ses(f, ses, fault_hz, *, shaft_hz=None, tolerance=0.02, n_harmonics
         modulation) or ``"none"``.
     lines : dict
         Per key: ``expected_hz``, ``measured_hz``, ``snr_db``, ``harmonics``,
-        ``groups``, ``sidebands``, ``evidence_db``, ``decoy_max_db``, ``detected``,
+        ``groups``, ``sidebands``, ``evidence_score``, ``decoy_max_score``, ``detected``,
         ``lines`` and ``units`` (``bsf`` is searched at 2 BSF: its
         ``expected_hz`` and ``measured_hz`` are 2 BSF).
 
@@ -230,5 +230,5 @@ def diagnose_ses(f, ses, fault_hz, *, shaft_hz=None, tolerance=0.02, n_harmonics
                            decoys=shaft_hz is not None)
     verdict = route_verdict(fams, cs.masked(shaft_hz), shaft_hz=shaft_hz, ftf_hz=fault_hz["ftf"],
                             n_harmonics=n_harmonics)
-    units = {"expected_hz": "Hz", "measured_hz": "Hz", "snr_db": "dB", "evidence_db": "dB"}
+    units = {"expected_hz": "Hz", "measured_hz": "Hz", "snr_db": "dB", "evidence_score": "1 (sum of line SNRs in dB)"}
     return verdict["verdict"], {k: dict(v, units=units) for k, v in fams.items()}

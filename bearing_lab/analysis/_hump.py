@@ -76,7 +76,7 @@ def route_humps(f, s, fault_hz, *, shaft_hz, factors, tolerance=0.02):
     Returns
     -------
     dict
-        ``score_db`` (2 BSF), ``bpfo_db``, ``bpfi_db``, ``decoy_max_db``, ``decoy_threshold_db``,
+        ``score_db`` (2 BSF), ``bpfo_db``, ``bpfi_db``, ``decoy_max_score``, ``decoy_threshold_score``,
         ``decoys`` (count), ``clear`` (bool).
     """
     kw = dict(shaft_hz=shaft_hz, ftf_hz=fault_hz["ftf"])
@@ -88,12 +88,12 @@ def route_humps(f, s, fault_hz, *, shaft_hz, factors, tolerance=0.02):
         return float(v) if np.isfinite(v) else None  # NaN: the spectrum does not reach the humps
     out = {"score_db": num(score), "bpfo_db": num(race["bpfo"]), "bpfi_db": num(race["bpfi"]),
            "decoys": int(dec.size),
-           "decoy_max_db": float(dec.max()) if dec.size else None, "decoy_threshold_db": None, "clear": False}
+           "decoy_max_score": float(dec.max()) if dec.size else None, "decoy_threshold_score": None, "clear": False}
     if dec.size < MIN_DECOYS or not np.isfinite(score):
         return out
     thr = float(max(dec.max(), dec.mean() + DECOY_SIGMAS * dec.std()))
     beats_races = all(not np.isfinite(v) or score > v for v in race.values())
-    out.update(decoy_threshold_db=thr, clear=bool(score > thr and beats_races))
+    out.update(decoy_threshold_score=thr, clear=bool(score > thr and beats_races))
     return out
 
 
@@ -112,7 +112,7 @@ def apply(verdict, routes, fault_hz, *, shaft_hz, factors, speed_status, toleran
     if not clear or race_named or speed_status in ("contradicted", "unresolved") or \
             verdict["verdict"] == "diagnosed":
         return verdict, humps
-    said = ", ".join(f"{n} {humps[n]['score_db']:.1f} dB (decoys up to {humps[n]['decoy_max_db']:.1f})"
+    said = ", ".join(f"{n} (hump score {humps[n]['score_db']:.1f}, decoys up to {humps[n]['decoy_max_score']:.1f})"
                      for n in clear)
     if len(clear) >= MIN_ROUTES:
         return dict(verdict, diagnosis="ball", verdict="diagnosed", decided_by=clear, candidates=["ball"], hump=True,

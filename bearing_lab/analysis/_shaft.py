@@ -354,7 +354,7 @@ def _corroborated(cs, geometry, f0, tolerance):
             continue
         for k in ("bpfo", "bpfi", "bsf"):
             if fams[k]["detected"]:
-                hits[k] = max(hits.get(k, 0.0), fams[k]["evidence_db"])
+                hits[k] = max(hits.get(k, 0.0), fams[k]["evidence_score"])
     return max(hits, key=hits.get) if hits else None
 
 

@@ -76,8 +76,8 @@ def _fault_families(res, out, notes) -> dict:
     A family's frequency only where a route of the analysis detects the family (noise rule and
     decoys): the best line of a slip window always exists in a dense spectrum, and comparing two
     such picks compares chance.  The routes that decided the diagnosis are asked first.  Returns,
-    per family, ``detected``, the ``route`` and ``evidence_margin_db`` (the best route's evidence
-    over its decoy threshold)."""
+    per family, ``detected``, the ``route`` and ``evidence_margin_score`` (the best route's evidence
+    score over its decoy threshold)."""
     ev = res.get("evidence", {})
     routes = ev.get("routes", {})
     order = [r for r in [*(ev.get("decided_by") or []), ev.get("reported_route")] + sorted(routes) if r in routes]
@@ -87,10 +87,10 @@ def _fault_families(res, out, notes) -> dict:
                       if routes[r]["families"][k]["detected"] and not routes[r]["families"][k]["explained_by"]),
                      None)
         fk = res["fault_frequencies"][k]
-        margins = [f["evidence_db"] - f["decoy_threshold_db"] for f in (routes[r]["families"][k] for r in routes)
-                   if f.get("decoy_threshold_db") is not None]
+        margins = [f["evidence_score"] - f["decoy_threshold_score"] for f in (routes[r]["families"][k] for r in routes)
+                   if f.get("decoy_threshold_score") is not None]
         families[k] = {"detected": found is not None, "route": None if found is None else found[0],
-                       "evidence_margin_db": max(margins) if margins else None}
+                       "evidence_margin_score": max(margins) if margins else None}
         out[k] = _num(found[1]["measured_hz"]) if found is not None else float("nan")
         if found is None:
             best = ("no line in the slip window" if fk["measured_hz"] is None else
@@ -129,7 +129,7 @@ def measure(x, fs, *, bearing, rpm=None, shaft_hz=None, fault=None, duration_lev
         ``analysis`` (the :func:`bearing_lab.analysis.analyze` result), ``band``,
         ``impact_times``, ``notes`` (why a value is NaN), ``fault``, ``shaft_hz_used``,
         ``families`` (per BPFO/BPFI: ``detected``, the ``route`` that detected it, and
-        ``evidence_margin_db``, the best route's evidence above its decoy threshold: how far the
+        ``evidence_margin_score``, the best route's evidence above its decoy threshold: how far the
         detection is from flipping).  BPFO and BPFI carry a value only where a route of the
         analysis *detects* the family; the best line of a slip window alone is no measurement.
 

@@ -38,8 +38,8 @@ import numpy as np
 
 from ..bearings import BearingGeometry, get_bearing
 from ..errors import AnalysisError, BearingLabError, check_choice
-from ._diagnosis import (coincidences, combine, deciding_route, interpretations, route_summary, run_routes,
-                         runner_up, spectrum_top)
+from ._diagnosis import (coincidences, combine, deciding_route, interpretations, line_stats, route_summary,
+                         run_routes, runner_up, spectrum_top)
 from ._families import LABELS, CyclicSpectrum
 from ._floor import band_rms, floor_in_units
 from ._hump import apply as apply_humps
@@ -157,8 +157,9 @@ def _evidence(res, verdict, speed, fs, n, tolerance, n_harmonics, decided):
     routes = res["routes"]
     lead, second, margin = runner_up(routes[decided])
     ff = res["fault_hz"]
+    fams = routes[decided]["families"]
     ev = {"candidates": verdict["candidates"], "secondary": verdict["secondary"], "runner_up": LABELS[second],
-          "margin_db": margin, "decided_by": verdict["decided_by"], "reason": verdict["reason"],
+          "margin_score": margin, "leader_lines": line_stats(fams[lead]), "runner_up_lines": line_stats(fams[second]), "decided_by": verdict["decided_by"], "reason": verdict["reason"],
           "band": {"low_hz": None if res["band"] is None else float(res["band"][0]),
                    "high_hz": None if res["band"] is None else float(res["band"][1]),
                    "spectral_kurtosis": float(res["spectral_kurtosis"]), "impulsive": bool(res["impulsive"])},
@@ -279,7 +280,8 @@ def _unresolved(speed, geom, fs, n, m, tolerance, n_harmonics):
     for k in ("bpfo", "bpfi", "bsf", "ftf"):
         result["fault_frequencies"][k] = {"expected_hz": float(ff[k]), "measured_hz": None, "snr_db": 0.0,
                                           "harmonics": 0, "sidebands": 0, "detected": False}
-    result["evidence"] = {"candidates": verdict["candidates"], "secondary": [], "runner_up": None, "margin_db": None,
+    result["evidence"] = {"candidates": verdict["candidates"], "secondary": [], "runner_up": None, "margin_score": None,
+                          "leader_lines": None, "runner_up_lines": None,
                           "decided_by": [], "reason": verdict["reason"], "band": None, "routes": {},
                           "flags": [], "interpretations": readings, "reported_route": None}
     extras = {"f": None, "ses": None, "band": None, "lines": None, "bearing": geom, "routes": {}, "route": None}

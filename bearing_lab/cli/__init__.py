@@ -5,6 +5,11 @@ Each sub-command lives in its own module in this package and exposes
 callable taking the parsed ``args`` and returning an exit status.  Errors that
 bearing_lab raises on purpose (:class:`bearing_lab.errors.BearingLabError`) are
 printed as one line on stderr with exit status 2.
+
+Conventions every command follows (docs/cli.md): ``-q/--quiet`` prints nothing but errors and
+warnings; ``--json`` (where a command prints results) prints them as strict JSON on stdout; an
+``-o`` file that exists is not overwritten without ``--force``; output cut short by a closed pipe
+(``bearing-lab data list | head``) ends quietly.
 """
 from __future__ import annotations
 
@@ -39,7 +44,11 @@ class _Parser(argparse.ArgumentParser):
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(
         prog="bearing-lab",
-        description="Rolling-bearing toolkit: import, simulate, analyse, validate.")
+        description="Rolling-bearing toolkit: import, simulate, analyse, validate.",
+        epilog="Every command: -q/--quiet prints nothing but errors and warnings; --json (where a command "
+               "prints results) prints them as JSON; an existing -o file is kept unless --force. Exit status: "
+               "0 done; 1 a result that fails (validate: a row fails unexplained; see its --help); 2 bad "
+               "input, said in one line on stderr.")
     from .. import __version__
     parser.add_argument("--version", action="version", version=f"bearing_lab {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
@@ -68,6 +77,11 @@ def main(argv=None) -> int:
         return 2
     try:
         return int(args.func(args) or 0)
+    except BrokenPipeError:  # the reader of our stdout went away (`| head`): stop quietly, as `cat` does
+        import os
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())  # so the interpreter's final flush does not fail again
+        return 141  # 128 + SIGPIPE, what the shell reports for a tool killed by the closed pipe
     except BearingLabError as exc:
         print(f"bearing-lab {args.command}: error: {exc}", file=sys.stderr)
         return 2

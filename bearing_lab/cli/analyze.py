@@ -47,6 +47,8 @@ def register(subparsers):
                         "(default: a channel named tacho, tach, keyphasor or once-per-rev)")
     p.add_argument("--pulses-per-rev", type=int, default=1, help="tacho pulses per revolution (default 1)")
     p.add_argument("--json", action="store_true", help="print the result as JSON (fields described in the analysis documentation, docs/analysis.md)")
+    p.add_argument("-q", "--quiet", action="store_true",
+                   help="print nothing but warnings and errors (--json and --plot still write their output)")
     p.add_argument("--plot", metavar="FILE.png", default=None,
                    help="also write a figure: waveform, spectrum, envelope spectrum with fault markers")
     p.set_defaults(func=run)
@@ -143,6 +145,25 @@ def _rpm(ds, value, path):
     return rpm, "given"
 
 
+_QUANTITY = {"Pa": "a sound pressure (a microphone)", "V": "a voltage (no sensor sensitivity applied)",
+             "m": "a displacement", "m s-1": "a velocity", "N": "a force", "rad s-1": "an angular speed"}
+
+
+def _not_an_acceleration(da, name, units) -> str:
+    """A warning when the channel analysed is not an acceleration ("" when it is, or says nothing)."""
+    if units in ("m s-2", "g", "m/s^2", "m/s2"):
+        return ""
+    what = _QUANTITY.get(str(units)) or (f"a quantity in {units!r}" if units not in (None, "", "1") else "")
+    quantity = da.attrs.get("quantity")
+    if quantity and quantity != "acceleration":
+        what = what or f"a {quantity}"
+    if not what:
+        return ""
+    return (f"channel {name!r} is {what}, not an acceleration: the fault frequencies and the diagnosis read "
+            f"the signal's periodicity, but the thresholds were set on accelerometer signals, and rms, peak and "
+            f"the band levels are in {units}, not vibration levels")
+
+
 def run(args) -> int:
     import numpy as np
 
@@ -172,6 +193,10 @@ def run(args) -> int:
             result = analyze(x, fs, **kw)
     if note:
         result["notes"] = [note]
+    not_acc = _not_an_acceleration(da, name, units)
+    if not_acc:
+        result.setdefault("notes", []).append(not_acc)
+        print(f"bearing-lab analyze: warning: {path.name} [{name}]: {not_acc}", file=sys.stderr)
     bad = [k for k, v in result.get("metrics", {}).items()
            if not isinstance(v, (int, float)) or not np.isfinite(v)]
     if bad:
@@ -181,6 +206,8 @@ def run(args) -> int:
     if args.json:
         from .._json import dumps
         print(dumps(result, indent=1))  # no NaN/Infinity tokens: strict parsers read it
+        return 0
+    if args.quiet:
         return 0
     _print(result, path, name, fs, bearing, units, tacho_name, note, args.plot)
     return 0
@@ -203,7 +230,12 @@ def _print(result, path, name, fs, bearing, units, tacho_name, note, plot):
     if ev.get("candidates") and result["verdict"] != "diagnosed":
         print(f"  candidates: {', '.join(ev['candidates'])}")
     if ev.get("runner_up"):
-        print(f"  runner-up: {ev['runner_up']} ({ev['margin_db']:.0f} dB less line evidence)")
+        a, b = ev.get("leader_lines") or {}, ev.get("runner_up_lines") or {}
+
+        def _lines(s):
+            return f"{s['n_lines']} at a mean {s['mean_line_snr_db']:.1f} dB" if s.get("n_lines") else "none"
+        print(f"  runner-up: {ev['runner_up']} (envelope-spectrum lines over the floor: {_lines(b)}; the "
+              f"leader's: {_lines(a)}; evidence score {ev['margin_score']:.0f} lower)")
     print(f"  why: {ev['reason']}")
     if ev.get("band") and ev["band"]["low_hz"] is not None:
         b = ev["band"]

@@ -13,6 +13,8 @@ def _bench(args) -> int:
                    scipy=not args.no_scipy,
                    scipy_duration=args.scipy_duration, rates=not args.no_rates,
                    rate_duration=args.rate_duration)
+    if args.quiet:
+        return 0
     print(summary_table(ds))
     if ds.attrs.get("rate_table_md"):
         print("\nAuto-rule study by output rate (auto_rate_study.csv):\n" + ds.attrs["rate_table_md"])
@@ -34,5 +36,5 @@ def register(sub) -> None:
     p.add_argument("--rate-duration", type=float, default=1.0, metavar="S",
                    help="simulated seconds per run of the auto-rule study at 20, 100 and 200 kHz output")
     p.add_argument("--no-rates", action="store_true", help="skip the auto-rule study by output rate")
-    p.add_argument("-q", "--quiet", action="store_true")
+    p.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors (the files are written)")
     p.set_defaults(func=_bench)

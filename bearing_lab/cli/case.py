@@ -27,21 +27,34 @@ def _cmd_new(args) -> int:
     from .._files import atomic_open
     with atomic_open(out, "w", encoding="utf-8") as fh:
         fh.write(text)
-    for line in text.splitlines():
-        if line.startswith("# NOTE: "):
-            print(f"bearing-lab case new: note: {line[len('# NOTE: '):]} (see {out})", file=sys.stderr)
-    print(f"{out}: starting case for {args.recording}; give the bearing, load and defect (see the comments), "
-          f"then run `bearing-lab validate {out}`")
+    notes = [line[len("# NOTE: "):] for line in text.splitlines() if line.startswith("# NOTE: ")]
+    if args.json:
+        from .._json import dumps
+        print(dumps({"case": str(out), "recording": args.recording, "notes": notes}, indent=1))
+        return 0
+    for note in notes:
+        print(f"bearing-lab case new: note: {note} (see {out})", file=sys.stderr)
+    if not args.quiet:
+        print(f"{out}: starting case for {args.recording}; give the bearing, load and defect (see the comments), "
+              f"then run `bearing-lab validate {out}`")
     return 0
 
 
 def _cmd_standin(args) -> int:
+    from ..io_netcdf import check_output_path
     from ..sim.scene import parse_set
     from ..validation.standin import make_standin_recording
+    check_output_path(args.output, force=args.force, suffixes=(".uff", ".mat"))
     s = make_standin_recording(args.output, scene=args.scene, overrides=parse_set(args.set), rpm=args.rpm,
                                duration=args.duration, fs=args.fs, jitter=args.jitter,
                                resonance_hz=args.resonance_hz, noise_g=args.noise_g, seed=args.seed)
     h = s.hidden
+    if args.json:
+        from .._json import dumps
+        print(dumps({"file": str(s.path), "hidden": h}, indent=1))
+        return 0
+    if args.quiet:
+        return 0
     print(f"{s.path}: {h['format']}, {h['duration_s']:g} s at {h['fs']:g} Hz; hidden: scene {h['scene']} "
           f"{' '.join(f'{k}={v}' for k, v in h['overrides'].items())}, {h['rpm']:g} r/min "
           f"(jitter {100 * h['jitter']:g} %), resonance {h['resonance_hz']:g} Hz, noise {h['noise_g']:g} g",
@@ -51,6 +64,9 @@ def _cmd_standin(args) -> int:
 
 def register(subparsers) -> None:
     p = subparsers.add_parser("case", help="validation cases: a starting case for a recording; stand-in recordings",
+                              epilog="Exit status: 0 the file is written; 2 bad input (one line on stderr), nothing "
+                                     "written. A case's verdict comes from `bearing-lab validate CASE.toml` (see its "
+                                     "--help: PASS, KNOWN LIMITATIONS, FAIL).",
                               description="Write a commented starting validation case from a recording (case new), "
                                           "or a stand-in recording with a hidden defect (case standin).")
     sub = p.add_subparsers(dest="case_command", metavar="ACTION")
@@ -63,6 +79,8 @@ def register(subparsers) -> None:
     n.add_argument("--channel", default=None, help="channel to compare (default: the file's default channel)")
     n.add_argument("--format", default=None, help="reader name (default: sniffed)")
     n.add_argument("--force", action="store_true", help="overwrite an existing case file")
+    n.add_argument("--json", action="store_true", help="print the case file written and the notes as JSON")
+    n.add_argument("-q", "--quiet", action="store_true", help="print nothing but the notes and errors")
     n.set_defaults(func=_cmd_new)
     s = sub.add_parser("standin", help="a recording with a hidden defect, jitter, a resonance, tones and noise")
     s.add_argument("scene", help="built-in scene or scene TOML with the hidden bearing, load and defect")
@@ -75,5 +93,8 @@ def register(subparsers) -> None:
     s.add_argument("--noise-g", type=float, default=0.05, help="white sensor noise RMS, g (default 0.05)")
     s.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     s.add_argument("-o", "--output", required=True, help="output file: .uff (UFF 58b) or .mat (Testlab export)")
+    s.add_argument("--force", action="store_true", help="overwrite an existing output file")
+    s.add_argument("--json", action="store_true", help="print the file and the hidden truth as JSON")
+    s.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors")
     s.set_defaults(func=_cmd_standin)
     p.set_defaults(func=lambda a: (p.print_help(), 2)[1])

@@ -50,6 +50,7 @@ def register(subparsers):
     p.add_argument("--json", action="store_true", help="print the result as JSON")
     p.add_argument("--mirror", default=None, metavar="DIR", help="directory holding public recordings")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors (the files are written)")
     p.set_defaults(func=run)
 
 
@@ -69,7 +70,7 @@ def run(args) -> int:
     n = 1
     for v in grid.values():
         n *= len(v)
-    if not args.json:
+    if not (args.json or args.quiet):
         lo, hi = (n, n) if args.no_refine else (n + REFINE_TYPICAL[0], n + REFINE_TYPICAL[1])
         sec = float(case.recording.duration_s)
         print(f"identify {case.name}: {n} scenes on the coarse grid"
@@ -77,12 +78,14 @@ def run(args) -> int:
               + f" of {sec:g} s each: about {SCENE_CPU_S[0] * lo * sec:.0f}-{SCENE_CPU_S[1] * hi * sec:.0f} s of CPU "
                 "(cached / new contact tables; measured at 20 kHz)", file=sys.stderr)
     res = identify(case, grid=grid, refine=not args.no_refine, scheduler="serial" if args.workers <= 1 else "local",
-                   n_workers=args.workers, progress=not args.no_progress, level_weight=args.amplitude_weight,
+                   n_workers=args.workers, progress=not (args.no_progress or args.quiet), level_weight=args.amplitude_weight,
                    mirror=args.mirror, cache_dir=args.cache or False)
     paths = write_identification(res, args.output, report=args.report)
     if args.json:
         from .._json import clean
         print(json.dumps(clean(res.to_dict()), allow_nan=False))
+        return 0
+    if args.quiet:
         return 0
     for p in res.parameters.values():
         print(p["statement"])

@@ -75,7 +75,7 @@ def _open(args, arrays_only=False):
 def _cmd_import(args) -> int:
     from ..io import get_warnings, to_netcdf
     from ..io_netcdf import check_output_path
-    check_output_path(args.output)  # before reading: a bad -o is said at once
+    check_output_path(args.output, force=args.force)  # before reading: a bad -o is said at once
     ds = _open(args)
     if args.rpm is not None:
         from ..errors import RecordingError
@@ -92,8 +92,12 @@ def _cmd_import(args) -> int:
         print(f"warning: {w}", file=sys.stderr)
     n = ds.sizes["time"]
     fs = ds.attrs["sampling_rate_hz"]
-    print(f"{args.output}: {len(ds.data_vars)} channel(s) {', '.join(ds.data_vars)}, {n} samples "
-          f"at {fs:g} Hz ({n / fs:.4g} s), reader {ds.attrs.get('reader') or 'netcdf (' + _kind(ds) + ')'}")
+    if args.json:
+        from .._json import dumps
+        print(dumps({**describe(ds, args.file), "output": args.output}, indent=1))
+    elif not args.quiet:
+        print(f"{args.output}: {len(ds.data_vars)} channel(s) {', '.join(ds.data_vars)}, {n} samples "
+              f"at {fs:g} Hz ({n / fs:.4g} s), reader {ds.attrs.get('reader') or 'netcdf (' + _kind(ds) + ')'}")
     return 0
 
 
@@ -166,6 +170,10 @@ def _fmt(v, spec="", none="-"):
 def _cmd_info(args) -> int:
     if args.formats:
         from ..io import list_engines
+        if args.json:
+            from .._json import dumps
+            print(dumps(list_engines(), indent=1))
+            return 0
         for name, desc in list_engines().items():
             print(f"{name:14s} {desc}")
         return 0
@@ -177,6 +185,8 @@ def _cmd_info(args) -> int:
     if args.json:
         from .._json import dumps
         print(dumps(d, indent=1))
+        return 0
+    if args.quiet:   # the file reads: exit status 0, nothing printed
         return 0
     print(f"file:      {d['file']}")
     what = d["reader"] if d["kind"] == "recording" else \
@@ -200,22 +210,54 @@ def _cmd_info(args) -> int:
 
 def _cmd_fetch(args) -> int:
     from .. import datasets
+    got = {}
     for name in args.names:
-        p = datasets.fetch(name, mirror=args.mirror, dest=args.dest, download=not args.no_download)
-        print(f"{name}: {p}")
+        got[name] = str(datasets.fetch(name, mirror=args.mirror, dest=args.dest, download=not args.no_download))
+        if not (args.quiet or args.json):
+            print(f"{name}: {got[name]}")
+    if args.json:
+        from .._json import dumps
+        print(dumps(got, indent=1))
+    return 0
+
+
+def _cmd_sample(args) -> int:
+    import shutil
+    from importlib import resources
+    from ..io_netcdf import check_output_path
+    out = check_output_path(args.output, force=args.force, suffixes=(".uff",))
+    src = resources.files("bearing_lab").joinpath("data", "sample_recording.uff")
+    with resources.as_file(src) as p:
+        shutil.copyfile(p, out)
+    if args.json:
+        from .._json import dumps
+        from ..validation.standin import SAMPLE
+        print(dumps({"file": str(out), **SAMPLE}, indent=1))
+    elif not args.quiet:
+        print(f"{out}: the sample recording (made by bearing_lab: a simulated 6308 with an outer-race defect, "
+              f"1 s at 12.8 kHz, stored in volts at 9.91 mV/g; import it with --sensitivity 9.91mV/g)")
     return 0
 
 
 def _cmd_list(args) -> int:
     from .. import datasets
+    rows = []
     for r in datasets.load_registry().values():
         if args.dataset and not r.dataset.startswith(args.dataset):
+            continue
+        if args.json or args.quiet:
+            rows.append({"name": r.name, "dataset": r.dataset, "sha256": r.sha256 or None, "defect": r.defect,
+                         "defect_size_in": r.defect_size_in, "defect_position": r.defect_position,
+                         "load_hp": r.load_hp, "rpm": r.rpm, "fs_hz": r.fs_hz})
             continue
         cond = ", ".join(x for x in (r.defect, f"{r.defect_size_in} in" if r.defect_size_in else "",
                                      r.defect_position, f"{r.load_hp:g} hp" if r.load_hp is not None
                                      else "", f"{r.rpm:g} rpm" if r.rpm else "",
                                      f"{r.fs_hz:g} Hz" if r.fs_hz else "") if x)
         print(f"{r.name:34s} {'sha256' if r.sha256 else 'no-hash':7s} {cond}")
+    if args.json:
+        from .._json import dumps
+        print(dumps(rows, indent=1))
     return 0
 
 
@@ -229,6 +271,9 @@ def register(subparsers) -> None:
     p.add_argument("--rpm", type=float, default=None,
                    help="shaft speed, r/min, stored in the output (validation cases read it with speed = \"file\")")
     p.add_argument("-o", "--output", required=True, help="output .nc file")
+    p.add_argument("--force", action="store_true", help="overwrite an existing output file")
+    p.add_argument("--json", action="store_true", help="print what was written (channels, rate, warnings) as JSON")
+    p.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors and the file's warnings")
     p.set_defaults(func=_cmd_import)
 
     p = subparsers.add_parser("info", help="channels, rate, duration, units and warnings of a recording")
@@ -236,17 +281,34 @@ def register(subparsers) -> None:
     _add_read_options(p)
     p.add_argument("--json", action="store_true", help="print JSON")
     p.add_argument("--formats", action="store_true", help="list the readers and exit")
+    p.add_argument("-q", "--quiet", action="store_true",
+                   help="print nothing: exit status 0 when the file reads, 2 (and the reason) when not")
     p.set_defaults(func=_cmd_info)
 
-    p = subparsers.add_parser("data", help="registered public recordings (fetch, list)")
+    p = subparsers.add_parser("data", help="registered public recordings (fetch, list) and the sample recording")
     sub = p.add_subparsers(dest="data_command", metavar="ACTION")
     f = sub.add_parser("fetch", help="copy (mirror) or download registered recordings, hash-checked")
     f.add_argument("names", nargs="+", metavar="NAME", help="registry name, e.g. cwru/130_OR007@6_0.mat")
     f.add_argument("--mirror", default=None, help="local mirror directory (default $BEARING_LAB_MIRROR)")
     f.add_argument("--dest", default=None, help="target directory (default data/cache or $BEARING_LAB_DATA)")
     f.add_argument("--no-download", action="store_true", help="never use the network")
+    f.add_argument("--json", action="store_true", help="print {name: path} as JSON")
+    f.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors")
     f.set_defaults(func=_cmd_fetch)
+    sm = sub.add_parser("sample", help="write the sample recording bearing_lab ships (a stand-in it made itself)",
+                        description="Copy the sample recording shipped with bearing_lab: a simulated 6308 with a "
+                                    "hidden 3 x 1 mm outer-race defect at 320 N and 1800 r/min (speed jitter, a "
+                                    "4.3 kHz housing resonance, machine tones, sensor noise), 1 s at 12.8 kHz, "
+                                    "stored as an accelerometer's voltage at 9.91 mV/g in UFF 58b. Made by "
+                                    "bearing_lab.validation.standin.make_sample_recording; no third-party data.")
+    sm.add_argument("-o", "--output", default="recording.uff", help="file to write (default recording.uff)")
+    sm.add_argument("--force", action="store_true", help="overwrite an existing file")
+    sm.add_argument("--json", action="store_true", help="print the file and how it was made as JSON")
+    sm.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors")
+    sm.set_defaults(func=_cmd_sample)
     ls = sub.add_parser("list", help="list the registry")
     ls.add_argument("--dataset", default=None, help="filter by dataset prefix (cwru, ims, mfpt, lms)")
+    ls.add_argument("--json", action="store_true", help="print the registry entries as JSON")
+    ls.add_argument("-q", "--quiet", action="store_true", help="print nothing (exit status 0: the registry reads)")
     ls.set_defaults(func=_cmd_list)
     p.set_defaults(func=lambda a: (p.print_help(), 2)[1])

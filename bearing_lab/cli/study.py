@@ -13,7 +13,14 @@ def _study(args) -> int:
     names = args.only or list(STUDIES)
     for n in names:
         check_choice(n, STUDIES, "--only")
-    table = run_paper_studies(args.output, progress=not args.quiet, studies=names)
+    table = run_paper_studies(args.output, progress=not (args.quiet or args.json), studies=names)
+    if args.json:
+        from .._json import dumps
+        print(dumps({"output": args.output, "rows": table.to_dataframe().reset_index().to_dict("records"),
+                     "total_wall_time_s": table.attrs["total_wall_time_s"]}, indent=1))
+        return 0
+    if args.quiet:
+        return 0
     for r in table.to_dataframe().itertuples():
         print(f"{r.study:7s} {r.label:12s} peak disp {r.peak_displacement*1e6:7.4f} µm  "
               f"peak acc {r.peak_acceleration/9.80665:7.2f} g  p-p {r.acceleration_peak_to_peak/9.80665:7.2f} g  "
@@ -28,5 +35,6 @@ def register(sub) -> None:
     p.add_argument("which", choices=["paper"], help="the study set")
     p.add_argument("-o", "--output", default="reports/studies", metavar="DIR")
     p.add_argument("--only", action="append", metavar="STUDY", help="size, offset, skew, speed or slot")
-    p.add_argument("-q", "--quiet", action="store_true")
+    p.add_argument("--json", action="store_true", help="print the study table as JSON")
+    p.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors (the files are written)")
     p.set_defaults(func=_study)

@@ -33,21 +33,27 @@ def _sweep(args) -> int:
     params = parse_params(args.param)
     overrides = parse_set(args.set)
     from ..io_netcdf import check_output_path
-    out = check_output_path(args.output)
+    out = check_output_path(args.output, force=args.force)
     cache = False if args.no_cache else args.cache_dir
     import warnings
     from ..sweeps import CacheWarning
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", CacheWarning)  # said below, in one line
         ds = sweep(args.scene, params, scheduler=args.scheduler, n_workers=args.workers,
-                   cache_dir=cache, progress=not args.quiet, duration=args.duration, fs=args.fs,
+                   cache_dir=cache, progress=not (args.quiet or args.json), duration=args.duration, fs=args.fs,
                    **overrides)
     from ..io_netcdf import write_netcdf
     write_netcdf(ds, out)
     dims = " x ".join(f"{d}={ds.sizes[d]}" for d in ds.attrs["sweep_dims"].split())
-    print(f"wrote {out}: {ds.attrs['sweep_n_scenes']} scenes ({dims}), {ds.attrs['sweep_computed']} computed, "
-          f"{ds.attrs['sweep_cache_hits']} from the cache, {ds.attrs['sweep_wall_time_s']:.1f} s; "
-          f"scheduler: {ds.attrs['sweep_scheduler']}", file=sys.stderr)
+    if args.json:
+        from .._json import dumps
+        print(dumps({"file": str(out), "dims": {d: ds.sizes[d] for d in ds.attrs["sweep_dims"].split()},
+                     **{k: ds.attrs[k] for k in ("sweep_n_scenes", "sweep_computed", "sweep_cache_hits",
+                                                 "sweep_wall_time_s", "sweep_scheduler")}}, indent=1))
+    elif not args.quiet:
+        print(f"wrote {out}: {ds.attrs['sweep_n_scenes']} scenes ({dims}), {ds.attrs['sweep_computed']} computed, "
+              f"{ds.attrs['sweep_cache_hits']} from the cache, {ds.attrs['sweep_wall_time_s']:.1f} s; "
+              f"scheduler: {ds.attrs['sweep_scheduler']}", file=sys.stderr)
     if ds.attrs.get("sweep_cache_rejected"):
         print(f"warning: {ds.attrs['sweep_cache_rejected']} damaged cache entries were computed "
               f"again: {ds.attrs['sweep_cache_rejected_entries']}", file=sys.stderr)
@@ -74,5 +80,7 @@ def register(sub) -> None:
                    help="scene cache (default $BEARING_LAB_CACHE or ~/.cache/bearing_lab/sweeps)")
     p.add_argument("--no-cache", action="store_true", help="neither read nor write the scene cache")
     p.add_argument("-o", "--output", required=True, metavar="OUT.nc")
-    p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--force", action="store_true", help="overwrite an existing OUT.nc")
+    p.add_argument("--json", action="store_true", help="print what was written as JSON (no progress bar)")
+    p.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors and warnings")
     p.set_defaults(func=_sweep)

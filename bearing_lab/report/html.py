@@ -10,7 +10,9 @@ from __future__ import annotations
 import base64
 import html
 import io
+import itertools
 import math
+import re
 from pathlib import Path
 from string import Template
 
@@ -66,6 +68,8 @@ def figure_html(fig, alt, caption="", dpi=80) -> str:
 
 
 def _cell(v) -> str:
+    if isinstance(v, bool):
+        return f'<td class="l">{"yes" if v else "no"}</td>'
     numeric = isinstance(v, (int, float)) and not isinstance(v, bool)
     return f'<td class="{"" if numeric else "l"}">{fmt(v) if numeric else esc("" if v is None else v)}</td>'
 
@@ -83,6 +87,15 @@ def table_html(rows: list, *, columns=None, intro="", row_class=None) -> str:
                                              rows=body)
 
 
+_LONG_REASON = 240          # characters of reason, limitation and note kept in the table cell
+_REASON_IDS = itertools.count(1)
+
+
+def _shorten(text, n=120) -> str:
+    text = str(text)
+    return text if len(text) <= n else text[:n].rsplit(" ", 1)[0] + " …"
+
+
 _STATUS = {"pass": ("pass", "pass"), "known limitation": ("known", "known limitation"), "fail": ("fail", "FAIL")}
 
 
@@ -94,7 +107,7 @@ def rows_table(rows: list, *, show_reference=False, show_paper=False, intro="") 
     if show_paper:
         head.append("paper's own simulation")
     head += ["difference %", "tolerance", "status", "signal / span", "reason, limitation, note"]
-    lines = []
+    lines, below = [], []
     for r in rows:
         status = r.get("status") or ("pass" if r.get("pass") else "fail")
         cls, label = _STATUS[status]
@@ -108,9 +121,16 @@ def rows_table(rows: list, *, show_reference=False, show_paper=False, intro="") 
             cells.append(f"<td>{fmt(r.get('paper_simulation'))}</td>")
         text = esc(r.get("reason", ""))
         if r.get("known_limitation") and not r.get("pass"):
-            text += f"<br><b>known limitation:</b> {esc(r['known_limitation'])}"
+            who = f" (declared by {esc(r['declared_by'])})" if r.get("declared_by") else ""
+            text += f"<br><b>known limitation{who}:</b> {esc(r['known_limitation'])}"
         if r.get("note"):
             text += f"<br><em>{esc(r['note'])}</em>"
+        plain = len(html.unescape(re.sub(r"<[^>]+>", "", text)))
+        if plain > _LONG_REASON:      # long reasons below the table, linked: rows stay a few lines tall
+            anchor = f"reason-{next(_REASON_IDS)}"
+            below.append(f'<li id="{anchor}"><b>{esc(r.get("label") or r["quantity"])}</b>: {text}</li>')
+            text = (esc(_shorten(r.get("reason", ""))) + f' <a href="#{anchor}">(full reason, limitation and note '
+                    f'below the table)</a>')
         cells += [f"<td>{fmt(r.get('difference_pct'), 3)}</td>", f"<td>{esc(r.get('tolerance', ''))}</td>",
                   f'<td class="status">{label}</td>',
                   f'<td class="l note">{esc(r.get("simulated_signal", ""))}<br>{esc(r.get("experiment_span", ""))}</td>',
@@ -119,26 +139,38 @@ def rows_table(rows: list, *, show_reference=False, show_paper=False, intro="") 
     return template("rows_table.html").substitute(
         intro=f"<p>{esc(intro)}</p>\n" if intro else "",
         head="".join(f'<th class="{"l" if h.startswith(("quantity", "reason")) else ""}">{esc(h)}</th>' for h in head),
-        rows="\n".join(lines))
+        rows="\n".join(lines)) + (f'<ol class="reasons note">{"".join(below)}</ol>' if below else "")
+
+
+_VERDICT_LABEL = {"pass": "PASS", "known limitations": "KNOWN LIMITATIONS", "fail": "FAIL", "skip": "skipped",
+                  "error": "error"}
+_VERDICT_CLASS = {"pass": "pass", "known limitations": "known", "fail": "fail", "skip": "skip", "error": "error"}
 
 
 def index_rows(entries: list) -> str:
+    """The index table's rows: per case its verdict in words, counts, and the failing rows by kind."""
     out = []
     for e in entries:
         st = e["status"]
+        verdict = e.get("verdict") or ({"pass": "pass"}.get(st) or ("fail" if st == "fail" else st))
         link = f'<a href="{esc(e["link"])}">{esc(e["case"])}</a>' if e.get("link") else esc(e["case"])
         what = esc(e.get("title", ""))
         if e.get("reason"):
             what += f'<br><span class="note">{esc(e["reason"])}</span>'
-        failing = ", ".join(esc(f) for f in e.get("failing", []))
-        known = ", ".join(esc(f) for f in e.get("known", []))
-        if known:
-            failing = (failing + " " if failing else "") + f"({known})"
+        parts = []
+        if e.get("failing"):
+            parts.append("<b>unexplained:</b> " + ", ".join(esc(f) for f in e["failing"]))
+        if e.get("known"):
+            who = ", ".join(e.get("declared_by") or []) or "the case"
+            parts.append(f"<b>declared limitations</b> (by {esc(who)}): " + ", ".join(esc(f) for f in e["known"]))
+        failing = "<br>".join(parts)
         wall = fmt(e.get("wall_time_s"), 3) if e.get("wall_time_s") is not None else "—"
         counts = f"{e.get('n_pass', 0)} / {e.get('n_rows', 0)}" if st in ("pass", "fail") else "—"
-        label = {"pass": "pass", "fail": "FAIL", "skip": "skipped", "error": "error"}[st]
-        out.append(template("index_row.html").substitute(status=st, link=link, what=what, label=label,
-                                                         counts=counts, wall=wall, failing=failing))
+        label = _VERDICT_LABEL[verdict]
+        if e.get("verdict_text") and st in ("pass", "fail"):
+            label += f'<br><span class="note">{esc(e["verdict_text"])}</span>'
+        out.append(template("index_row.html").substitute(status=_VERDICT_CLASS[verdict], link=link, what=what,
+                                                         label=label, counts=counts, wall=wall, failing=failing))
     return "\n".join(out)
 
 

@@ -113,15 +113,15 @@ class Report:
         return all(r.get("pass") for r in self.rows)
 
     def status(self) -> tuple:
-        """(css class, text) of the page's result badge."""
+        """(css class, text) of the page's result badge: the verdict in words."""
         if not self.rows:
             return "skip", "no rows"
         failing = [r for r in self.rows if not r.get("pass")]
         if not failing:
-            return "pass", "all rows pass"
+            return "pass", "PASS: every row agrees"
         if all(r.get("known_limitation") for r in failing):
-            return "fail", "rows fail, each a known model limitation"
-        return "fail", "rows fail"
+            return "known", "KNOWN LIMITATIONS: every failing row is a limitation the case declares"
+        return "fail", "FAIL: rows fail without a declared reason"
 
     def to_html(self) -> str:
         used: set = set()
@@ -136,7 +136,7 @@ class Report:
         return template("case.html").substitute(
             title=esc(self.title), subtitle=esc(self.subtitle), css=css(), toc=" ".join(toc),
             sections="\n".join(secs), n_pass=n_pass, n_rows=len(self.rows), status_class=cls, status_text=text,
-            known=f" ({n_known} failing as known model limitations)" if n_known else "", date=_now(),
+            known=f" ({n_known} failing as limitations the case declares)" if n_known else "", date=_now(),
             version=_version())
 
     def save(self, path, *, overwrite=True):
@@ -165,17 +165,19 @@ class Report:
         return r
 
 
-def write_index(path, entries: list, *, title="bearing_lab validation", notes=()):
+def write_index(path, entries: list, *, title="bearing_lab validation", notes=(), opening=""):
     """The page listing all cases.
 
     ``entries``: dicts with ``case``, ``title``, ``status`` ("pass", "fail", "skip", "error"),
     ``n_pass``, ``n_rows``, ``wall_time_s``, ``failing`` and ``known`` (row labels), ``link``
-    (relative, or None), ``reason`` (for skipped or errored cases).
+    (relative, or None), ``reason`` (for skipped or errored cases); optionally ``verdict``,
+    ``verdict_text`` and ``declared_by``.  ``opening``: HTML shown above the table.
     """
     from .._files import atomic_open
     notes_html = "".join(f'<p class="note">{esc(n)}</p>' for n in notes)
     page = template("index.html").substitute(title=esc(title), css=css(), date=_now(), version=_version(),
-                                              rows=index_rows(entries), notes=notes_html)
+                                              rows=index_rows(entries), notes=notes_html,
+                                              verdicts=opening)
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     with atomic_open(path, "w", encoding="utf-8") as fh:

@@ -145,6 +145,14 @@ class ValidationCase:
     reference_tolerances: dict = field(default_factory=dict)
     speed: object = "file"
 
+    @property
+    def author(self) -> str:
+        """Who wrote the case, and so declared its known limitations: the project (a shipped case)
+        or the author of a case file."""
+        if self.source.startswith("shipped case"):
+            return f"bearing_lab (shipped case {self.name})"
+        return f"the author of {self.source}"
+
     def section(self, key) -> dict:
         v = self.data.get(key)
         return dict(v) if isinstance(v, dict) else {}
@@ -337,4 +345,8 @@ def load_case(spec) -> ValidationCase:
                           data=raw, base_dir=base_dir, default=bool(raw.get("default", False)))
     from .case_checks import check_paper, check_recording
     (check_paper if kind == "paper" else check_recording)(case)
+    from dataclasses import replace
+    for attr in ("tolerances", "reference_tolerances"):
+        setattr(case, attr, {q: replace(t, declared_by=case.author) if t.known_limitation else t
+                             for q, t in getattr(case, attr).items()})
     return case

@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..compare import SIGNAL_COLORS
+
 G0 = 9.80665
 
 __all__ = ["waveforms", "spectra", "envelope_spectra", "structural_path", "psd_overlay", "paper_run"]
@@ -31,7 +33,7 @@ def waveforms(signals: dict, fs, *, recording_label, window_s=0.1, shift=0):
     for ax, k in zip(axes[1:], names):
         if k != "model":
             ax.plot(t[win], xe[win] / G0, lw=0.5, color="0.65", label="recording")
-        ax.plot(t[win], signals[k][win] / G0, lw=0.6, color="tab:blue" if k == "model" else "tab:red",
+        ax.plot(t[win], signals[k][win] / G0, lw=0.6, color=SIGNAL_COLORS.get(k, "tab:red"),
                 label="simulation")
         ax.set_title(titles[k], fontsize=10)
         ax.legend(loc="upper right", fontsize=8)
@@ -46,7 +48,7 @@ def spectra(signals: dict, fs):
     """Amplitude spectra: recording, and each simulated signal."""
     from ..analysis import amplitude_spectrum
     fig, (ax,) = _fig(h=3.6)
-    colors = {"experiment": "k", "model": "tab:blue", "path": "tab:orange", "path+background": "tab:red"}
+    colors = SIGNAL_COLORS
     for k, y in signals.items():
         y = np.nan_to_num(np.asarray(y, float))
         f, a = amplitude_spectrum(y - y.mean(), fs, window="hann")

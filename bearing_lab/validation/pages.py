@@ -4,6 +4,8 @@ Public API
 ----------
 write_case(case, result, out, *, wall) -> status   -- DIR/<case>/{index.html, comparison.nc, summary.json[, structural_path.json]}
 summary(case, result, wall) -> dict                -- the summary.json content
+verdict_html(rows, author) -> str                  -- a case page's opening: the verdict in words
+verdict_legend(entries) -> str                     -- the index page's opening: overall verdict, meanings, exit status
 MODEL_ASSUMPTIONS                                  -- the assumptions listed on every page
 """
 from __future__ import annotations
@@ -15,7 +17,7 @@ import numpy as np
 from ..report import Report
 from .rows import ROW_KEYS
 
-__all__ = ["write_case", "summary", "MODEL_ASSUMPTIONS", "clean"]
+__all__ = ["write_case", "summary", "verdict_html", "verdict_legend", "MODEL_ASSUMPTIONS", "clean"]
 
 #: what every simulated number assumes (docs/validation.md explains each)
 MODEL_ASSUMPTIONS = [
@@ -36,29 +38,83 @@ from .._json import clean  # noqa: E402  (NaN/inf -> null: one rule for every JS
 
 
 def summary(case, result, wall) -> dict:
+    from .rows import case_verdict
     rows = [{k: r.get(k) for k in ROW_KEYS} for r in result.rows]
     failing = [r for r in result.rows if not r["pass"]]
+    v = case_verdict(result.rows)
     return clean({"case": case.name, "rows": rows, "wall_time_s": wall, "title": case.title,
                   "status": "pass" if result.rows and not failing else "fail",
+                  "verdict": v["verdict"], "verdict_text": v["text"], "declared_by": case.author,
+                  "n_rows": v["n_rows"], "n_pass": v["n_pass"], "n_declared_limitations": v["n_declared"],
+                  "n_unexplained_failures": v["n_unexplained"],
                   "unexplained_failures": [r["quantity"] for r in failing if not r.get("known_limitation")],
                   "known_limitations": [r["quantity"] for r in failing if r.get("known_limitation")],
                   **result.extra})
 
 
-def _overview(report, rows):
-    failing = [r for r in rows if not r["pass"]]
-    unexplained = [r for r in failing if not r.get("known_limitation")]
-    known = [r for r in failing if r.get("known_limitation")]
-    if not failing:
-        report.add_notice("All rows pass.", "", level="good", title="Overview")
-        return
-    body = ""
+def verdict_html(rows, author) -> str:
+    """The verdict in words, first on a case page: unexplained failures, the limitations the case's
+    author declared (with the author's reason), the passes, and what the case expects."""
+    from ..report import esc, fmt
+    from .rows import VERDICTS, case_verdict
+    v = case_verdict(rows)
+    word = {"pass": "PASS", "known limitations": "KNOWN LIMITATIONS", "fail": "FAIL"}[v["verdict"]]
+    cls = {"pass": "good", "known limitations": "warn", "fail": "bad"}[v["verdict"]]
+    out = [f'<div class="notice {cls}"><b>{word}</b>: {esc(v["text"])}.<br>'
+           f'<span class="note">{esc(word)} means: {esc(VERDICTS[v["verdict"]])}.</span></div>']
+    unexplained = [r for r in rows if not r["pass"] and not r.get("known_limitation")]
+    declared = [r for r in rows if not r["pass"] and r.get("known_limitation")]
+    passing = [r for r in rows if r["pass"]]
+
+    def _nums(r):
+        return (f'simulation {fmt(r.get("simulation"))}, experiment {fmt(r.get("experiment"))} '
+                f'{esc(r.get("units", ""))}, tolerance {esc(r.get("tolerance", ""))}')
     if unexplained:
-        body += "Failing without a known reason: " + "; ".join(r["label"] for r in unexplained) + ". "
-    if known:
-        body += "Failing as known model limitations: " + "; ".join(r["label"] for r in known) + "."
-    report.add_notice(f"{len(failing)} of {len(rows)} rows fail.", body,
-                      level="bad" if unexplained else "warn", title="Overview")
+        out.append("<h3>Unexplained failures (a regression until fixed or explained)</h3><ul>"
+                   + "".join(f'<li><b>{esc(r.get("label") or r["quantity"])}</b>: {_nums(r)}'
+                             + (f'<br><span class="note">{esc(r["note"])}</span>' if r.get("note") else "")
+                             + "</li>" for r in unexplained) + "</ul>")
+    if declared:
+        who = sorted({r.get("declared_by") or author for r in declared})
+        out.append(f"<h3>Limitations declared by {esc(', '.join(who))}</h3>"
+                   "<p class=\"note\">The case file gives each of these rows a <code>known_limitation</code>: "
+                   "its author's reason why the model cannot reproduce the quantity. The row still fails; the "
+                   "reason is the author's statement, not a result of this run.</p><ul>"
+                   + "".join(f'<li><b>{esc(r.get("label") or r["quantity"])}</b> ({_nums(r)}): '
+                             f'{esc(r["known_limitation"])}</li>' for r in declared) + "</ul>")
+    if passing:
+        out.append("<h3>Passing</h3><p>" + esc(", ".join(r.get("label") or r["quantity"] for r in passing))
+                   + ".</p>")
+    n_lim = sum(bool(r.get("known_limitation")) for r in rows)
+    out.append(f'<p class="note">Expected result, as the case declares it: {n_lim} of {len(rows)} rows carry a '
+               f'declared limitation (allowed to fail with the stated reason); every other row is expected to '
+               f'pass. Declared by: {esc(author)}.</p>')
+    return "\n".join(out)
+
+
+def verdict_legend(entries: list) -> str:
+    """The index's opening: the overall verdict in words, then what each verdict and the exit status mean."""
+    from ..report import esc
+    from .rows import VERDICTS
+    from .runner import EXIT_STATUS
+    n_unexp = sum(len(e.get("failing") or []) for e in entries)
+    n_decl = sum(len(e.get("known") or []) for e in entries)
+    errors = [e["case"] for e in entries if e.get("status") == "error"]
+    if n_unexp or errors:
+        head = (f"<b>FAIL</b>: {n_unexp} row(s) fail without a declared reason"
+                + (f"; case(s) that could not run: {esc(', '.join(errors))}" if errors else "") + ".")
+        cls = "bad"
+    elif n_decl:
+        head, cls = f"<b>KNOWN LIMITATIONS</b>: no unexplained failure; {n_decl} row(s) fail as declared limitations.", "warn"
+    else:
+        head, cls = "<b>PASS</b>: every row of every case that ran agrees.", "good"
+    items = "".join(f"<li><b>{esc(k)}</b>: {esc(v)}</li>" for k, v in VERDICTS.items())
+    return (f'<div class="notice {cls}">{head}</div><p class="note">Verdicts:</p><ul class="note">{items}</ul>'
+            f'<p class="note">Exit status of <code>bearing-lab validate</code>: {esc(EXIT_STATUS)}.</p>')
+
+
+def _overview(report, rows, author):
+    report.add_html(verdict_html(rows, author), "Verdict")
 
 
 def _render_sections(report, sections):
@@ -98,7 +154,7 @@ def _compute_tables(report, result, wall):
 
 def build_report(case, result, wall) -> Report:
     report = Report(f"Validation: {case.name}", subtitle=case.title)
-    _overview(report, result.rows)
+    _overview(report, result.rows, case.author)
     _render_sections(report, result.sections)
     # the page counts the case's rows, as summary.json, the index and the terminal do (a rows table shown
     # twice, e.g. the healthy rows in their own section, is not counted twice)

@@ -114,11 +114,12 @@ def _notes(q, sim_m, exp_m) -> str:
     for who, m in (("simulation", sim_m), ("recording", exp_m)):
         if q.measured in m["extras"]["notes"]:
             parts.append(f"{who}: " + m["extras"]["notes"][q.measured])
-    margins = [(who, m["extras"].get("families", {}).get(q.measured, {}).get("evidence_margin_db"))
+    margins = [(who, m["extras"].get("families", {}).get(q.measured, {}).get("evidence_margin_score"))
                for who, m in (("simulation", sim_m), ("recording", exp_m))]
     if any(v is not None for _, v in margins):
-        parts.append("family evidence over the decoy threshold: " + ", ".join(
-            f"{who} {v:+.1f} dB" for who, v in margins if v is not None))
+        parts.append("family evidence score over the decoy threshold (a sum of line-to-floor ratios in dB over "
+                     "the family's lines: a score, not a level): " + ", ".join(
+                         f"{who} {v:+.1f}" for who, v in margins if v is not None))
     return "; ".join(parts)
 
 

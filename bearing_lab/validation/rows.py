@@ -9,10 +9,12 @@ whether it is a known model limitation (with the reason given in the case) or no
 
 Public API
 ----------
-Tolerance(kind, value, reason, known_limitation="") -- "pct" (|sim - exp| <= value % of |exp|) or
+Tolerance(kind, value, reason, known_limitation="", declared_by="") -- "pct" (|sim - exp| <= value % of |exp|) or
                                                        "factor" (1/value <= sim/exp <= value)
 make_row(quantity, simulation, experiment, tolerance, ...) -> dict
 row_status(row) -> "pass" | "known limitation" | "fail"
+case_verdict(rows) -> dict                          -- a case's verdict in words and its three counts
+VERDICTS                                            -- verdict -> what it means (CLI, pages, docs)
 ROW_KEYS                                            -- the keys every row has (summary.json, netCDF)
 """
 from __future__ import annotations
@@ -22,14 +24,26 @@ from dataclasses import dataclass
 
 from ..errors import ValidationCaseError, check_choice
 
-__all__ = ["Tolerance", "make_row", "row_status", "ROW_KEYS", "TOLERANCE_KINDS"]
+__all__ = ["Tolerance", "make_row", "row_status", "case_verdict", "VERDICTS", "ROW_KEYS", "TOLERANCE_KINDS"]
 
 TOLERANCE_KINDS = ("pct", "factor")
 
 #: keys of a row, in table order
 ROW_KEYS = ("quantity", "label", "units", "simulation", "experiment", "reference_value", "reference_label",
             "difference", "difference_pct", "tolerance_pct", "tolerance", "rule", "pass", "status", "reason",
-            "known_limitation", "note", "simulated_signal", "experiment_span", "independent", "paper_simulation")
+            "known_limitation", "declared_by", "note", "simulated_signal", "experiment_span", "independent",
+            "paper_simulation")
+
+#: a case's verdict -> what it means (the same words on the terminal, the pages and in summary.json)
+VERDICTS = {
+    "pass": "every row agrees within its tolerance",
+    "known limitations": "rows fail, and each is a limitation the case's author declared, with a reason "
+                         "(known_limitation in the case file); no row fails unexplained",
+    "fail": "at least one row fails without a declared reason: an unexplained failure, to be treated as a "
+            "regression until it is fixed or explained",
+    "error": "the case could not run (the reason is given)",
+    "skip": "the case needs a recording that is not available",
+}
 
 
 @dataclass(frozen=True)
@@ -44,6 +58,7 @@ class Tolerance:
     value: float
     reason: str
     known_limitation: str = ""
+    declared_by: str = ""     # who declared the limitation: the shipped case (the project) or a case file's author
 
     def __post_init__(self):
         check_choice(self.kind, TOLERANCE_KINDS, "tolerance kind", ValidationCaseError)
@@ -91,6 +106,27 @@ def row_status(row: dict) -> str:
     return "known limitation" if row.get("known_limitation") else "fail"
 
 
+def case_verdict(rows: list) -> dict:
+    """A case's verdict from its rows: ``verdict`` (a key of :data:`VERDICTS`), the counts
+    ``n_rows``, ``n_pass``, ``n_declared`` (failing as declared limitations) and ``n_unexplained``,
+    the failing row labels of each kind, and ``text`` (one sentence)."""
+    unexplained = [r for r in rows if not r["pass"] and not r.get("known_limitation")]
+    declared = [r for r in rows if not r["pass"] and r.get("known_limitation")]
+    n_pass = len(rows) - len(unexplained) - len(declared)
+    verdict = "fail" if unexplained or not rows else "known limitations" if declared else "pass"
+    parts = [f"{n_pass} of {len(rows)} rows pass"]
+    if declared:
+        parts.append(f"{len(declared)} fail{'s' if len(declared) == 1 else ''} as limitation"
+                     f"{'s' if len(declared) > 1 else ''} the case declares")
+    if unexplained:
+        parts.append(f"{len(unexplained)} fail{'s' if len(unexplained) == 1 else ''} unexplained")
+    if not rows:
+        parts = ["no rows"]
+    return {"verdict": verdict, "n_rows": len(rows), "n_pass": n_pass, "n_declared": len(declared),
+            "n_unexplained": len(unexplained), "declared": [r.get("label") or r["quantity"] for r in declared],
+            "unexplained": [r.get("label") or r["quantity"] for r in unexplained], "text": ", ".join(parts)}
+
+
 def make_row(quantity: str, simulation, experiment, tolerance: Tolerance, *, label, units, note="",
              reference_value=None, reference_label="", signal="", span="", independent=True,
              paper_simulation=None, untrusted="", absence_agrees=False) -> dict:
@@ -120,7 +156,8 @@ def make_row(quantity: str, simulation, experiment, tolerance: Tolerance, *, lab
            "reference_value": _f(reference_value), "reference_label": reference_label,
            "difference": diff, "difference_pct": pct, "tolerance_pct": tolerance.pct,
            "tolerance": tolerance.text(), "rule": tolerance.kind, "pass": bool(ok), "reason": tolerance.reason,
-           "known_limitation": tolerance.known_limitation, "note": "; ".join(notes), "simulated_signal": signal,
+           "known_limitation": tolerance.known_limitation,
+           "declared_by": tolerance.declared_by if tolerance.known_limitation else "", "note": "; ".join(notes), "simulated_signal": signal,
            "experiment_span": span, "independent": bool(independent), "paper_simulation": _f(paper_simulation)}
     row["status"] = row_status(row)
     return row

@@ -7,6 +7,8 @@ check_case(case, mirror=None)                -- raise ValidationCaseError if a r
 default_set(mirror=None) -> (cases, skipped) -- the shipped cases marked default (skipped: recordings missing)
 run_case(case, out_dir, *, progress, mirror) -> CaseOutcome
 run_validation(specs, out_dir, *, strict, progress, mirror) -> (outcomes, exit status)
+exit_status(outcomes, strict=False) -> 0 | 1                 -- what `bearing-lab validate` returns
+EXIT_STATUS                                                   -- its meaning, as --help and the docs say it
 """
 from __future__ import annotations
 
@@ -19,7 +21,22 @@ from pathlib import Path
 from ..errors import BearingLabError, ValidationCaseError
 from .case import DEFAULT_CASE, load_case, shipped_cases
 
-__all__ = ["CaseOutcome", "check_case", "default_set", "run_case", "run_validation"]
+__all__ = ["CaseOutcome", "check_case", "default_set", "run_case", "run_validation", "exit_status", "EXIT_STATUS"]
+
+#: the exit status of ``bearing-lab validate`` (its --help, the index page and docs/validation.md say this)
+EXIT_STATUS = ("0: every case ran and no row fails unexplained (each failing row is a limitation its case "
+               "declares); 1: a row fails without a declared reason (an unexplained failure) or a case could "
+               "not run, and with --strict also when a declared limitation fails; 2: bad input (an unknown "
+               "case, an invalid case file, a missing recording of a named case), nothing run")
+
+
+def exit_status(outcomes, strict=False) -> int:
+    """1 when a case errored or has an unexplained failure (with ``strict``: any failing row), else 0."""
+    for o in outcomes:
+        v = o.verdict
+        if v["verdict"] in ("error", "fail") or (strict and v["verdict"] == "known limitations"):
+            return 1
+    return 0
 
 
 class _Steps:
@@ -55,6 +72,15 @@ class CaseOutcome:
     @property
     def n_pass(self):
         return sum(bool(r["pass"]) for r in self.rows)
+
+    @property
+    def verdict(self) -> dict:
+        """:func:`~bearing_lab.validation.rows.case_verdict` of the rows ("error"/"skip" when it did not run)."""
+        from .rows import case_verdict
+        v = case_verdict(self.rows)
+        if self.status in ("error", "skip"):
+            v.update(verdict=self.status, text=self.reason)
+        return v
 
 
 def check_case(case, mirror=None) -> None:
@@ -113,7 +139,10 @@ def _load_named(specs, mirror):
 
 def _index_entry(oc) -> dict:
     failing = [r for r in oc.rows if not r["pass"]]
+    v = oc.verdict
     return {"case": oc.name, "title": oc.title, "status": oc.status, "n_pass": oc.n_pass, "n_rows": len(oc.rows),
+            "verdict": v["verdict"], "verdict_text": v["text"],
+            "declared_by": sorted({r.get("declared_by", "") for r in failing if r.get("known_limitation")} - {""}),
             "wall_time_s": oc.wall_time_s, "failing": [r["label"] for r in failing if not r.get("known_limitation")],
             "known": [r["label"] for r in failing if r.get("known_limitation")],
             "link": f"{oc.name}/index.html" if oc.status in ("pass", "fail") else None, "reason": oc.reason}
@@ -134,8 +163,9 @@ def run_validation(specs=None, out_dir="reports", *, strict=False, progress=True
 
     Bad input (an unknown case, an invalid file, a missing recording of a named case) raises
     ValidationCaseError before anything runs.  A case that fails while running is listed as an
-    error in the index and the others still run.  Returns (outcomes, exit status): 0, or 1 with
-    ``strict`` when a row fails or a case errors.
+    error in the index and the others still run.  Returns (outcomes, exit status): see
+    :func:`exit_status` (1 when a row fails unexplained or a case errors; with ``strict`` also when a
+    declared limitation fails).
     """
     from ..report import write_index
     out_dir = Path(out_dir)
@@ -166,6 +196,6 @@ def run_validation(specs=None, out_dir="reports", *, strict=False, progress=True
         bar.close()
     entries = [_index_entry(o) for o in outcomes]
     entries += [{"case": n, "title": t, "status": "skip", "reason": r, "link": None} for n, t, r in skipped]
-    write_index(out_dir / "index.html", entries, notes=notes)
-    bad = any(o.status in ("fail", "error") for o in outcomes)
-    return outcomes, (1 if strict and bad else 0)
+    from .pages import verdict_legend
+    write_index(out_dir / "index.html", entries, notes=notes, opening=verdict_legend(entries))
+    return outcomes, exit_status(outcomes, strict)

@@ -164,3 +164,35 @@ def _write(path, ds, x, fs, channel):
         raise RecordingError(f"{path}: cannot write ({exc})") from None
     except BearingLabError:
         raise
+
+
+#: the sample recording shipped as package data (``bearing-lab data sample``): how it is made
+SAMPLE = {"scene": "paper-O2", "overrides": {"load.radial_n": 320.0}, "rpm": 1800.0, "duration": 1.0,
+          "fs": 12800.0, "seed": 7, "sensitivity_v_per_g": 9.91e-3, "channel": "Acc"}
+
+
+def make_sample_recording(path) -> Path:
+    """Write the project's sample recording: a 1 s stand-in (6308, hidden 3 x 1 mm outer-race defect,
+    320 N, 1800 r/min with jitter, a 4.3 kHz resonance, tones, noise) stored as an IEPE accelerometer's
+    voltage at 9.91 mV/g in UFF 58b, as a rig's front end would record it.  The file shipped as
+    ``bearing_lab/data/sample_recording.uff`` is this function's output (a test regenerates it)."""
+    import tempfile
+
+    import xarray as xr
+    from .._files import atomic_path
+    from ..io import to_uff58b
+    s = SAMPLE
+    with tempfile.TemporaryDirectory() as tmp:
+        st = make_standin_recording(Path(tmp) / "a.uff", scene=s["scene"], overrides=s["overrides"], rpm=s["rpm"],
+                                    duration=s["duration"], fs=s["fs"], seed=s["seed"], channel=s["channel"])
+    x = np.asarray(st.dataset[s["channel"]].values, float)
+    volts = x / G0 * s["sensitivity_v_per_g"]
+    ds = xr.Dataset({s["channel"]: ("time", volts, {"units": "V", "quantity": "voltage", "original_units": "V",
+                                                  "long_name": "accelerometer output, 9.91 mV/g (sample)"})},
+                    coords={"time": st.dataset["time"]},
+                    attrs={"sampling_rate_hz": s["fs"], "source_file": "bearing_lab sample recording"})
+    path = Path(path)
+    with atomic_path(path) as t:
+        to_uff58b(ds, t, channels=[s["channel"]], id1="bearing_lab sample: 6308 stand-in, 9.91 mV/g",
+                  id2="made by bearing_lab.validation.standin.make_sample_recording", id4="1800 r/min")
+    return path

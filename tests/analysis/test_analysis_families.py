@@ -42,7 +42,7 @@ def test_outer_race_family_detected_and_located():
     assert v["verdict"] == "outer_race"
     assert fams["bpfo"]["detected"] and fams["bpfo"]["harmonics"] >= 4
     assert fams["bpfo"]["measured_hz"] == pytest.approx(bpfo, rel=2e-3)
-    assert fams["bpfo"]["evidence_db"] > fams["bpfo"]["decoy_max_db"]
+    assert fams["bpfo"]["evidence_score"] > fams["bpfo"]["decoy_max_score"]
     assert not fams["bpfi"]["detected"]
 
 
@@ -146,4 +146,4 @@ def test_measure_names_a_family_frequency_only_where_the_family_is_detected():
     assert abs(m["bpfo"] / ff["bpfo"] - 1) < 0.01
     assert np.isnan(m["bpfi"]) and not m["extras"]["families"]["bpfi"]["detected"]
     assert "below the detection rule" in m["extras"]["notes"]["bpfi"]
-    assert m["extras"]["families"]["bpfo"]["detected"] and m["extras"]["families"]["bpfo"]["evidence_margin_db"] > 0
+    assert m["extras"]["families"]["bpfo"]["detected"] and m["extras"]["families"]["bpfo"]["evidence_margin_score"] > 0

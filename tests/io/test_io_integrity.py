@@ -204,7 +204,7 @@ def test_two_writers_of_one_output_both_leave_a_whole_file(datafile, tmp_path):
     """Two imports to the same -o at once: each succeeds and the file that stays is whole."""
     out = tmp_path / "same.nc"
     cmd = [sys.executable, "-m", "bearing_lab", "import", str(datafile("cwru/130_OR007@6_0.mat")),
-           "-o", str(out)]
+           "-o", str(out), "--force"]
     procs = [subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE) for _ in range(2)]
     codes = [p.wait(120) for p in procs]
     assert codes == [0, 0]

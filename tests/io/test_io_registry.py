@@ -46,9 +46,13 @@ def test_fetch_missing_without_network(tmp_path, monkeypatch):
     monkeypatch.setattr(pooch, "retrieve", boom)
     with pytest.raises(RecordingError, match="download from https://engineering.case.edu.* failed"):
         datasets.fetch("cwru/131_OR007@6_1.mat", mirror=tmp_path, dest=tmp_path / "d")
-    with pytest.raises(RecordingError, match="not in mirror"):
+    with pytest.raises(RecordingError, match="is not in the mirror"):
         datasets.fetch("cwru/131_OR007@6_1.mat", mirror=tmp_path, dest=tmp_path / "d",
                        download=False)
+    monkeypatch.delenv("BEARING_LAB_MIRROR", raising=False)
+    with pytest.raises(RecordingError) as info:
+        datasets.fetch("cwru/131_OR007@6_1.mat", dest=tmp_path / "d", download=False)
+    assert "is not cached and no mirror is set" in str(info.value) and "no mirror (" not in str(info.value)
     with pytest.raises(RecordingError, match="no registered recording 'nope.mat'"):
         datasets.fetch("nope.mat")
 

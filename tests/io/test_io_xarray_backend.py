@@ -38,3 +38,24 @@ def test_bad_file_one_error(tmp_path):
     bad.write_bytes(b"    -1\n    58\n garbage\n")
     with pytest.raises(RecordingError, match="bad.uff"):
         xr.open_dataset(bad, engine="bearing_lab")
+
+
+def test_every_reader_keyword_passes_through():
+    from bearing_lab.io import ENGINES
+    from bearing_lab.io.xarray_backend import READER_OPTIONS
+    names = set().union(*(e().option_names() for e in ENGINES.values()))
+    assert names == set(READER_OPTIONS)
+
+
+def test_allow_truncated_as_the_error_message_says(tmp_path, datafile):
+    """A truncated UFF is refused with 'pass allow_truncated=True', and that keyword then works."""
+    src = datafile("lms/binary8byte_g.uff").read_bytes()
+    cut = tmp_path / "cut.uff"
+    cut.write_bytes(src[: len(src) - 200])
+    with pytest.raises(RecordingError, match="allow_truncated=True"):
+        xr.open_dataset(cut, engine="bearing_lab")
+    ds = xr.open_dataset(cut, engine="bearing_lab", allow_truncated=True)
+    from bearing_lab.io import get_warnings
+    assert ds.sizes["time"] > 0 and any("truncat" in w for w in get_warnings(ds)), get_warnings(ds)
+    with pytest.raises(RecordingError, match="takes no keyword 'nope'"):
+        xr.open_dataset(cut, engine="bearing_lab", nope=1)

@@ -1,5 +1,7 @@
 """The report layer: sections from templates, self-contained HTML, JSON round trip, provenance and
 citation as report methods, the index with known limitations apart, atomic writes."""
+import re
+
 import numpy as np
 from matplotlib.figure import Figure
 
@@ -29,7 +31,7 @@ def test_report_html_is_self_contained_and_round_trips(tmp_path):
     assert html.count("data:image/png;base64,") == 1
     assert "a &lt;test&gt; case" in html and "a &lt;b&gt; notice" in html
     assert "<link" not in html and "<script" not in html
-    assert "1 of 3 rows pass" in html and "1 failing as known model limitations" in html
+    assert "1 of 3 rows pass" in html and "1 failing as limitations the case declares" in html
     assert "FAIL" in html and "known limitation" in html
     # provenance is a report method: the software versions, revision, host and date come with it
     assert "numpy" in r.info["versions"] and r.info["date"] and "host" in r.info
@@ -53,4 +55,27 @@ def test_rows_table_and_index(tmp_path):
         notes=["mirror missing"])
     html = p.read_text()
     assert 'href="paper/index.html"' in html and "skipped" in html and "mirror missing" in html
-    assert "recording not found" in html and "speed unresolved" in html and "(slot: peak)" in html
+    assert "recording not found" in html and "speed unresolved" in html
+    assert "<b>unexplained:</b> healthy: BPFI" in html and "<b>declared limitations</b> (by the case): slot: peak" in html
+
+
+def test_report_cosmetics_booleans_long_reasons_and_trace_colours():
+    """A True/False cell reads yes/no; a long reason goes below the table, linked; no compared signal
+    is drawn in a fault marker's colour (BPFO red, BPFI green)."""
+    from bearing_lab.compare import SIGNAL_COLORS
+    from bearing_lab.report import rows_table, table_html
+    from bearing_lab.validation.rows import Tolerance, make_row
+    html = table_html([{"study": "size", "agrees": True}, {"study": "skew", "agrees": False}])
+    assert ">yes<" in html and ">no<" in html and "True" not in html and "False" not in html
+    long = "the impacts ring on between them " * 30
+    rows = [make_row("kurtosis", 15.0, 7.0, Tolerance("factor", 2.0, "short reason", known_limitation=long,
+                                                      declared_by="bearing_lab (shipped case x)"),
+                     label="kurtosis", units="1"),
+            make_row("rms", 1.0, 1.0, Tolerance("factor", 2.0, "a short one"), label="rms", units="m s-2")]
+    t = rows_table(rows)
+    table, below = t.split("</table>")
+    assert long.strip()[:60] not in table and "(full reason, limitation and note below the table)" in table
+    assert long.strip()[:60] in below and "declared by bearing_lab (shipped case x)" in below
+    anchor = re.search(r'href="#(reason-\d+)"', table).group(1)
+    assert f'id="{anchor}"' in below and "a short one" in table
+    assert not {SIGNAL_COLORS[k] for k in ("model", "path", "path+background")} & {"tab:red", "tab:green"}

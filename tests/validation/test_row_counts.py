@@ -35,24 +35,29 @@ kurtosis = {}
 '''
 
 
-def test_terminal_index_page_and_summary_count_the_same_rows(tmp_path, capsys):
+def test_terminal_json_index_page_and_summary_count_the_same_rows(tmp_path, capsys):
     from bearing_lab.validation import make_standin_recording
     make_standin_recording(tmp_path / "rig.uff", duration=1.0, overrides={"load.radial_n": 320})
     make_standin_recording(tmp_path / "healthy.uff", scene="paper-healthy", duration=1.0, seed=1)
     (tmp_path / "rig.toml").write_text(CASE)
     out = tmp_path / "out"
-    main(["validate", str(tmp_path / "rig.toml"), "-o", str(out), "--no-progress"])
-    term = re.search(r"rig\s+\w+\s+(\d+)/(\d+) rows pass", capsys.readouterr().out)
+    status = main(["validate", str(tmp_path / "rig.toml"), "-o", str(out), "--no-progress"])
+    term = re.search(r"rig\s+(PASS|KNOWN LIMITATIONS|FAIL)\s+(\d+)/(\d+) rows pass", capsys.readouterr().out)
     s = json.loads((out / "rig" / "summary.json").read_text())
+    assert term.group(1).lower() == s["verdict"] and status == (1 if s["verdict"] == "fail" else 0)
+    assert main(["validate", str(tmp_path / "rig.toml"), "-o", str(out), "--json"]) == status
+    js = json.loads(capsys.readouterr().out)["cases"][0]
     n_rows, n_pass = len(s["rows"]), sum(bool(r["pass"]) for r in s["rows"])
     assert any(r["quantity"].startswith("healthy:") for r in s["rows"])      # the rows shown in two tables
-    assert (int(term.group(1)), int(term.group(2))) == (n_pass, n_rows)
+    assert (int(term.group(2)), int(term.group(3))) == (n_pass, n_rows)
+    assert (js["n_pass"], js["n_rows"], js["verdict"]) == (n_pass, n_rows, s["verdict"])
+    assert (s["n_pass"], s["n_rows"]) == (n_pass, n_rows)
     page = (out / "rig" / "index.html").read_text()
     assert re.search(rf"\b{n_pass} of {n_rows} rows pass", page)
-    fail = re.search(r"(\d+) of (\d+) rows fail", page)
-    if fail:
-        assert (int(fail.group(1)), int(fail.group(2))) == (n_rows - n_pass, n_rows)
-    else:
-        assert n_pass == n_rows
+    # the verdict sentence at the top of the page: its failing counts add up to the rest
+    declared = re.search(r"(\d+) fails? as limitations? the case declares", page)
+    unexplained = re.search(r"(\d+) fails? unexplained", page)
+    assert sum(int(m.group(1)) for m in (declared, unexplained) if m) == n_rows - n_pass
+    assert (int(unexplained.group(1)) if unexplained else 0) == s["n_unexplained_failures"]
     index = (out / "index.html").read_text()
     assert f"{n_pass} / {n_rows}" in index
