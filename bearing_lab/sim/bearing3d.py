@@ -88,8 +88,17 @@ def _ball_multibody(u_i, z_i, u_o, z_o, fc, pd4, a_i, a_o, k_in, k_out, e, guess
         tot = max(ln - a_i - a_o, 0.0)
         share = 1.0 / (1.0 + (k_out / k_in) ** (1.0 / e))
         guess = co + (ci - co) / ln * (a_o + tot * share)
+        if tot * share < (max(fc, 0.0) / k_out) ** (1.0 / e):
+            # a ball the rings do not squeeze: its centrifugal force holds it on the outer race
+            guess = co + (guess - co) / max(float(np.hypot(*(guess - co))), 1e-30) * (
+                a_o + (max(fc, 0.0) / k_out) ** (1.0 / e))
     sol = root(res, np.asarray(guess) * 1e6, method="hybr", options={"xtol": 1e-13})
-    return sol.x * 1e-6, parts(sol.x * 1e-6)
+    x = sol.x
+    if max(abs(v) for v in res(x)) > 1e-11:
+        sol = root(res, x, method="lm", options={"xtol": 1e-15, "ftol": 1e-15})
+        if max(abs(v) for v in res(sol.x)) < max(abs(v) for v in res(x)):
+            x = sol.x
+    return x * 1e-6, parts(x * 1e-6)
 
 
 def ball_forces(e_vec, phis, *, k_in, k_out, pd, a_i, a_o, exponent, ball_mass, omega_cage, g, pitch_radius,
@@ -173,30 +182,54 @@ def static_equilibrium_3d(scene, phi_c0, k_in, k_out, *, ball_mass=0.0, omega_ca
     def forces(e):
         return ball_forces(e, phis, **kw)
 
-    if path == "bearing":
-        def resid(e):
-            fi, fo = forces(e)[:2]
-            return ((fo + f_out) if on_outer else (fi + f_in)) / max(float(np.linalg.norm(load)), 1.0)
-    else:
-        def resid(e):
-            fi, fo = forces(e)[:2]
-            xi, xo = (fi + f_in) / ks, (fo + f_out) / km
-            return (xi - xo - e) / scale
+    ax_unit = np.array([0.0, 0.0, 1.0])
+
+    def make_resid(frac):
+        # the residual with the axial load scaled by frac (a continuation from the radial solution)
+        fi_ext, fo_ext = f_in - (1 - frac) * (0.0 if on_outer else axial) * ax_unit, \
+            f_out - (1 - frac) * (axial if on_outer else 0.0) * ax_unit
+        if path == "bearing":
+            def resid(e):
+                fi, fo = forces(e)[:2]
+                return ((fo + fo_ext) if on_outer else (fi + fi_ext)) / max(float(np.linalg.norm(load)), 1.0)
+        else:
+            def resid(e):
+                fi, fo = forces(e)[:2]
+                xi, xo = (fi + fi_ext) / ks, (fo + fo_ext) / km
+                return (xi - xo - e) / scale
+        return resid
+
+    def solve(resid, starts, unit):
+        best = None
+        for start in starts:
+            for method, opts in (("hybr", {"xtol": 1e-15}), ("lm", {"xtol": 1e-15, "ftol": 1e-15})):
+                sol = root(lambda x: resid(x * unit), start / unit, method=method, options=opts)
+                r = np.max(np.abs(resid(sol.x * unit)))
+                if best is None or r < best[1]:
+                    best = (sol.x * unit, r, sol.message)
+                if r <= 1e-9:
+                    return best
+                start = best[0]      # polish the best point with the other method
+        return best
+
     # unknowns in units of their expected size (the axial one can be 10-100 times the radial one)
     unit = np.array([scale, scale, max(abs(e0[2]), scale)])
-    best = None
-    for start in (e0, e0 * np.array([1.0, 1.0, 1.5]), e0 * np.array([2.0, 2.0, 0.8])):
-        sol = root(lambda x: resid(x * unit), start / unit, method="hybr", options={"xtol": 1e-15})
-        r = np.max(np.abs(resid(sol.x * unit)))
-        if best is None or r < best[1]:
-            best = (sol, r)
-        if r <= 1e-9:
-            break
-    sol, r = best
-    if not np.all(np.isfinite(sol.x)) or r > 1e-8:
-        raise SolverError(f"scene {scene.name!r}: 3-D static equilibrium not found ({sol.message}; "
+    resid = make_resid(1.0)
+    e, r, msg = solve(resid, (e0, e0 * np.array([1.0, 1.0, 1.5]), e0 * np.array([2.0, 2.0, 0.8])), unit)
+    if (not np.all(np.isfinite(e)) or r > 1e-8) and d["load"]["radial_n"]:
+        # a small axial load beside a large radial one: from the radial solution, raise the axial load
+        e, r, msg = solve(make_resid(0.0), (e0 * np.array([1.0, 1.0, 0.0]),), np.array([scale, scale, scale]))
+        for frac in (0.05, 0.1, 0.2, 0.35, 0.5, 0.7, 0.85, 1.0):
+            q = forces(e)[3]
+            s_q = float(np.sum(q))
+            # the axial displacement that a small angle asks (sum Q sin(a) = F_a, sin(a) ~ e_z / a0)
+            dz = abs(frac * axial) * a0 / s_q if s_q > 0 else 0.0
+            start = np.array([e[0], e[1], sgn * math.copysign(dz, axial)])
+            e, r, msg = solve(make_resid(frac), (start, e), np.array([scale, scale, max(abs(start[2]), scale)]))
+        resid = make_resid(1.0)
+    if not np.all(np.isfinite(e)) or r > 1e-8:
+        raise SolverError(f"scene {scene.name!r}: 3-D static equilibrium not found ({msg}; "
                           f"residual {r:.3g})")
-    e = sol.x * unit
     fi, fo, q_in, q_out, al_i, al_o, q, w = forces(e)
     if path == "bearing":
         if on_outer:

@@ -209,3 +209,13 @@ def test_the_turned_table_sees_the_drop_a_ball_meets_at_its_contact_angle(h_mm):
     brute = _brute_drop_at_angle(d, b, alpha)
     assert brute > 0.05e-6
     assert table_drop == pytest.approx(brute, rel=0.03, abs=0.02e-6)
+
+
+@pytest.mark.parametrize("fa", [1.0, 10.0, 50.0, -40.0])
+@pytest.mark.parametrize("fidelity", ["quasi-static", "multibody"])
+def test_a_small_axial_load_beside_a_large_radial_one_finds_its_equilibrium(fa, fidelity):
+    """480 N radial with 1-50 N axial: the axial play is barely taken up and the balls outside the load
+    zone carry only their centrifugal force; the start still balances the axial load to 0.1 %."""
+    st = assemble(load_scene("paper-O1", **{"load.axial_n": fa, "load.on": "outer", "fidelity": fidelity})).static
+    q, a = st["ball_loads_outer"], st["alpha_o"]
+    assert abs(abs(np.sum(q * np.sin(a))) - abs(fa)) < 1e-3 * abs(fa) + 1e-6
