@@ -199,34 +199,12 @@ def static_equilibrium_3d(scene, phi_c0, k_in, k_out, *, ball_mass=0.0, omega_ca
                 return (xi - xo - e) / scale
         return resid
 
-    def solve(resid, starts, unit):
-        best = None
-        for start in starts:
-            for method, opts in (("hybr", {"xtol": 1e-15}), ("lm", {"xtol": 1e-15, "ftol": 1e-15})):
-                sol = root(lambda x: resid(x * unit), start / unit, method=method, options=opts)
-                r = np.max(np.abs(resid(sol.x * unit)))
-                if best is None or r < best[1]:
-                    best = (sol.x * unit, r, sol.message)
-                if r <= 1e-9:
-                    return best
-                start = best[0]      # polish the best point with the other method
-        return best
-
     # unknowns in units of their expected size (the axial one can be 10-100 times the radial one)
     unit = np.array([scale, scale, max(abs(e0[2]), scale)])
     resid = make_resid(1.0)
-    e, r, msg = solve(resid, (e0, e0 * np.array([1.0, 1.0, 1.5]), e0 * np.array([2.0, 2.0, 0.8])), unit)
+    e, r, msg = _root_best(resid, (e0, e0 * np.array([1.0, 1.0, 1.5]), e0 * np.array([2.0, 2.0, 0.8])), unit)
     if (not np.all(np.isfinite(e)) or r > 1e-8) and d["load"]["radial_n"]:
-        # a small axial load beside a large radial one: from the radial solution, raise the axial load
-        e, r, msg = solve(make_resid(0.0), (e0 * np.array([1.0, 1.0, 0.0]),), np.array([scale, scale, scale]))
-        for frac in (0.05, 0.1, 0.2, 0.35, 0.5, 0.7, 0.85, 1.0):
-            q = forces(e)[3]
-            s_q = float(np.sum(q))
-            # the axial displacement that a small angle asks (sum Q sin(a) = F_a, sin(a) ~ e_z / a0)
-            dz = abs(frac * axial) * a0 / s_q if s_q > 0 else 0.0
-            start = np.array([e[0], e[1], sgn * math.copysign(dz, axial)])
-            e, r, msg = solve(make_resid(frac), (start, e), np.array([scale, scale, max(abs(start[2]), scale)]))
-        resid = make_resid(1.0)
+        e, r, msg = _continuation(make_resid, forces, e0, scale, axial * sgn, a0)
     if not np.all(np.isfinite(e)) or r > 1e-8:
         raise SolverError(f"scene {scene.name!r}: 3-D static equilibrium not found ({msg}; "
                           f"residual {r:.3g})")
@@ -250,6 +228,34 @@ def static_equilibrium_3d(scene, phi_c0, k_in, k_out, *, ball_mass=0.0, omega_ca
             "phis": phis, "load_vec": radial, "gvec": grav[:2], "alpha_i": al_i, "alpha_o": al_o,
             "q": q + np.array([xo[0] * math.cos(p) + xo[1] * math.sin(p) for p in phis]), "w": w + xo[2],
             "residual": float(np.max(np.abs(resid(e))))}
+
+
+def _root_best(resid, starts, unit):
+    """(x, max |residual|, message) of the best root from ``starts``; unknowns in units of ``unit``;
+    each start by Powell's hybrid method, then polished by Levenberg-Marquardt if not converged."""
+    best = None
+    for start in starts:
+        for method, opts in (("hybr", {"xtol": 1e-15}), ("lm", {"xtol": 1e-15, "ftol": 1e-15})):
+            sol = root(lambda x: resid(x * unit), start / unit, method=method, options=opts)
+            r = np.max(np.abs(resid(sol.x * unit)))
+            if best is None or r < best[1]:
+                best = (sol.x * unit, r, sol.message)
+            if r <= 1e-9:
+                return best
+            start = best[0]      # polish the best point with the other method
+    return best
+
+
+def _continuation(make_resid, forces, e0, scale, signed_axial, a0):
+    """A small axial load beside a large radial one: from the radial solution, raise the axial load
+    in steps, each started where a small contact angle puts it (sum Q sin(a) = F_a, sin(a) ~ e_z / a0)."""
+    e, r, msg = _root_best(make_resid(0.0), (e0 * np.array([1.0, 1.0, 0.0]),), np.array([scale, scale, scale]))
+    for frac in (0.05, 0.1, 0.2, 0.35, 0.5, 0.7, 0.85, 1.0):
+        s_q = float(np.sum(forces(e)[3]))
+        dz = frac * signed_axial * a0 / s_q if s_q > 0 else 0.0
+        start = np.array([e[0], e[1], dz])
+        e, r, msg = _root_best(make_resid(frac), (start, e), np.array([scale, scale, max(abs(dz), scale)]))
+    return e, r, msg
 
 
 def _axial_angle(fa, z, k_eff, a0, pd, exponent):
