@@ -318,6 +318,15 @@ def loads_at(out_t, out_state, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, fi_
 
 
 @njit(cache=True, error_model="numpy")
+def shaft_angles(ts, sp_t, sp_w, sp_th):
+    """Shaft angles (rad) at the output times ``ts``, in one compiled pass (:func:`_kernels.shaft_state`)."""
+    out = np.empty(ts.shape[0])
+    for i in range(ts.shape[0]):
+        out[i] = K.shaft_state(ts[i], sp_t, sp_w, sp_th)[0]
+    return out
+
+
+@njit(cache=True, error_model="numpy")
 def fir_decimate(a_fine, taps_rev, s0, R, out):
     """out[k, ch] = Σ_i a_fine[s0 + k R + i, ch] taps_rev[i] for the two channels (x, y): the
     anti-alias FIR evaluated at the kept samples only, on one thread (a BLAS product here spins

@@ -222,7 +222,7 @@ def _contact_angles(asm, out_t, out_state):
     the load line leans as under a +Z force on the outer ring (see :mod:`.bearing3d`)."""
     from .bearing3d import contact_angles, groove_offsets
     p, z = asm.p, asm.n_balls
-    theta = np.array([K.shaft_state(t, asm.sp_t, asm.sp_w, asm.sp_th)[0] for t in out_t])
+    theta = S.shaft_angles(np.ascontiguousarray(out_t, dtype=float), asm.sp_t, asm.sp_w, asm.sp_th)
     phis = (p[K.P_PHI0] + p[K.P_FTF] * theta)[:, None] + 2 * np.pi * np.arange(z)[None, :] / z
     a_i, a_o = groove_offsets(asm.scene.bearing)
     ao, ai = contact_angles(out_state, phis, zoff=int(p[K.P_ZOFF]), pd=p[K.P_PD], a_i=a_i, a_o=a_o,
