@@ -91,21 +91,21 @@ def _write_failure(path: Path, exc, ds) -> str:
     return f"{type(exc).__name__}: {exc}"
 
 
-def check_output_path(text: str, *, force: bool = False, suffixes=(".nc", ".nc4")) -> Path:
-    """The CLI's ``-o FILE``: refuse a wrong suffix, a missing directory or (without ``force``) an
-    existing file before any work."""
+def check_output_path(text: str, *, force: bool = False, suffixes=(".nc", ".nc4"), flag: str = "-o") -> Path:
+    """The CLI's ``-o FILE`` (or another output option, ``flag``): refuse a wrong suffix, a missing
+    directory or (without ``force``) an existing file before any work."""
     out = Path(text)
     if out.suffix not in suffixes:
         what = "a netCDF file ending in .nc" if ".nc" in suffixes else "a file ending in " + " or ".join(suffixes)
-        raise BearingLabError(f"-o {text}: the output must be {what}")
+        raise BearingLabError(f"{flag} {text}: the output must be {what}")
     if not out.parent.exists():
-        raise BearingLabError(f"-o {text}: directory {out.parent} does not exist")
+        raise BearingLabError(f"{flag} {text}: directory {out.parent} does not exist")
     size = len(os.fsencode(out.name))
     if size > 255:
-        raise BearingLabError(f"-o {text}: the file name has {size} bytes; a file name has at most "
+        raise BearingLabError(f"{flag} {text}: the file name has {size} bytes; a file name has at most "
                               "255")
     if out.is_dir():
-        raise BearingLabError(f"-o {text}: is a directory; give a file name ending in {suffixes[0]}")
+        raise BearingLabError(f"{flag} {text}: is a directory; give a file name ending in {suffixes[0]}")
     if out.exists() and not force:
-        raise BearingLabError(f"-o {text}: exists; pass --force to overwrite it")
+        raise BearingLabError(f"{flag} {text}: exists; pass --force to overwrite it")
     return out

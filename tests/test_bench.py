@@ -30,6 +30,17 @@ def test_bench_writes_report_rules_and_rows(tmp_path):
     rules = tomllib.loads((tmp_path / "auto_rules.toml").read_text())
     assert rules["defect"]["fidelity"] == "multibody" and rules["defect"]["method"] in ("dp54", "bs32")
     assert "paper-slot" in summary_table(ds)
+    # `bench --json`: strict JSON with every row and the scene's fastest setting within tolerance
+    import json
+    from bearing_lab._json import dumps
+    from bearing_lab.cli.bench import json_summary
+    js = json.loads(dumps(json_summary(ds, tmp_path)))
+    assert len(js["rows"]) == len(rows) and js["tolerance"]["peak"] > 0
+    best = js["fastest_within_tolerance"]["paper-slot"]
+    assert best is not None and best["err_peak"] <= js["tolerance"]["peak"] and best in js["rows"]
+    assert best["cost"] == min(r["cost"] for r in js["rows"] if r["scene"] == "paper-slot"
+                               and r["solver"] == "bearing_lab" and r["err_peak"] <= js["tolerance"]["peak"]
+                               and not r["err_period"] > js["tolerance"]["period"])
     # the rate study: every candidate at 20, 100 and 200 kHz, each against its own reference at that
     # rate, and a rule per rate made from those rows
     from bearing_lab.bench import RATE_SETTINGS, RATES_HZ, rate_choices, read_rate_study

@@ -13,7 +13,7 @@ from bearing_lab.cli import build_parser, main
 
 #: commands whose result is printed: each takes --json
 PRINTS_RESULTS = {"scenes", "simulate", "import", "info", "analyze", "validate", "case new", "case standin",
-                  "identify", "data fetch", "data list", "data sample", "study", "sweep"}
+                  "identify", "data fetch", "data list", "data sample", "study", "sweep", "bench"}
 
 
 def _leaves(parser, prefix=""):

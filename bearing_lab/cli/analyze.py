@@ -50,9 +50,14 @@ def register(subparsers):
     p.add_argument("-q", "--quiet", action="store_true",
                    help="print nothing but warnings and errors (--json and --plot still write their output)")
     p.add_argument("--plot", metavar="FILE.png", default=None,
-                   help="also write a figure: waveform, spectrum, envelope spectrum with fault markers")
+                   help="also write a figure: waveform, spectrum, envelope spectrum with fault markers "
+                        "(.png, .svg or .pdf)")
+    p.add_argument("--force", action="store_true", help="overwrite an existing --plot file")
     p.set_defaults(func=run)
     return p
+
+
+PLOT_SUFFIXES = (".png", ".svg", ".pdf")
 
 
 def _open(path: Path, fs):
@@ -171,6 +176,9 @@ def run(args) -> int:
     from ..analysis.xr import sampling_rate
 
     path = Path(args.file)
+    if args.plot:  # before reading: a bad or existing figure path is said at once
+        from ..io_netcdf import check_output_path
+        check_output_path(args.plot, force=args.force, suffixes=PLOT_SUFFIXES, flag="--plot")
     ds, fs, note = _open(path, args.fs)
     name = _pick_channel(ds, args.channel, path)
     da = ds[name]

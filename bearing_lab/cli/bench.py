@@ -2,6 +2,19 @@
 from __future__ import annotations
 
 
+def json_summary(ds, output) -> dict:
+    """What ``bench --json`` prints: every run and, per scene, the fastest setting within tolerance."""
+    from ..bench import fastest_within_tolerance, rows_of
+    rows = rows_of(ds)
+    scenes = list(dict.fromkeys(r["scene"] for r in rows))
+    return {"output": str(output),
+            "units": {"cost": "CPU s per simulated s", "err_peak": "relative", "err_rms": "relative",
+                      "err_period": "relative", "err_duration": "relative"},
+            "tolerance": {"peak": ds.attrs["tolerance_peak"], "period": ds.attrs["tolerance_period"]},
+            "fastest_within_tolerance": {sc: fastest_within_tolerance(rows, sc) for sc in scenes},
+            "rows": rows}
+
+
 def _bench(args) -> int:
     from ..bench import SCENES, run_bench, summary_table
     names = [s[0] for s in SCENES]
@@ -9,10 +22,15 @@ def _bench(args) -> int:
         from ..errors import check_choice
         for s in args.scene:
             check_choice(s, names, "--scene")
-    ds = run_bench(args.output, duration=args.duration, scenes=args.scene, progress=not args.quiet,
+    ds = run_bench(args.output, duration=args.duration, scenes=args.scene,
+                   progress=not (args.quiet or args.json),
                    scipy=not args.no_scipy,
                    scipy_duration=args.scipy_duration, rates=not args.no_rates,
                    rate_duration=args.rate_duration)
+    if args.json:
+        from .._json import dumps
+        print(dumps(json_summary(ds, args.output), indent=1))
+        return 0
     if args.quiet:
         return 0
     print(summary_table(ds))
@@ -36,5 +54,8 @@ def register(sub) -> None:
     p.add_argument("--rate-duration", type=float, default=1.0, metavar="S",
                    help="simulated seconds per run of the auto-rule study at 20, 100 and 200 kHz output")
     p.add_argument("--no-rates", action="store_true", help="skip the auto-rule study by output rate")
+    p.add_argument("--json", action="store_true",
+                   help="print every run (scene, setting, CPU s per simulated s, errors) and each scene's "
+                        "fastest setting within tolerance as JSON")
     p.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors (the files are written)")
     p.set_defaults(func=_bench)

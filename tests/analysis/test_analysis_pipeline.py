@@ -92,6 +92,14 @@ def test_cli_analyze_json_and_plot(tmp_path, capsys):
     check_schema(r)
     assert r["diagnosis"] == "outer_race" and r["channel"] == "acc"
     assert png.is_file()
+    # an existing figure is kept unless --force, and refused before any work
+    stamp = png.stat().st_mtime_ns
+    assert main(["analyze", str(path), "--rpm", "file", "--plot", str(png)]) == 2
+    assert "--plot" in capsys.readouterr().err and png.stat().st_mtime_ns == stamp
+    assert main(["analyze", str(path), "--rpm", "file", "--plot", str(png), "--force", "-q"]) == 0
+    assert png.stat().st_mtime_ns != stamp
+    assert main(["analyze", str(path), "--plot", str(tmp_path / "fig.txt")]) == 2
+    assert ".png" in capsys.readouterr().err
     assert main(["analyze", str(path), "--bearing", "6205"]) == 0
     out = capsys.readouterr().out
     assert "verdict: diagnosed  diagnosis: outer_race" in out and "BPFO" in out
