@@ -63,17 +63,23 @@ def apply_sensor(x, fs, frequency_hz, damping_ratio, gain=1.0):
     return StructuralPath((Resonance(frequency_hz, damping_ratio),), gain).apply(x, fs)
 
 
-def align_by_impulse_phase(experiment, simulation, fs, period, *, band=None):
-    """Samples to delay ``simulation`` by so that its first impact falls on the experiment's.
+def align_by_impulse_phase(experiment, simulation, fs, period, *, band=None, periods=10):
+    """Samples to delay ``simulation`` by so that its impacts fall on the experiment's.
 
-    Both signals at the same rate ``fs``.  Returns ``shift`` in [0, period*fs): the
-    aligned simulation is ``sim[n - shift]``.
+    Both signals at the same rate ``fs``.  Each signal's impact phase is the circular mean of
+    its impact times modulo ``period`` over its first ``periods`` impacts, skipping the first
+    half period, where the band-pass filter's start transient can make the envelope's largest
+    value (so one early, wrong impact cannot set the shift; slip jitter averages out).
+    Returns ``shift`` in [0, period*fs): the aligned simulation is ``sim[n - shift]``.
     """
-    te = impact_times(experiment, fs, period, band=band)
-    ts = impact_times(simulation, fs, period, band=band)
-    if te.size == 0 or ts.size == 0:
-        return 0
-    return int(round((te[0] * fs - ts[0] * fs) % (period * fs)))
+    phases = []
+    for x in (experiment, simulation):
+        t = impact_times(x, fs, period, band=band)
+        t = t[t >= 0.5 * period][:periods]
+        if t.size == 0:
+            return 0
+        phases.append(np.angle(np.mean(np.exp(2j * np.pi * t / period))) / (2 * np.pi) * period)
+    return int(round(((phases[0] - phases[1]) * fs) % (period * fs))) % max(int(round(period * fs)), 1)
 
 
 def shift(x, shift, n):
