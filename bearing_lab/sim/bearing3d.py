@@ -101,39 +101,54 @@ def _ball_multibody(u_i, z_i, u_o, z_o, fc, pd4, a_i, a_o, k_in, k_out, e, guess
     return x * 1e-6, parts(x * 1e-6)
 
 
-def ball_forces(e_vec, phis, *, k_in, k_out, pd, a_i, a_o, exponent, ball_mass, omega_cage, g, pitch_radius,
-                guesses=None):
+def _balls_multibody(u, z_i, fc, pd4, a_i, a_o, k_in, k_out, e):
+    """(q, w, out) of every ball (:func:`._equilibrium_kernel.balls_3d`, compiled: a scipy root per
+    ball cost 25-35 ms of every 3-D multibody start): Newton's method from the line through the
+    curvature centres; a ball it leaves unbalanced is solved by :func:`_ball_multibody`."""
+    from ._equilibrium_kernel import balls_3d
+    z = u.size
+    co = np.stack([np.full(z, pd4 - a_o), np.zeros(z)])
+    ci = np.stack([u - pd4 + a_i, np.full(z, float(z_i))])
+    ln = np.hypot(*(ci - co))
+    tot = np.maximum(ln - a_i - a_o, 0.0)
+    share = 1.0 / (1.0 + (k_out / k_in) ** (1.0 / e))
+    free = (np.maximum(fc, 0.0) / k_out) ** (1.0 / e)
+    reach = np.where(tot * share < free, a_o + free, a_o + tot * share)
+    q, w = co + (ci - co) / ln * reach
+    out = np.empty((z, 9))
+    if balls_3d(np.ascontiguousarray(u, dtype=float), float(z_i), np.ascontiguousarray(fc, dtype=float), pd4, a_i,
+                a_o, k_in, k_out, float(e), q, w, out):
+        for j in np.flatnonzero(~(out[:, 8] <= 1e-11)):
+            (q[j], w[j]), parts = _ball_multibody(u[j], z_i, 0.0, 0.0, fc[j], pd4, a_i, a_o, k_in, k_out, e, None)
+            out[j, :8] = parts
+    return q, w, out
+
+
+def ball_forces(e_vec, phis, *, k_in, k_out, pd, a_i, a_o, exponent, ball_mass, omega_cage, g, pitch_radius):
     """Balls between rings displaced by ``e_vec = (inner - outer)`` (x, y, z), outer ring at the origin.
 
     Returns ``(force on inner ring (3,), force on outer ring (3,), Q_i (Z,), Q_o (Z,), alpha_i, alpha_o
     (Z, rad), q (Z,), w (Z,))``: q, w the ball centres relative to the outer ring (radial, axial)."""
-    z = len(phis)
+    phis = np.asarray(phis, dtype=float)
+    c, s = np.cos(phis), np.sin(phis)
+    u = e_vec[0] * c + e_vec[1] * s
     pd4 = pd / 4
-    f_i, f_o = np.zeros(3), np.zeros(3)
-    qi, qo, ai, ao, qq, ww = (np.zeros(z) for _ in range(6))
-    for j, phi in enumerate(phis):
-        c, s = math.cos(phi), math.sin(phi)
-        u = e_vec[0] * c + e_vec[1] * s
-        if ball_mass > 0:
-            fc = ball_mass * (pitch_radius * omega_cage ** 2 - g * s)
-            guess = guesses[j] if guesses is not None else None
-            (q, w), (fo, fi, ro, zo, lo, ri, zi, li) = _ball_multibody(u, e_vec[2], 0.0, 0.0, fc, pd4, a_i, a_o,
-                                                                       k_in, k_out, exponent, guess)
-            nri, nzi, nro, nzo = ri / li, zi / li, ro / lo, zo / lo
-        else:
-            rho, zeta = a_i + a_o - 2 * pd4 + u, e_vec[2]
-            ln = math.hypot(rho, zeta)
-            k_eff = (k_in ** (-1 / exponent) + k_out ** (-1 / exponent)) ** (-exponent)
-            fi = fo = _hz(k_eff, ln - a_i - a_o, exponent)
-            nri = nro = rho / ln
-            nzi = nzo = zeta / ln
-            q, w = u / 2, zeta / 2
-        f_i -= fi * np.array([nri * c, nri * s, nzi])
-        f_o += fo * np.array([nro * c, nro * s, nzo])
-        qi[j], qo[j] = fi, fo
-        ai[j], ao[j] = math.atan2(nzi, nri), math.atan2(nzo, nro)
-        qq[j], ww[j] = q, w
-    return f_i, f_o, qi, qo, ai, ao, qq, ww
+    if ball_mass > 0:
+        fc = ball_mass * (pitch_radius * omega_cage ** 2 - g * s)
+        qq, ww, out = _balls_multibody(u, e_vec[2], fc, pd4, a_i, a_o, k_in, k_out, exponent)
+        qo, qi, ro, zo, lo, ri, zi, li = out[:, :8].T
+        nri, nzi, nro, nzo = ri / li, zi / li, ro / lo, zo / lo
+    else:
+        rho, zeta = a_i + a_o - 2 * pd4 + u, np.full_like(u, e_vec[2])
+        ln = np.hypot(rho, zeta)
+        k_eff = (k_in ** (-1 / exponent) + k_out ** (-1 / exponent)) ** (-exponent)
+        qi = qo = k_eff * np.maximum(ln - a_i - a_o, 0.0) ** exponent
+        nri = nro = rho / ln
+        nzi = nzo = zeta / ln
+        qq, ww = u / 2, zeta / 2
+    f_i = -np.array([np.sum(qi * nri * c), np.sum(qi * nri * s), np.sum(qi * nzi)])
+    f_o = np.array([np.sum(qo * nro * c), np.sum(qo * nro * s), np.sum(qo * nzo)])
+    return f_i, f_o, qi, qo, np.arctan2(nzi, nri), np.arctan2(nzo, nro), qq, ww
 
 
 def static_equilibrium_3d(scene, phi_c0, k_in, k_out, *, ball_mass=0.0, omega_cage=0.0, exponent=1.5) -> dict:
