@@ -84,7 +84,7 @@ def balls_3d(u, z_i, fc, pd4, a_i, a_o, k_in, k_out, n, q, w, out):
     the distance to the groove's curvature centre less ``a``, minus ``fc q``): a convex
     function, so Newton's method with the step halved until the energy falls converges from any
     start where a contact is loaded.  ``out[j]``: (Q_o, Q_i, rho_o, zeta_o, l_o, rho_i, zeta_i,
-    l_i, |residual| / max(|fc|, 1 N)).  Returns the number of balls whose residual stayed above
+    l_i, |residual| / max(|fc|, Q_o, Q_i, 1 N)).  Returns the number of balls whose residual stayed above
     1e-11 (the caller solves those another way)."""
     bad = 0
     for j in range(u.shape[0]):
@@ -97,7 +97,7 @@ def balls_3d(u, z_i, fc, pd4, a_i, a_o, k_in, k_out, n, q, w, out):
             e0, r1, r2, fo, fi, ro, zo, lo, ri, zi, li = _ball_state(qj, wj, ro0, ri0, z_i, fc[j], a_i, a_o, k_in,
                                                                      k_out, n)
             res = math.hypot(r1, r2)
-            if res < 1e-14 * scale:
+            if res < 1e-14 * max(scale, fo, fi):
                 break
             do = lo - a_o
             di = li - a_i
@@ -126,7 +126,9 @@ def balls_3d(u, z_i, fc, pd4, a_i, a_o, k_in, k_out, n, q, w, out):
         w[j] = wj
         _, r1, r2, fo, fi, ro, zo, lo, ri, zi, li = _ball_state(qj, wj, ro0, ri0, z_i, fc[j], a_i, a_o, k_in, k_out,
                                                                 n)
-        res = math.hypot(r1, r2) / scale
+        # relative to the largest force on the ball (the root search of the rings tries
+        # displacements where the contacts carry 1e7 N: there 1e-11 N cannot be resolved)
+        res = math.hypot(r1, r2) / max(scale, fo, fi)
         out[j, 0], out[j, 1], out[j, 2], out[j, 3], out[j, 4] = fo, fi, ro, zo, lo
         out[j, 5], out[j, 6], out[j, 7], out[j, 8] = ri, zi, li, res
         if not res <= 1e-11:
