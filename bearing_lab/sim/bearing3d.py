@@ -31,7 +31,9 @@ with fewer operations (and so the planar scenes keep their results to the last b
 
 Public API
 ----------
-needs_3d(scene) -> bool                       -- the scene has an axial load
+needs_3d(scene) -> bool                       -- the scene has an axial load or preload
+preload_geometry(bearing, clearance, delta)   -- rigid-ring displacement preload: offset, approach, angle
+check_axial_keys(scene)                       -- the displacement preload's checks (SceneError)
 static_equilibrium_3d(scene, phi_c0, k_in, k_out, *, ball_mass, omega_cage, exponent) -> dict
 contact_angles(...)                           -- per ball, from states (see :func:`contact_angles`)
 """
@@ -44,12 +46,63 @@ from scipy.optimize import root
 
 from ..errors import SceneError, SolverError
 
-__all__ = ["needs_3d", "static_equilibrium_3d", "contact_angles", "groove_offsets"]
+__all__ = ["needs_3d", "static_equilibrium_3d", "contact_angles", "groove_offsets", "preload_geometry",
+           "check_axial_keys"]
 
 
 def needs_3d(scene) -> bool:
-    """True when the scene loads the bearing axially (``load.axial_n`` not zero)."""
-    return abs(float(scene.data["load"].get("axial_n") or 0.0)) > 0.0
+    """True when the scene loads the bearing axially (``load.axial_n`` not zero, or a displacement
+    preload ``load.axial_preload_um`` above zero)."""
+    d = scene.data["load"]
+    return abs(float(d.get("axial_n") or 0.0)) > 0.0 or float(d.get("axial_preload_um") or 0.0) > 0.0
+
+
+#: the largest normal approach of a ball's two contacts a displacement preload may ask for, as a
+#: fraction of the ball diameter (the limit the scene check puts on a radial preload)
+MAX_APPROACH = 0.005
+
+
+def preload_geometry(bearing, clearance, delta):
+    """Rigid rings, centred radially, the loaded one pushed axially by ``delta`` (m) beyond the point
+    where the axial play is taken up: ``(axial offset of the curvature centres, normal approach of
+    each ball's two contacts, contact angle)`` (m, m, rad).  The centres lie ``A = a_i + a_o`` apart
+    at zero load and ``A - P_d/2`` apart radially, so the play is taken up at the axial offset
+    ``sqrt(A^2 - (A - P_d/2)^2)`` (the free contact angle, Harris & Kotzalas 2007, sec. 2.2); with a
+    negative clearance there is no play and the offset counts from the centred rings."""
+    a_i, a_o = groove_offsets(bearing)
+    a0 = a_i + a_o
+    rho = a0 - clearance / 2
+    z = math.sqrt(max(a0 * a0 - rho * rho, 0.0)) + delta
+    return z, math.hypot(rho, z) - a0, math.atan2(z, rho)
+
+
+def check_axial_keys(scene) -> None:
+    """``load.axial_preload_um``: not with ``load.axial_n``, grooves that can take a contact angle,
+    and no more than :data:`MAX_APPROACH` of the ball diameter pressed into the grooves."""
+    d = scene.data["load"]
+    pre = float(d.get("axial_preload_um") or 0.0)
+    if pre <= 0.0:
+        return
+    if d["axial_n"]:
+        raise SceneError(f"load.axial_preload_um={pre:g} and load.axial_n={d['axial_n']:g} are both given: a "
+                         "displacement preload fixes how far the rings are pushed together and the start "
+                         "solves for the force that takes, which a force on top would change; give one (a "
+                         "preloaded bearing under a further thrust: load.axial_n = the preload's force, "
+                         "reported as the attribute axial_force_n, plus the thrust)")
+    b = scene.bearing
+    a_i, a_o = groove_offsets(b)
+    if a_i <= 0 or a_o <= 0:
+        raise SceneError(f"load.axial_preload_um={pre:g}: bearing {b.name!r} has groove conformities of 0.5 or "
+                         f"less (inner {b.inner_conformity:g}, outer {b.outer_conformity:g}): no contact angle")
+    _, approach, alpha = preload_geometry(b, scene.clearance, pre * 1e-6)
+    limit = MAX_APPROACH * b.ball_diameter
+    if approach > limit:
+        rho = a_i + a_o - scene.clearance / 2
+        z_max = math.sqrt((a_i + a_o + limit) ** 2 - rho * rho)
+        most = z_max - preload_geometry(b, scene.clearance, 0.0)[0]
+        raise SceneError(f"load.axial_preload_um={pre:g}: presses each ball {approach * 1e6:.3g} µm into its "
+                         f"grooves (contact angle {math.degrees(alpha):.1f} deg), beyond the {limit * 1e6:.0f} µm "
+                         f"(0.5 % of the ball diameter) that crushes the balls; at most {most * 1e6:.0f} µm here")
 
 
 def groove_offsets(bearing):
@@ -156,9 +209,12 @@ def static_equilibrium_3d(scene, phi_c0, k_in, k_out, *, ball_mass=0.0, omega_ca
 
     Load path "bearing": the loaded ring's supports (radial and axial) are preloaded so that they
     carry nothing at the start: the bearing carries the whole load.  Path "springs": every support
-    spring is unstressed at the centre.  Returns the keys of the planar ``static_equilibrium``
-    (x, y parts) plus ``zi``, ``zo``, ``rest_zi``, ``rest_zo``, ``f_inz``, ``f_outz``, the balls'
-    ``q``, ``w`` (absolute, m) and contact angles ``alpha_i``, ``alpha_o`` (rad).
+    spring is unstressed at the centre.  A displacement preload (``load.axial_preload_um``) fixes
+    the rings' relative axial position (:func:`preload_geometry`); the radial balance is solved and
+    the axial force the balls then carry is held by the axial supports (see :func:`_ring_positions`).
+    Returns the keys of the planar ``static_equilibrium`` (x, y parts) plus ``zi``, ``zo``,
+    ``rest_zi``, ``rest_zo``, ``f_inz``, ``f_outz``, the balls' ``q``, ``w`` (absolute, m), contact
+    angles ``alpha_i``, ``alpha_o`` (rad) and ``axial_force_n``, the axial force the balls carry.
     """
     d = scene.data
     b = scene.bearing
@@ -167,6 +223,7 @@ def static_equilibrium_3d(scene, phi_c0, k_in, k_out, *, ball_mass=0.0, omega_ca
     g = d["gravity"]["g_m_s2"] if d["gravity"]["enabled"] else 0.0
     radial = d["load"]["radial_n"] * _unit(math.radians(d["load"]["direction_deg"]))
     axial = float(d["load"]["axial_n"] or 0.0)
+    pre = float(d["load"].get("axial_preload_um") or 0.0) * 1e-6
     on_outer = d["load"]["on"] == "outer"
     load = np.array([radial[0], radial[1], axial])
     grav = np.array([0.0, -g, 0.0])
@@ -189,9 +246,9 @@ def static_equilibrium_3d(scene, phi_c0, k_in, k_out, *, ball_mass=0.0, omega_ca
     # start: the axial play taken up (rigid rings, no load) plus a deflection, e = inner - outer
     sgn = -1.0 if on_outer else 1.0
     dr = _unit(math.radians(d["load"]["direction_deg"])) * (0.25 * scale if d["load"]["radial_n"] else 0.0)
-    e0 = sgn * np.array([dr[0], dr[1], math.copysign(a0 * math.sin(_axial_angle(abs(axial), z, k_eff, a0, pd,
-                                                                                exponent)), axial)
-                         if axial else 0.0])
+    ez = (preload_geometry(b, pd, pre)[0] if pre else
+          math.copysign(a0 * math.sin(_axial_angle(abs(axial), z, k_eff, a0, pd, exponent)), axial) if axial else 0.0)
+    e0 = sgn * np.array([dr[0], dr[1], ez])
     path = d["load"]["path"]
 
     def forces(e):
@@ -214,35 +271,74 @@ def static_equilibrium_3d(scene, phi_c0, k_in, k_out, *, ball_mass=0.0, omega_ca
                 return (xi - xo - e) / scale
         return resid
 
-    # unknowns in units of their expected size (the axial one can be 10-100 times the radial one)
-    unit = np.array([scale, scale, max(abs(e0[2]), scale)])
-    resid = make_resid(1.0)
-    e, r, msg = _root_best(resid, (e0, e0 * np.array([1.0, 1.0, 1.5]), e0 * np.array([2.0, 2.0, 0.8])), unit)
-    if (not np.all(np.isfinite(e)) or r > 1e-8) and d["load"]["radial_n"]:
-        e, r, msg = _continuation(make_resid, forces, e0, scale, axial * sgn, a0)
+    if pre:
+        e, r, msg, resid = _solve_preload(make_resid(1.0), e0, scale)
+    else:
+        # unknowns in units of their expected size (the axial one can be 10-100 times the radial one)
+        unit = np.array([scale, scale, max(abs(e0[2]), scale)])
+        resid = make_resid(1.0)
+        e, r, msg = _root_best(resid, (e0, e0 * np.array([1.0, 1.0, 1.5]), e0 * np.array([2.0, 2.0, 0.8])), unit)
+        if (not np.all(np.isfinite(e)) or r > 1e-8) and d["load"]["radial_n"]:
+            e, r, msg = _continuation(make_resid, forces, e0, scale, axial * sgn, a0)
     if not np.all(np.isfinite(e)) or r > 1e-8:
         raise SolverError(f"scene {scene.name!r}: 3-D static equilibrium not found ({msg}; "
                           f"residual {r:.3g})")
     fi, fo, q_in, q_out, al_i, al_o, q, w = forces(e)
-    if path == "bearing":
-        if on_outer:
-            xi = (fi + f_in) / ks
-            xo = xi - e
-            rest_i, rest_o = np.zeros(3), xo.copy()
-        else:
-            xo = (fo + f_out) / km
-            xi = xo + e
-            rest_i, rest_o = xi.copy(), np.zeros(3)
-    else:
-        xi, xo = (fi + f_in) / ks, (fo + f_out) / km
-        rest_i, rest_o = np.zeros(3), np.zeros(3)
+    xi, xo, rest_i, rest_o = _ring_positions(path, on_outer, e, fi, fo, f_in, f_out, ks, km, bool(pre))
+    from .limits import MAX_SUPPORT_DEFLECTION
+    for sec, x, k in (("shaft", xi[2], ks[2]), ("mount", xo[2], km[2])):
+        if abs(x) > MAX_SUPPORT_DEFLECTION:
+            raise SceneError(f"{sec}.stiffness_z_n_m={k:g} (unset: the Y stiffness): holding the bearing's axial "
+                             f"force of {abs(fo[2]):.3g} N it puts the ring {abs(x):.3g} m off centre; a bearing "
+                             f"support gives less than {MAX_SUPPORT_DEFLECTION * 1e3:g} mm")
     return {"xi": xi[:2], "xo": xo[:2], "zi": float(xi[2]), "zo": float(xo[2]),
             "rest_i": rest_i[:2], "rest_o": rest_o[:2], "rest_zi": float(rest_i[2]), "rest_zo": float(rest_o[2]),
             "f_in": f_in[:2], "f_out": f_out[:2], "f_inz": float(f_in[2]), "f_outz": float(f_out[2]),
             "ball_loads": q_out, "ball_loads_inner": q_in, "ball_loads_outer": q_out,
             "phis": phis, "load_vec": radial, "gvec": grav[:2], "alpha_i": al_i, "alpha_o": al_o,
             "q": q + np.array([xo[0] * math.cos(p) + xo[1] * math.sin(p) for p in phis]), "w": w + xo[2],
-            "residual": float(np.max(np.abs(resid(e))))}
+            "residual": float(np.max(np.abs(resid(e)))), "axial_force_n": float(abs(fo[2]))}
+
+
+def _solve_preload(resid3, e0, scale):
+    """A displacement preload: the relative axial position ``e0[2]`` fixed, the radial balance (the x,
+    y parts of the residual) solved.  Returns (e, max |residual|, message, residual of e)."""
+    ez = e0[2]
+
+    def resid(exy):
+        return resid3(np.array([exy[0], exy[1], ez]))[:2]
+    exy, r, msg = _root_best(resid, (e0[:2], 2.0 * e0[:2]), np.array([scale, scale]))
+    return np.array([exy[0], exy[1], ez]), r, msg, lambda e: resid(e[:2])
+
+
+def _ring_positions(path, on_outer, e, fi, fo, f_in, f_out, ks, km, preload):
+    """(xi, xo, rest_i, rest_o), 3-vectors, for the relative displacement ``e`` and the balls' forces:
+    path "bearing" preloads the loaded ring's supports to carry nothing, "springs" leaves every
+    support unstressed at the centre.  A displacement preload has no axial force to carry: the
+    unloaded ring's axial support is unstressed at the centre and holds the balls' axial force, the
+    loaded ring's axial support sits where it pushes that ring against the balls with the same force
+    (a locknut, a housing shoulder)."""
+    if path == "bearing" and on_outer:
+        xi = (fi + f_in) / ks
+        xo = xi - e
+        rest_i, rest_o = np.zeros(3), xo.copy()
+    elif path == "bearing":
+        xo = (fo + f_out) / km
+        xi = xo + e
+        rest_i, rest_o = xi.copy(), np.zeros(3)
+    else:
+        xi, xo = (fi + f_in) / ks, (fo + f_out) / km
+        rest_i, rest_o = np.zeros(3), np.zeros(3)
+    if preload:
+        if on_outer:
+            xi[2], rest_i[2] = (fi[2] + f_in[2]) / ks[2], 0.0
+            xo[2] = xi[2] - e[2]
+            rest_o[2] = xo[2] - (fo[2] + f_out[2]) / km[2]
+        else:
+            xo[2], rest_o[2] = (fo[2] + f_out[2]) / km[2], 0.0
+            xi[2] = xo[2] + e[2]
+            rest_i[2] = xi[2] - (fi[2] + f_in[2]) / ks[2]
+    return xi, xo, rest_i, rest_o
 
 
 def _root_best(resid, starts, unit):

@@ -219,6 +219,14 @@ def _run(asm, method, rtol, *, progress, t_end_override=None, step=None, max_ste
                 m_pad=m_pad, n_out=n_out, stats=stats, dt_f=dt_f, t0=t0, t_end=t_end)
 
 
+def _bearing_model(d, static):
+    """The ``bearing_model`` attribute of a 3-D run: what loads the bearing axially."""
+    pre = float(d["load"].get("axial_preload_um") or 0.0)
+    what = (f"axial displacement preload {pre:g} um ({static['axial_force_n']:.4g} N at the start)" if pre > 0
+            else f"axial load {float(d['load']['axial_n']):g} N")
+    return f"3-D: {what}, contact angles and axial ring motion"
+
+
 def _decimate_acc(res):
     """Fine velocity -> fine-interval mean acceleration -> FIR -> output rate (whole record
     in memory; used for outside solvers' dense output in the benchmarks)."""
@@ -388,8 +396,8 @@ def simulate(scene, *, fidelity: str | None = None, duration: float | None = Non
         "fidelity_requested": sc.fidelity,
         "auto_choice": (choice["reason"] + f"; kind {choice['kind']}; expected peak-acceleration error "
                         f"{choice['expected_peak_error']}") if "auto" in (sc.fidelity, d["solver"]["method"]) else "",
-        "bearing_model": (f"3-D: axial load {float(d['load']['axial_n']):g} N, contact angles and axial ring "
-                          "motion" if res["angles"] is not None else "planar (no axial load)"),
+        "bearing_model": _bearing_model(d, asm.static) if res["angles"] is not None else "planar (no axial load)",
+        **({"axial_force_n": float(asm.static["axial_force_n"])} if res["angles"] is not None else {}),
         "defect_table_top_um": ",".join(f"{1e6 * t.delta_max:.4g}" for t in asm.tables) if asm.tables else "none",
         "defect_table_reach_um": (",".join(f"{1e6 * asm.dflt[k, K.F_REACH]:.4g}" for k in range(len(asm.tables)))
                                   if asm.tables else "none"),

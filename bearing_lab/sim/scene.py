@@ -265,6 +265,8 @@ class Scene:
         if pd > 0.02 * b.ball_diameter:
             raise SceneError(f"clearance.radial_um={pd*1e6:g} is larger than 2 % of the ball diameter: "
                              "not a bearing")
+        from .bearing3d import check_axial_keys
+        check_axial_keys(self)
         if self.fs_out < 1000:
             raise SceneError(f"output.sample_rate_hz={self.fs_out:g} is below 1 kHz: too coarse for bearing vibration")
         if d["output"]["duration_s"] > 600:
@@ -301,7 +303,8 @@ class Scene:
         within it (on cwru-normal with 188 N axial, the healthy kurtosis is 15 after 0.02 s of
         settling, 7.6 after 0.05 s, 1.8 after 0.1 s; planar 1.7)."""
         s = self.data["output"]["settle_s"]
-        if abs(float(self.data["load"].get("axial_n") or 0.0)) > 0.0:
+        from .bearing3d import needs_3d
+        if needs_3d(self):
             return max(s, SETTLE_3D_S)
         return s
 
