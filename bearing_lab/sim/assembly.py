@@ -432,6 +432,9 @@ def _parameters(scene: Scene, fid, st, hi, ho, k_eff, masses, loads, ftf, phi_c0
         p[K.P_KZO], p[K.P_CZO] = _axial(d["mount"])
         p[K.P_ZIR], p[K.P_ZOR] = st["rest_zi"], st["rest_zo"]
         p[K.P_FIZ], p[K.P_FOZ] = st["f_inz"], st["f_outz"]
+        from . import scene as _sc
+        p[K.P_ZSET] = _sc.SETTLE_AXIAL_RATE
+        p[K.P_TZSET] = max(scene.settle - _sc.SETTLE_FREE_S, 0.0)
     return p, dyn
 
 

@@ -120,7 +120,9 @@ SCHEMA: dict[str, dict[str, tuple]] = {
     "output": {
         "duration_s": (1.0, _NUM, "pos", "recorded duration"),
         "sample_rate_hz": (20000.0, _NUM, "pos", "output rate (as the DAQ: anti-alias filtered)"),
-        "settle_s": (0.02, _NUM, "nonneg", "simulated and discarded before the record starts"),
+        "settle_s": (0.02, _NUM, "nonneg", "simulated and discarded before the record starts (the 3-D bearing: "
+                     "at least 0.03 s, its balls' axial motion damped until 0.01 s before the record; "
+                     "docs/model.md)"),
         "oversample": (8, int, "pos", "internal fine grid = oversample x sample_rate before the anti-alias FIR"),
         "ball_loads": (True, bool, None, "store per-ball contact loads"),
     },
