@@ -1,6 +1,7 @@
-"""numba kernel of the static equilibrium: each ball's split of its approach between its two
+"""numba kernels of the static equilibrium: each ball's split of its approach between its two
 contacts (called a few hundred times while the start state is solved; in numpy each call cost
-~0.5 ms of array overhead for 8-20 balls)."""
+~0.5 ms of array overhead for 8-20 balls), and in the 3-D bearing each multibody ball's position
+between its grooves (:func:`balls_3d`)."""
 from __future__ import annotations
 
 import math
