@@ -272,7 +272,7 @@ def static_equilibrium_3d(scene, phi_c0, k_in, k_out, *, ball_mass=0.0, omega_ca
         return resid
 
     if pre:
-        e, r, msg, resid = _solve_preload(make_resid(1.0), e0, scale)
+        e, r, msg, resid = _solve_preload(make_resid(1.0), e0, scale, sgn * 50e-6)
     else:
         # unknowns in units of their expected size (the axial one can be 10-100 times the radial one)
         unit = np.array([scale, scale, max(abs(e0[2]), scale)])
@@ -282,7 +282,7 @@ def static_equilibrium_3d(scene, phi_c0, k_in, k_out, *, ball_mass=0.0, omega_ca
             e, r, msg = _continuation(make_resid, forces, e0, scale, axial * sgn, a0)
     if not np.all(np.isfinite(e)) or r > 1e-8:
         raise SolverError(f"scene {scene.name!r}: 3-D static equilibrium not found ({msg}; "
-                          f"residual {r:.3g})")
+                          f"residual {r:.3g})" + (_preload_hint(b, pd, pre, k_eff, exponent) if pre else ""))
     fi, fo, q_in, q_out, al_i, al_o, q, w = forces(e)
     xi, xo, rest_i, rest_o = _ring_positions(path, on_outer, e, fi, fo, f_in, f_out, ks, km, bool(pre))
     from .limits import MAX_SUPPORT_DEFLECTION
@@ -300,15 +300,34 @@ def static_equilibrium_3d(scene, phi_c0, k_in, k_out, *, ball_mass=0.0, omega_ca
             "residual": float(np.max(np.abs(resid(e)))), "axial_force_n": float(abs(fo[2]))}
 
 
-def _solve_preload(resid3, e0, scale):
-    """A displacement preload: the relative axial position ``e0[2]`` fixed, the radial balance (the x,
-    y parts of the residual) solved.  Returns (e, max |residual|, message, residual of e)."""
-    ez = e0[2]
+def _preload_hint(bearing, clearance, pre, k_eff, exponent):
+    """What a displacement preload that found no start does, rigid rings: for the error message."""
+    _, dn, alpha = preload_geometry(bearing, clearance, pre)
+    fa = bearing.n_balls * k_eff * max(dn, 0.0) ** exponent * math.sin(alpha)
+    return (f"; load.axial_preload_um={pre * 1e6:g} presses each ball {dn * 1e6:.3g} µm into its grooves, about "
+            f"{fa:.3g} N axial on rigid rings: a preload this light beside the radial load, the weights or the "
+            "balls' centrifugal force leaves balls barely touching; give a larger preload")
 
-    def resid(exy):
-        return resid3(np.array([exy[0], exy[1], ez]))[:2]
-    exy, r, msg = _root_best(resid, (e0[:2], 2.0 * e0[:2]), np.array([scale, scale]))
-    return np.array([exy[0], exy[1], ez]), r, msg, lambda e: resid(e[:2])
+
+def _solve_preload(resid3, e0, scale, firmer):
+    """A displacement preload: the relative axial position ``e0[2]`` fixed, the radial balance (the x,
+    y parts of the residual) solved.  A small preload beside a radial load, or one the balls'
+    centrifugal force lifts them against, leaves balls barely touching and the root search
+    stalling: then the rings are first pressed ``firmer`` (m, signed) further together, and the
+    displacement brought back to the preload in steps, each started from the last solution.
+    Returns (e, max |residual|, message, residual of e)."""
+    unit = np.array([scale, scale])
+
+    def at(ez):
+        return lambda exy: resid3(np.array([exy[0], exy[1], ez]))[:2]
+    ez = e0[2]
+    exy, r, msg = _root_best(at(ez), (e0[:2], 2.0 * e0[:2]), unit)
+    if not (np.all(np.isfinite(exy)) and r <= 1e-8):
+        start = e0[:2]
+        for frac in (1.0, 0.5, 0.25, 0.12, 0.06, 0.03, 0.01, 0.0):
+            start, r, msg = _root_best(at(ez + frac * firmer), (start, e0[:2]), unit)
+        exy = start
+    return np.array([exy[0], exy[1], ez]), r, msg, lambda e: at(ez)(e[:2])
 
 
 def _ring_positions(path, on_outer, e, fi, fo, f_in, f_out, ks, km, preload):

@@ -148,3 +148,17 @@ def test_the_dynamic_cage_refusal_names_the_fix():
     with pytest.raises(SceneError, match=r"load\.axial_preload_um=10 with cage\.model='dynamic'.*cage\.model = "
                                          r"'kinematic'"):
         assemble(load_scene("paper-healthy", **{"load.axial_preload_um": 10.0, "cage.model": "dynamic"}))
+
+
+def test_a_light_preload_that_finds_no_start_says_so_naming_the_key():
+    """5 µm on the 6308 presses each ball 0.017 µm in (about 0.001 N): the multibody start with the
+    inner ring's weight alone may stall; it then names the preload and what it amounts to."""
+    from bearing_lab.errors import SolverError
+    sc = load_scene("paper-healthy", **{"load.axial_preload_um": 5.0, "load.radial_n": 0.0, "speed.rpm": 1.0,
+                                        "load.on": "inner", "fidelity": "multibody"})
+    try:
+        st = assemble(sc).static
+    except SolverError as exc:
+        assert "load.axial_preload_um=5 presses each ball 0.0166 µm" in str(exc)
+    else:
+        assert st["residual"] < 1e-8
