@@ -55,7 +55,8 @@ P_DRATE = 54    # damping rate over a defect: 0 the bodies' approach rate, 1 the
 # axial springs' rest positions; the constant axial forces on the rings
 P_3D, P_ZOFF, P_AGI, P_AGO = 55, 56, 57, 58
 P_KZI, P_CZI, P_KZO, P_CZO, P_ZIR, P_ZOR, P_FIZ, P_FOZ = 59, 60, 61, 62, 63, 64, 65, 66
-P_SIZE = 67
+P_ZSET, P_TZSET = 67, 68  # settling only: damping rate (1/s) of the balls' axial motion, until this time
+P_SIZE = 69
 # after P_SIZE: cos(2 pi j / Z) for j < Z, then sin(2 pi j / Z) (ball offsets around the cage,
 # so the right-hand side rotates them with 4 products instead of calling cos/sin per ball)
 P_TRIG = P_SIZE
@@ -352,8 +353,6 @@ def _qs_ball(kk, rel, reld, dtot, dtot_rate, p, dint, dflt, hbuf, gbuf):
         rate = dtot_rate + (dg_dd - 1.0) * x_rate + dg_dpsi * reld
     f = q + step_fn(g + rem, 0.0, 0.0, dpen, cser) * rate
     return f if f > 0.0 else 0.0
-
-
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -804,6 +803,9 @@ def _rhs_3d(t, y, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, dy, fi_out, fo_o
         fix, fiy, fiz, fox, foy, foz = _balls_kinematic_3d(y, p, z, math.cos(phic), math.sin(phic), phic, phidot,
                                                            theta_s, omega_s, dint, dflt, hbuf, gbuf, dy, fi_out,
                                                            fo_out)
+        if t < p[P_TZSET]:  # start transient of the nearly undamped axial ball modes (scene.settle)
+            for j in range(zb + 4 + z, zb + 4 + 2 * z):
+                dy[j] -= p[P_ZSET] * (y[j] - 0.5 * (y[zb + 2] + y[zb + 3]))
     if t >= p[P_TSTEP]:
         lix, liy, lox, loy = p[P_FIX2], p[P_FIY2], p[P_FOX2], p[P_FOY2]
     else:

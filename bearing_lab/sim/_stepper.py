@@ -317,13 +317,44 @@ def loads_at(out_t, out_state, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, fi_
             fo_all[j, i] = fo[j]
 
 
-@njit(cache=True, error_model="numpy")
-def shaft_angles(ts, sp_t, sp_w, sp_th):
-    """Shaft angles (rad) at the output times ``ts``, in one compiled pass (:func:`_kernels.shaft_state`)."""
-    out = np.empty(ts.shape[0])
-    for i in range(ts.shape[0]):
-        out[i] = K.shaft_state(ts[i], sp_t, sp_w, sp_th)[0]
-    return out
+@njit(cache=True, error_model="numpy", inline="always")
+def _atan2(y, x):
+    """atan2 for the contact line's (axial, radial) parts: the radial part is the groove's offset
+    (tenths of a mm) give or take microns, so atan(y / x), 40 % cheaper, serves."""
+    return math.atan(y / x) if x > 0.0 else math.atan2(y, x)
+
+
+@njit(cache=True, error_model="numpy", **K.NO_REFCOUNT)
+def contact_angles_at(out_t, out_state, p, sp_t, sp_w, sp_th, out):
+    """The 3-D bearing's contact angles (deg) at the output samples: ``out[0]`` outer race, ``out[1]``
+    inner race, (Z, n) each, positive when the load line leans as under a +Z force on the outer
+    ring; the geometry of :func:`.bearing3d.contact_angles`, in one compiled pass (in numpy it cost
+    5-7 ms per simulated second at 20 kHz, now 2-3 ms)."""
+    z = int(p[K.P_Z])
+    zb = int(p[K.P_ZOFF])
+    pd4 = 0.25 * p[K.P_PD]
+    a_i = p[K.P_AGI]
+    a_o = p[K.P_AGO]
+    multibody = p[K.P_FID] < 0.5
+    deg = 180.0 / math.pi
+    for i in range(out_t.shape[0]):
+        y = out_state[i]
+        phic = p[K.P_PHI0] + p[K.P_FTF] * K.shaft_state(out_t[i], sp_t, sp_w, sp_th)[0]
+        c0 = math.cos(phic)
+        s0 = math.sin(phic)
+        for j in range(z):
+            c, s = K._ball_dir(p, z, j, c0, s0)
+            ui = y[0] * c + y[1] * s
+            uo = y[4] * c + y[5] * s
+            if multibody:
+                q = y[8 + j]
+                w = y[zb + 4 + j]
+                out[0, j, i] = -(_atan2(w - y[zb + 1], q - uo - pd4 + a_o) * deg)
+                out[1, j, i] = -(_atan2(y[zb] - w, ui - q - pd4 + a_i) * deg)
+            else:
+                a = -(_atan2(y[zb] - y[zb + 1], a_i + a_o - 2.0 * pd4 + ui - uo) * deg)
+                out[0, j, i] = a
+                out[1, j, i] = a
 
 
 @njit(cache=True, error_model="numpy")
@@ -346,6 +377,26 @@ def fir_decimate(a_fine, taps_rev, s0, R, out):
         out[kk, 1] = acc1
 
 
+@njit(cache=True, error_model="numpy")
+def fir_decimate3(a_fine, taps_rev, s0, R, out, out_z):
+    """:func:`fir_decimate` for three channels (x, y into ``out``, the axial z into ``out_z``) in one
+    pass over the taps; each sum in the same order, so the same bits as one channel at a time."""
+    nt = taps_rev.shape[0]
+    for kk in range(out.shape[0]):
+        b = s0 + kk * R
+        acc0 = 0.0
+        acc1 = 0.0
+        acc2 = 0.0
+        for i in range(nt):
+            w = taps_rev[i]
+            acc0 += a_fine[b + i, 0] * w
+            acc1 += a_fine[b + i, 1] * w
+            acc2 += a_fine[b + i, 2] * w
+        out[kk, 0] = acc0
+        out[kk, 1] = acc1
+        out_z[kk] = acc2
+
+
 def _drop_stale_cache():
     """numba keys a cached function on its own source file only, and these functions compile the
     right-hand side of ``_kernels.py`` into themselves: when that file changes (a development
@@ -353,7 +404,7 @@ def _drop_stale_cache():
     import hashlib
     from pathlib import Path
     stamp = hashlib.sha256(Path(K.__file__).read_bytes() + Path(__file__).read_bytes()).hexdigest()
-    for fn in (integrate, loads_at, step_limit):
+    for fn in (integrate, loads_at, step_limit, contact_angles_at):
         cache = getattr(fn, "_cache", None)
         path = getattr(cache, "cache_path", None)
         if not path:

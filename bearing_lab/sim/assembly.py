@@ -432,6 +432,9 @@ def _parameters(scene: Scene, fid, st, hi, ho, k_eff, masses, loads, ftf, phi_c0
         p[K.P_KZO], p[K.P_CZO] = _axial(d["mount"])
         p[K.P_ZIR], p[K.P_ZOR] = st["rest_zi"], st["rest_zo"]
         p[K.P_FIZ], p[K.P_FOZ] = st["f_inz"], st["f_outz"]
+        from . import scene as _sc
+        p[K.P_ZSET] = _sc.SETTLE_AXIAL_RATE
+        p[K.P_TZSET] = max(scene.settle - _sc.SETTLE_FREE_S, 0.0)
     return p, dyn
 
 
@@ -485,8 +488,13 @@ def assemble(scene: Scene, *, fidelity: str | None = None, delta_top=None) -> As
     three_d = needs_3d(scene)
     if three_d:
         if d["cage"]["model"] == "dynamic":
-            raise SceneError("load.axial_n: the 3-D bearing runs with the kinematic cage only (cage.model = "
-                             "'kinematic'); the dynamic cage is planar")
+            ld = d["load"]
+            key = (f"load.axial_n={ld['axial_n']:g}" if ld["axial_n"] else
+                   f"load.axial_preload_um={ld['axial_preload_um']:g}")
+            raise SceneError(f"{key} with cage.model='dynamic': the 3-D bearing runs with the kinematic cage "
+                             "only (its balls' traction and pocket forces are planar). Set cage.model = "
+                             "'kinematic' to keep the axial load, or remove the axial load to run the dynamic "
+                             "cage in the planar bearing")
         st = static_equilibrium_3d(scene, phi_c0, hi.stiffness, ho.stiffness,
                                    ball_mass=0.0 if fid == "quasi-static" else m_b, omega_cage=omega_c0,
                                    exponent=d["contact"]["exponent"])

@@ -31,7 +31,9 @@ with fewer operations (and so the planar scenes keep their results to the last b
 
 Public API
 ----------
-needs_3d(scene) -> bool                       -- the scene has an axial load
+needs_3d(scene) -> bool                       -- the scene has an axial load or preload
+preload_geometry(bearing, clearance, delta)   -- rigid-ring displacement preload: offset, approach, angle
+check_axial_keys(scene)                       -- the displacement preload's checks (SceneError)
 static_equilibrium_3d(scene, phi_c0, k_in, k_out, *, ball_mass, omega_cage, exponent) -> dict
 contact_angles(...)                           -- per ball, from states (see :func:`contact_angles`)
 """
@@ -44,12 +46,63 @@ from scipy.optimize import root
 
 from ..errors import SceneError, SolverError
 
-__all__ = ["needs_3d", "static_equilibrium_3d", "contact_angles", "groove_offsets"]
+__all__ = ["needs_3d", "static_equilibrium_3d", "contact_angles", "groove_offsets", "preload_geometry",
+           "check_axial_keys"]
 
 
 def needs_3d(scene) -> bool:
-    """True when the scene loads the bearing axially (``load.axial_n`` not zero)."""
-    return abs(float(scene.data["load"].get("axial_n") or 0.0)) > 0.0
+    """True when the scene loads the bearing axially (``load.axial_n`` not zero, or a displacement
+    preload ``load.axial_preload_um`` above zero)."""
+    d = scene.data["load"]
+    return abs(float(d.get("axial_n") or 0.0)) > 0.0 or float(d.get("axial_preload_um") or 0.0) > 0.0
+
+
+#: the largest normal approach of a ball's two contacts a displacement preload may ask for, as a
+#: fraction of the ball diameter (the limit the scene check puts on a radial preload)
+MAX_APPROACH = 0.005
+
+
+def preload_geometry(bearing, clearance, delta):
+    """Rigid rings, centred radially, the loaded one pushed axially by ``delta`` (m) beyond the point
+    where the axial play is taken up: ``(axial offset of the curvature centres, normal approach of
+    each ball's two contacts, contact angle)`` (m, m, rad).  The centres lie ``A = a_i + a_o`` apart
+    at zero load and ``A - P_d/2`` apart radially, so the play is taken up at the axial offset
+    ``sqrt(A^2 - (A - P_d/2)^2)`` (the free contact angle, Harris & Kotzalas 2007, sec. 2.2); with a
+    negative clearance there is no play and the offset counts from the centred rings."""
+    a_i, a_o = groove_offsets(bearing)
+    a0 = a_i + a_o
+    rho = a0 - clearance / 2
+    z = math.sqrt(max(a0 * a0 - rho * rho, 0.0)) + delta
+    return z, math.hypot(rho, z) - a0, math.atan2(z, rho)
+
+
+def check_axial_keys(scene) -> None:
+    """``load.axial_preload_um``: not with ``load.axial_n``, grooves that can take a contact angle,
+    and no more than :data:`MAX_APPROACH` of the ball diameter pressed into the grooves."""
+    d = scene.data["load"]
+    pre = float(d.get("axial_preload_um") or 0.0)
+    if pre <= 0.0:
+        return
+    if d["axial_n"]:
+        raise SceneError(f"load.axial_preload_um={pre:g} and load.axial_n={d['axial_n']:g} are both given: a "
+                         "displacement preload fixes how far the rings are pushed together and the start "
+                         "solves for the force that takes, which a force on top would change; give one (a "
+                         "preloaded bearing under a further thrust: load.axial_n = the preload's force, "
+                         "reported as the attribute axial_force_n, plus the thrust)")
+    b = scene.bearing
+    a_i, a_o = groove_offsets(b)
+    if a_i <= 0 or a_o <= 0:
+        raise SceneError(f"load.axial_preload_um={pre:g}: bearing {b.name!r} has groove conformities of 0.5 or "
+                         f"less (inner {b.inner_conformity:g}, outer {b.outer_conformity:g}): no contact angle")
+    _, approach, alpha = preload_geometry(b, scene.clearance, pre * 1e-6)
+    limit = MAX_APPROACH * b.ball_diameter
+    if approach > limit:
+        rho = a_i + a_o - scene.clearance / 2
+        z_max = math.sqrt((a_i + a_o + limit) ** 2 - rho * rho)
+        most = z_max - preload_geometry(b, scene.clearance, 0.0)[0]
+        raise SceneError(f"load.axial_preload_um={pre:g}: presses each ball {approach * 1e6:.3g} µm into its "
+                         f"grooves (contact angle {math.degrees(alpha):.1f} deg), beyond the {limit * 1e6:.0f} µm "
+                         f"(0.5 % of the ball diameter) that crushes the balls; at most {most * 1e6:.0f} µm here")
 
 
 def groove_offsets(bearing):
@@ -101,39 +154,54 @@ def _ball_multibody(u_i, z_i, u_o, z_o, fc, pd4, a_i, a_o, k_in, k_out, e, guess
     return x * 1e-6, parts(x * 1e-6)
 
 
-def ball_forces(e_vec, phis, *, k_in, k_out, pd, a_i, a_o, exponent, ball_mass, omega_cage, g, pitch_radius,
-                guesses=None):
+def _balls_multibody(u, z_i, fc, pd4, a_i, a_o, k_in, k_out, e):
+    """(q, w, out) of every ball (:func:`._equilibrium_kernel.balls_3d`, compiled: a scipy root per
+    ball cost 25-35 ms of every 3-D multibody start): Newton's method from the line through the
+    curvature centres; a ball it leaves unbalanced is solved by :func:`_ball_multibody`."""
+    from ._equilibrium_kernel import balls_3d
+    z = u.size
+    co = np.stack([np.full(z, pd4 - a_o), np.zeros(z)])
+    ci = np.stack([u - pd4 + a_i, np.full(z, float(z_i))])
+    ln = np.hypot(*(ci - co))
+    tot = np.maximum(ln - a_i - a_o, 0.0)
+    share = 1.0 / (1.0 + (k_out / k_in) ** (1.0 / e))
+    free = (np.maximum(fc, 0.0) / k_out) ** (1.0 / e)
+    reach = np.where(tot * share < free, a_o + free, a_o + tot * share)
+    q, w = co + (ci - co) / ln * reach
+    out = np.empty((z, 9))
+    if balls_3d(np.ascontiguousarray(u, dtype=float), float(z_i), np.ascontiguousarray(fc, dtype=float), pd4, a_i,
+                a_o, k_in, k_out, float(e), q, w, out):
+        for j in np.flatnonzero(~(out[:, 8] <= 1e-11)):
+            (q[j], w[j]), parts = _ball_multibody(u[j], z_i, 0.0, 0.0, fc[j], pd4, a_i, a_o, k_in, k_out, e, None)
+            out[j, :8] = parts
+    return q, w, out
+
+
+def ball_forces(e_vec, phis, *, k_in, k_out, pd, a_i, a_o, exponent, ball_mass, omega_cage, g, pitch_radius):
     """Balls between rings displaced by ``e_vec = (inner - outer)`` (x, y, z), outer ring at the origin.
 
     Returns ``(force on inner ring (3,), force on outer ring (3,), Q_i (Z,), Q_o (Z,), alpha_i, alpha_o
     (Z, rad), q (Z,), w (Z,))``: q, w the ball centres relative to the outer ring (radial, axial)."""
-    z = len(phis)
+    phis = np.asarray(phis, dtype=float)
+    c, s = np.cos(phis), np.sin(phis)
+    u = e_vec[0] * c + e_vec[1] * s
     pd4 = pd / 4
-    f_i, f_o = np.zeros(3), np.zeros(3)
-    qi, qo, ai, ao, qq, ww = (np.zeros(z) for _ in range(6))
-    for j, phi in enumerate(phis):
-        c, s = math.cos(phi), math.sin(phi)
-        u = e_vec[0] * c + e_vec[1] * s
-        if ball_mass > 0:
-            fc = ball_mass * (pitch_radius * omega_cage ** 2 - g * s)
-            guess = guesses[j] if guesses is not None else None
-            (q, w), (fo, fi, ro, zo, lo, ri, zi, li) = _ball_multibody(u, e_vec[2], 0.0, 0.0, fc, pd4, a_i, a_o,
-                                                                       k_in, k_out, exponent, guess)
-            nri, nzi, nro, nzo = ri / li, zi / li, ro / lo, zo / lo
-        else:
-            rho, zeta = a_i + a_o - 2 * pd4 + u, e_vec[2]
-            ln = math.hypot(rho, zeta)
-            k_eff = (k_in ** (-1 / exponent) + k_out ** (-1 / exponent)) ** (-exponent)
-            fi = fo = _hz(k_eff, ln - a_i - a_o, exponent)
-            nri = nro = rho / ln
-            nzi = nzo = zeta / ln
-            q, w = u / 2, zeta / 2
-        f_i -= fi * np.array([nri * c, nri * s, nzi])
-        f_o += fo * np.array([nro * c, nro * s, nzo])
-        qi[j], qo[j] = fi, fo
-        ai[j], ao[j] = math.atan2(nzi, nri), math.atan2(nzo, nro)
-        qq[j], ww[j] = q, w
-    return f_i, f_o, qi, qo, ai, ao, qq, ww
+    if ball_mass > 0:
+        fc = ball_mass * (pitch_radius * omega_cage ** 2 - g * s)
+        qq, ww, out = _balls_multibody(u, e_vec[2], fc, pd4, a_i, a_o, k_in, k_out, exponent)
+        qo, qi, ro, zo, lo, ri, zi, li = out[:, :8].T
+        nri, nzi, nro, nzo = ri / li, zi / li, ro / lo, zo / lo
+    else:
+        rho, zeta = a_i + a_o - 2 * pd4 + u, np.full_like(u, e_vec[2])
+        ln = np.hypot(rho, zeta)
+        k_eff = (k_in ** (-1 / exponent) + k_out ** (-1 / exponent)) ** (-exponent)
+        qi = qo = k_eff * np.maximum(ln - a_i - a_o, 0.0) ** exponent
+        nri = nro = rho / ln
+        nzi = nzo = zeta / ln
+        qq, ww = u / 2, zeta / 2
+    f_i = -np.array([np.sum(qi * nri * c), np.sum(qi * nri * s), np.sum(qi * nzi)])
+    f_o = np.array([np.sum(qo * nro * c), np.sum(qo * nro * s), np.sum(qo * nzo)])
+    return f_i, f_o, qi, qo, np.arctan2(nzi, nri), np.arctan2(nzo, nro), qq, ww
 
 
 def static_equilibrium_3d(scene, phi_c0, k_in, k_out, *, ball_mass=0.0, omega_cage=0.0, exponent=1.5) -> dict:
@@ -141,9 +209,12 @@ def static_equilibrium_3d(scene, phi_c0, k_in, k_out, *, ball_mass=0.0, omega_ca
 
     Load path "bearing": the loaded ring's supports (radial and axial) are preloaded so that they
     carry nothing at the start: the bearing carries the whole load.  Path "springs": every support
-    spring is unstressed at the centre.  Returns the keys of the planar ``static_equilibrium``
-    (x, y parts) plus ``zi``, ``zo``, ``rest_zi``, ``rest_zo``, ``f_inz``, ``f_outz``, the balls'
-    ``q``, ``w`` (absolute, m) and contact angles ``alpha_i``, ``alpha_o`` (rad).
+    spring is unstressed at the centre.  A displacement preload (``load.axial_preload_um``) fixes
+    the rings' relative axial position (:func:`preload_geometry`); the radial balance is solved and
+    the axial force the balls then carry is held by the axial supports (see :func:`_ring_positions`).
+    Returns the keys of the planar ``static_equilibrium`` (x, y parts) plus ``zi``, ``zo``,
+    ``rest_zi``, ``rest_zo``, ``f_inz``, ``f_outz``, the balls' ``q``, ``w`` (absolute, m), contact
+    angles ``alpha_i``, ``alpha_o`` (rad) and ``axial_force_n``, the axial force the balls carry.
     """
     d = scene.data
     b = scene.bearing
@@ -152,6 +223,7 @@ def static_equilibrium_3d(scene, phi_c0, k_in, k_out, *, ball_mass=0.0, omega_ca
     g = d["gravity"]["g_m_s2"] if d["gravity"]["enabled"] else 0.0
     radial = d["load"]["radial_n"] * _unit(math.radians(d["load"]["direction_deg"]))
     axial = float(d["load"]["axial_n"] or 0.0)
+    pre = float(d["load"].get("axial_preload_um") or 0.0) * 1e-6
     on_outer = d["load"]["on"] == "outer"
     load = np.array([radial[0], radial[1], axial])
     grav = np.array([0.0, -g, 0.0])
@@ -174,9 +246,9 @@ def static_equilibrium_3d(scene, phi_c0, k_in, k_out, *, ball_mass=0.0, omega_ca
     # start: the axial play taken up (rigid rings, no load) plus a deflection, e = inner - outer
     sgn = -1.0 if on_outer else 1.0
     dr = _unit(math.radians(d["load"]["direction_deg"])) * (0.25 * scale if d["load"]["radial_n"] else 0.0)
-    e0 = sgn * np.array([dr[0], dr[1], math.copysign(a0 * math.sin(_axial_angle(abs(axial), z, k_eff, a0, pd,
-                                                                                exponent)), axial)
-                         if axial else 0.0])
+    ez = (preload_geometry(b, pd, pre)[0] if pre else
+          math.copysign(a0 * math.sin(_axial_angle(abs(axial), z, k_eff, a0, pd, exponent)), axial) if axial else 0.0)
+    e0 = sgn * np.array([dr[0], dr[1], ez])
     path = d["load"]["path"]
 
     def forces(e):
@@ -199,35 +271,93 @@ def static_equilibrium_3d(scene, phi_c0, k_in, k_out, *, ball_mass=0.0, omega_ca
                 return (xi - xo - e) / scale
         return resid
 
-    # unknowns in units of their expected size (the axial one can be 10-100 times the radial one)
-    unit = np.array([scale, scale, max(abs(e0[2]), scale)])
-    resid = make_resid(1.0)
-    e, r, msg = _root_best(resid, (e0, e0 * np.array([1.0, 1.0, 1.5]), e0 * np.array([2.0, 2.0, 0.8])), unit)
-    if (not np.all(np.isfinite(e)) or r > 1e-8) and d["load"]["radial_n"]:
-        e, r, msg = _continuation(make_resid, forces, e0, scale, axial * sgn, a0)
+    if pre:
+        e, r, msg, resid = _solve_preload(make_resid(1.0), e0, scale, sgn * 50e-6)
+    else:
+        # unknowns in units of their expected size (the axial one can be 10-100 times the radial one)
+        unit = np.array([scale, scale, max(abs(e0[2]), scale)])
+        resid = make_resid(1.0)
+        e, r, msg = _root_best(resid, (e0, e0 * np.array([1.0, 1.0, 1.5]), e0 * np.array([2.0, 2.0, 0.8])), unit)
+        if (not np.all(np.isfinite(e)) or r > 1e-8) and d["load"]["radial_n"]:
+            e, r, msg = _continuation(make_resid, forces, e0, scale, axial * sgn, a0)
     if not np.all(np.isfinite(e)) or r > 1e-8:
         raise SolverError(f"scene {scene.name!r}: 3-D static equilibrium not found ({msg}; "
-                          f"residual {r:.3g})")
+                          f"residual {r:.3g})" + (_preload_hint(b, pd, pre, k_eff, exponent) if pre else ""))
     fi, fo, q_in, q_out, al_i, al_o, q, w = forces(e)
-    if path == "bearing":
-        if on_outer:
-            xi = (fi + f_in) / ks
-            xo = xi - e
-            rest_i, rest_o = np.zeros(3), xo.copy()
-        else:
-            xo = (fo + f_out) / km
-            xi = xo + e
-            rest_i, rest_o = xi.copy(), np.zeros(3)
-    else:
-        xi, xo = (fi + f_in) / ks, (fo + f_out) / km
-        rest_i, rest_o = np.zeros(3), np.zeros(3)
+    xi, xo, rest_i, rest_o = _ring_positions(path, on_outer, e, fi, fo, f_in, f_out, ks, km, bool(pre))
+    from .limits import MAX_SUPPORT_DEFLECTION
+    for sec, x, k in (("shaft", xi[2], ks[2]), ("mount", xo[2], km[2])):
+        if abs(x) > MAX_SUPPORT_DEFLECTION:
+            raise SceneError(f"{sec}.stiffness_z_n_m={k:g} (unset: the Y stiffness): holding the bearing's axial "
+                             f"force of {abs(fo[2]):.3g} N it puts the ring {abs(x):.3g} m off centre; a bearing "
+                             f"support gives less than {MAX_SUPPORT_DEFLECTION * 1e3:g} mm")
     return {"xi": xi[:2], "xo": xo[:2], "zi": float(xi[2]), "zo": float(xo[2]),
             "rest_i": rest_i[:2], "rest_o": rest_o[:2], "rest_zi": float(rest_i[2]), "rest_zo": float(rest_o[2]),
             "f_in": f_in[:2], "f_out": f_out[:2], "f_inz": float(f_in[2]), "f_outz": float(f_out[2]),
             "ball_loads": q_out, "ball_loads_inner": q_in, "ball_loads_outer": q_out,
             "phis": phis, "load_vec": radial, "gvec": grav[:2], "alpha_i": al_i, "alpha_o": al_o,
             "q": q + np.array([xo[0] * math.cos(p) + xo[1] * math.sin(p) for p in phis]), "w": w + xo[2],
-            "residual": float(np.max(np.abs(resid(e))))}
+            "residual": float(np.max(np.abs(resid(e)))), "axial_force_n": float(abs(fo[2]))}
+
+
+def _preload_hint(bearing, clearance, pre, k_eff, exponent):
+    """What a displacement preload that found no start does, rigid rings: for the error message."""
+    _, dn, alpha = preload_geometry(bearing, clearance, pre)
+    fa = bearing.n_balls * k_eff * max(dn, 0.0) ** exponent * math.sin(alpha)
+    return (f"; load.axial_preload_um={pre * 1e6:g} presses each ball {dn * 1e6:.3g} µm into its grooves, about "
+            f"{fa:.3g} N axial on rigid rings: a preload this light beside the radial load, the weights or the "
+            "balls' centrifugal force leaves balls barely touching; give a larger preload")
+
+
+def _solve_preload(resid3, e0, scale, firmer):
+    """A displacement preload: the relative axial position ``e0[2]`` fixed, the radial balance (the x,
+    y parts of the residual) solved.  A small preload beside a radial load, or one the balls'
+    centrifugal force lifts them against, leaves balls barely touching and the root search
+    stalling: then the rings are first pressed ``firmer`` (m, signed) further together, and the
+    displacement brought back to the preload in steps, each started from the last solution.
+    Returns (e, max |residual|, message, residual of e)."""
+    unit = np.array([scale, scale])
+
+    def at(ez):
+        return lambda exy: resid3(np.array([exy[0], exy[1], ez]))[:2]
+    ez = e0[2]
+    exy, r, msg = _root_best(at(ez), (e0[:2], 2.0 * e0[:2]), unit)
+    if not (np.all(np.isfinite(exy)) and r <= 1e-8):
+        start = e0[:2]
+        for frac in (1.0, 0.5, 0.25, 0.12, 0.06, 0.03, 0.01, 0.0):
+            start, r, msg = _root_best(at(ez + frac * firmer), (start, e0[:2]), unit)
+        exy = start
+    return np.array([exy[0], exy[1], ez]), r, msg, lambda e: at(ez)(e[:2])
+
+
+def _ring_positions(path, on_outer, e, fi, fo, f_in, f_out, ks, km, preload):
+    """(xi, xo, rest_i, rest_o), 3-vectors, for the relative displacement ``e`` and the balls' forces:
+    path "bearing" preloads the loaded ring's supports to carry nothing, "springs" leaves every
+    support unstressed at the centre.  A displacement preload has no axial force to carry: the
+    unloaded ring's axial support is unstressed at the centre and holds the balls' axial force, the
+    loaded ring's axial support sits where it pushes that ring against the balls with the same force
+    (a locknut, a housing shoulder)."""
+    if path == "bearing" and on_outer:
+        xi = (fi + f_in) / ks
+        xo = xi - e
+        rest_i, rest_o = np.zeros(3), xo.copy()
+    elif path == "bearing":
+        xo = (fo + f_out) / km
+        xi = xo + e
+        rest_i, rest_o = xi.copy(), np.zeros(3)
+    else:
+        xi, xo = (fi + f_in) / ks, (fo + f_out) / km
+        rest_i, rest_o = np.zeros(3), np.zeros(3)
+    if preload:
+        if on_outer:
+            xi[2], rest_i[2] = (fi[2] + f_in[2]) / ks[2], 0.0
+            xo[2] = xi[2] - e[2]
+            rest_o[2] = xo[2] - (fo[2] + f_out[2]) / km[2]
+        else:
+            xo[2], rest_o[2] = (fo[2] + f_out[2]) / km[2], 0.0
+            xi[2] = xo[2] + e[2]
+            rest_i[2] = xi[2] - (fi[2] + f_in[2]) / ks[2]
+    return xi, xo, rest_i, rest_o
 
 
 def _root_best(resid, starts, unit):

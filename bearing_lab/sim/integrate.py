@@ -117,7 +117,7 @@ def _run(asm, method, rtol, *, progress, t_end_override=None, step=None, max_ste
     out_t_all = t0 + np.arange(n_out) / fs
     acc = np.zeros((n_out, 2))
     disp = np.zeros((n_out, 4))
-    acc_z = np.zeros((n_out, 2)) if three_d else None
+    acc_z = np.zeros(n_out) if three_d else None
     disp_z = np.zeros(n_out) if three_d else None
     angles = np.zeros((2, z, n_out)) if three_d else None
     dyn = d["cage"]["model"] == "dynamic"
@@ -181,7 +181,8 @@ def _run(asm, method, rtol, *, progress, t_end_override=None, step=None, max_ste
                 disp[o_next:o_hi] = out_state[:, [0, 1, 4, 5]]
                 if three_d:
                     disp_z[o_next:o_hi] = out_state[:, zb + 1]
-                    angles[:, :, o_next:o_hi] = _contact_angles(asm, out_t, out_state)
+                    S.contact_angles_at(out_t, out_state, asm.p, asm.sp_t, asm.sp_w, asm.sp_th,
+                                        angles[:, :, o_next:o_hi])
                 if dyn:
                     cage_speed[o_next:o_hi] = out_state[:, cage_idx]
                 if loads:
@@ -196,9 +197,10 @@ def _run(asm, method, rtol, *, progress, t_end_override=None, step=None, max_ste
             k_hi = min(n_out, (last - half - m_pad) // R + 1) if last - half - m_pad >= 0 else k_acc
             if k_hi > k_acc:
                 s0 = m_pad + k_acc * R - half - v_start
-                S.fir_decimate(a_fine, taps_rev, s0, R, acc[k_acc:k_hi])
                 if three_d:
-                    S.fir_decimate(np.ascontiguousarray(a_fine[:, [2, 2]]), taps_rev, s0, R, acc_z[k_acc:k_hi])
+                    S.fir_decimate3(a_fine, taps_rev, s0, R, acc[k_acc:k_hi], acc_z[k_acc:k_hi])
+                else:
+                    S.fir_decimate(a_fine, taps_rev, s0, R, acc[k_acc:k_hi])
                 k_acc = k_hi
             # drop the velocities no later output needs; v_buf[0] is always fine index v_start
             drop = min(max(m_pad + k_acc * R - half - v_start, 0), v_buf.shape[0])
@@ -213,21 +215,16 @@ def _run(asm, method, rtol, *, progress, t_end_override=None, step=None, max_ste
     if t_end_override is None and (k_acc != n_out or o_next != n_out):
         raise SolverError(f"scene {scene.name!r}: output incomplete ({k_acc}/{o_next} of {n_out} samples)")
     return dict(acc=acc, disp=disp, fi=fi_all, fo=fo_all, out_t=out_t_all, cage_speed=cage_speed, taps=taps, R=R,
-                acc_z=None if acc_z is None else acc_z[:, 0], disp_z=disp_z, angles=angles,
+                acc_z=acc_z, disp_z=disp_z, angles=angles,
                 m_pad=m_pad, n_out=n_out, stats=stats, dt_f=dt_f, t0=t0, t_end=t_end)
 
 
-def _contact_angles(asm, out_t, out_state):
-    """(2, Z, n) contact angles (deg) at the outer and inner race from output states: positive when
-    the load line leans as under a +Z force on the outer ring (see :mod:`.bearing3d`)."""
-    from .bearing3d import contact_angles, groove_offsets
-    p, z = asm.p, asm.n_balls
-    theta = S.shaft_angles(np.ascontiguousarray(out_t, dtype=float), asm.sp_t, asm.sp_w, asm.sp_th)
-    phis = (p[K.P_PHI0] + p[K.P_FTF] * theta)[:, None] + 2 * np.pi * np.arange(z)[None, :] / z
-    a_i, a_o = groove_offsets(asm.scene.bearing)
-    ao, ai = contact_angles(out_state, phis, zoff=int(p[K.P_ZOFF]), pd=p[K.P_PD], a_i=a_i, a_o=a_o,
-                            multibody=p[K.P_FID] < 0.5, z=z)
-    return np.stack([-ao, -ai])
+def _bearing_model(d, static):
+    """The ``bearing_model`` attribute of a 3-D run: what loads the bearing axially."""
+    pre = float(d["load"].get("axial_preload_um") or 0.0)
+    what = (f"axial displacement preload {pre:g} um ({static['axial_force_n']:.4g} N at the start)" if pre > 0
+            else f"axial load {float(d['load']['axial_n']):g} N")
+    return f"3-D: {what}, contact angles and axial ring motion"
 
 
 def _decimate_acc(res):
@@ -399,8 +396,8 @@ def simulate(scene, *, fidelity: str | None = None, duration: float | None = Non
         "fidelity_requested": sc.fidelity,
         "auto_choice": (choice["reason"] + f"; kind {choice['kind']}; expected peak-acceleration error "
                         f"{choice['expected_peak_error']}") if "auto" in (sc.fidelity, d["solver"]["method"]) else "",
-        "bearing_model": (f"3-D: axial load {float(d['load']['axial_n']):g} N, contact angles and axial ring "
-                          "motion" if res["angles"] is not None else "planar (no axial load)"),
+        "bearing_model": _bearing_model(d, asm.static) if res["angles"] is not None else "planar (no axial load)",
+        **({"axial_force_n": float(asm.static["axial_force_n"])} if res["angles"] is not None else {}),
         "defect_table_top_um": ",".join(f"{1e6 * t.delta_max:.4g}" for t in asm.tables) if asm.tables else "none",
         "defect_table_reach_um": (",".join(f"{1e6 * asm.dflt[k, K.F_REACH]:.4g}" for k in range(len(asm.tables)))
                                   if asm.tables else "none"),

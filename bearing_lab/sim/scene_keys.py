@@ -73,6 +73,11 @@ SCHEMA: dict[str, dict[str, tuple]] = {
         "radial_n": (150.0, _NUM, "nonneg", "radial load magnitude"),
         "axial_n": (0.0, _NUM, "any", "constant axial force on the loaded ring, N, along +Z (a thrust or a "
                     "spring preload); non-zero runs the 3-D bearing (contact angles, axial ring motion)"),
+        "axial_preload_um": (None, _NUM, "nonneg", "displacement preload instead of a force: the loaded ring pushed "
+                             "along +Z relative to the other by this much beyond the point where the axial play "
+                             "is taken up (the balls just touching both grooves); the start solves for the axial "
+                             "force it takes, held by the axial supports (docs/model.md); at most the 0.5 % of "
+                             "D_b normal approach the clearance check allows; not together with axial_n; 0 = none"),
         "direction_deg": (270.0, _NUM, "any", "direction of the force on the ring (270 = -Y, downward)"),
         "on": ("outer", str, ("inner", "outer"), "ring the load is applied to"),
         "path": ("bearing", str, ("bearing", "springs"), "see module docs: who carries the static load"),
@@ -115,7 +120,9 @@ SCHEMA: dict[str, dict[str, tuple]] = {
     "output": {
         "duration_s": (1.0, _NUM, "pos", "recorded duration"),
         "sample_rate_hz": (20000.0, _NUM, "pos", "output rate (as the DAQ: anti-alias filtered)"),
-        "settle_s": (0.02, _NUM, "nonneg", "simulated and discarded before the record starts"),
+        "settle_s": (0.02, _NUM, "nonneg", "simulated and discarded before the record starts (the 3-D bearing: "
+                     "at least 0.03 s, its balls' axial motion damped until 0.01 s before the record; "
+                     "docs/model.md)"),
         "oversample": (8, int, "pos", "internal fine grid = oversample x sample_rate before the anti-alias FIR"),
         "ball_loads": (True, bool, None, "store per-ball contact loads"),
     },
