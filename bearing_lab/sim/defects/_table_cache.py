@@ -69,10 +69,12 @@ def table_key(defect, bearing, **args) -> str:
     the table."""
     from .contact import ABOVE_NODE_STEP, HALFSPACE_NODES
     from .halfspace import COARSE_STEP, REFINE_TOL, SOLVE_TOL, TABLE_CELLS
+    from .halfspace_skewed import INTACT_LATTICE
     payload = {"format": FORMAT, "code": code_fingerprint(), "defect": _plain(defect),
                "bearing": {f: _plain(getattr(bearing, f)) for f in BEARING_FIELDS},
                "args": _plain(args),
-               "halfspace": _plain([HALFSPACE_NODES, ABOVE_NODE_STEP, TABLE_CELLS, SOLVE_TOL, REFINE_TOL, COARSE_STEP])}
+               "halfspace": _plain([HALFSPACE_NODES, ABOVE_NODE_STEP, TABLE_CELLS, SOLVE_TOL, REFINE_TOL,
+                                    COARSE_STEP, INTACT_LATTICE])}
     return hashlib.sha256(json.dumps(payload, sort_keys=True).encode()).hexdigest()
 
 

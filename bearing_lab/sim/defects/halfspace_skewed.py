@@ -37,8 +37,10 @@ import numpy as np
 from .geometry import RaceGeometry
 from .model import Defect
 
-#: odd size of the lattice of the ball's sub-cell offsets on which the intact force is solved
-INTACT_LATTICE = 5
+#: odd sizes of the lattice of the ball's sub-cell offsets on which the intact force is solved:
+#: on grids of at least the tables' cells, and on the coarser Richardson partner (where the force
+#: spreads several times more over the offsets)
+INTACT_LATTICE = (3, 5)
 
 
 @dataclass(frozen=True)
@@ -129,8 +131,11 @@ class IntactForce:
     from the intact pressure ``p0`` at another offset) and read between them by
     trigonometric interpolation, instead of one intact solve per ball position (which
     doubled a table's solves).  On the tables' grids the force spreads by 0.03 % (fine) to
-    0.17 % (coarse) over the offsets; a 5 x 5 lattice reads it within about a quarter of
-    that."""
+    0.17 % (coarse) over the offsets (up to 0.3 % on paper-O2's coarse grids); the lattice
+    (:data:`INTACT_LATTICE`: 3 x 3 on the fine grid, whose solves cost three times the coarse
+    grid's, 5 x 5 on the coarse one) reads it within 1.5e-4 (fine) and 4.6e-4 (coarse) of a
+    solve at the ball's own offset (paper-O2 at 30 and 60 degrees, 5-150 % of the loaded
+    range)."""
 
     def __init__(self, hs, geom: RaceGeometry, skew: float, g: SkewedGrid, delta: float,
                  m: int, tol: float, p0: np.ndarray):
@@ -154,7 +159,8 @@ def ratio_curve_skewed(defect: Defect, geom: RaceGeometry, delta: float, *, cell
     """:func:`.halfspace.ratio_curve` for a rectangle inclined to the track: the same
     returns, computed on the defect-anchored rotated grid.  Ball positions are whole
     numbers of the track-aligned grid's along-track cells from the defect centre."""
-    from .halfspace import HalfSpace, _curve, _refine, _symmetry, e_star_of, intact_contact
+    from .halfspace import (TABLE_CELLS, HalfSpace, _curve, _refine, _symmetry, e_star_of,
+                            intact_contact)
     e_star = e_star_of() if e_star is None else e_star
     base = intact_contact(geom, delta, cells=cells, e_star=e_star, tol=min(tol, 1e-6))
     step = base["grid"].dy
@@ -169,7 +175,8 @@ def ratio_curve_skewed(defect: Defect, geom: RaceGeometry, delta: float, *, cell
     if _symmetry(defect):
         k_lo = max(k_lo, 0)
     solved: dict[int, tuple[float, np.ndarray]] = {}
-    intact = IntactForce(hs, geom, defect.skew, g, delta, INTACT_LATTICE, tol, p_ref)
+    m = INTACT_LATTICE[0] if cells[0] >= TABLE_CELLS[0] else INTACT_LATTICE[1]
+    intact = IntactForce(hs, geom, defect.skew, g, delta, m, tol, p_ref)
     stats = {"solves": intact.solves, "iterations": intact.iterations}
 
     def solve_round(ks, starts):
