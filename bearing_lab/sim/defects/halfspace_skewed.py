@@ -154,20 +154,32 @@ class IntactForce:
         return float((eu @ self.coef @ ev).real)
 
 
+def _intact_diagnostics(defect: Defect, g: SkewedGrid, p: np.ndarray):
+    """Intact force (N) and semi-axes (a across, b along the track; m, from the pressure's
+    moments) of the intact pressure ``p`` on the window of the ball at the defect centre."""
+    from .halfspace import pressure_semi_axes
+    fu, fv = _anchor(defect, g, 0.0)[2:]
+    S, Z = _track_coords(defect.skew, g, fu, fv)
+    c, sn = math.cos(defect.skew), math.sin(defect.skew)
+    # a rotated cell's own second moments across and along the track
+    dz, ds = math.hypot(sn * g.du, c * g.dv), math.hypot(c * g.du, sn * g.dv)
+    return float(p.sum()) * g.du * g.dv, pressure_semi_axes(p, Z, S, dz, ds)
+
+
 def ratio_curve_skewed(defect: Defect, geom: RaceGeometry, delta: float, *, cells, e_star,
                        tol, refine_tol, coarse_step):
     """:func:`.halfspace.ratio_curve` for a rectangle inclined to the track: the same
     returns, computed on the defect-anchored rotated grid.  Ball positions are whole
     numbers of the track-aligned grid's along-track cells from the defect centre."""
-    from .halfspace import (TABLE_CELLS, HalfSpace, _curve, _refine, _symmetry, e_star_of,
-                            intact_contact)
+    from .halfspace import (TABLE_CELLS, HalfSpace, _curve, _refine, _symmetry, contact_grid,
+                            e_star_of)
     e_star = e_star_of() if e_star is None else e_star
-    base = intact_contact(geom, delta, cells=cells, e_star=e_star, tol=min(tol, 1e-6))
-    step = base["grid"].dy
+    step = contact_grid(None, geom, delta, cells).dy
     g = skewed_grid(defect, geom, delta, cells)
     hs = HalfSpace(g.nu, g.nv, g.du, g.dv, e_star)
     g0, _, _ = window(defect, geom, g, 0.0)
     p_ref, _ = hs.solve(g0, delta, tol=tol)
+    force, axes = _intact_diagnostics(defect, g, p_ref)
     b_r = geom.reach(delta)[0]
     s0, s1, _, _ = defect.track_extent()
     k_lo = math.floor((s0 - 1.05 * b_r) / step) - 1
@@ -204,7 +216,7 @@ def ratio_curve_skewed(defect: Defect, geom: RaceGeometry, delta: float, *, cell
 
     _refine(solve_round, solved, p_ref, k_lo, k_hi, coarse_step, refine_tol)
     s_nodes, ratio = _curve(solved, step, defect)
-    info = {"intact_force_n": base["force"], "semi_axes_m": (base["a"], base["b"]),
+    info = {"intact_force_n": force, "semi_axes_m": axes,
             "cells": (g.nu, g.nv), "cell_m": (g.du, g.dv), "aligned": True, "skewed": True,
             **stats}
     return s_nodes, ratio, info
