@@ -114,12 +114,27 @@ def _gap(geom: RaceGeometry, S, Z, depth=0.0):
 def window(defect: Defect, geom: RaceGeometry, g: SkewedGrid, s_ball: float):
     """Intact gap, floor gap (m) and the in-outline mask on the window of cells around the
     ball at track position ``s_ball`` (m from the defect centre); arrays (nu, nv)."""
-    i0, j0, fu, fv = _anchor(defect, g, s_ball)
-    S, Z = _track_coords(defect.skew, g, fu, fv)
-    iu = i0 + np.arange(g.nu)
-    jv = j0 + np.arange(g.nv)
-    ins = ((iu >= 0) & (iu < g.n_u))[:, None] & ((jv >= 0) & (jv < g.n_v))[None, :]
-    return _gap(geom, S, Z), _gap(geom, S, Z, defect.depth), ins
+    gi, gf, ins, _ = windows(defect, geom, g, np.array([s_ball]))
+    return gi[0], gf[0], ins[0]
+
+
+def windows(defect: Defect, geom: RaceGeometry, g: SkewedGrid, s_balls: np.ndarray):
+    """:func:`window` for K ball positions at once (one pass of the gap formula): arrays
+    (K, nu, nv), and the ball's sub-cell offsets (fu, fv) (each (K,), see :func:`_anchor`)."""
+    c, sn = math.cos(defect.skew), math.sin(defect.skew)
+    s_balls = np.asarray(s_balls, dtype=float)
+    xu = ((s_balls * c - defect.offset * sn) + defect.length / 2) / g.du - g.nu / 2
+    xv = ((-s_balls * sn - defect.offset * c) + defect.width / 2) / g.dv - g.nv / 2
+    i0, j0 = np.floor(xu), np.floor(xv)
+    fu, fv = xu - i0, xv - j0
+    dU = (np.arange(g.nu)[None, :] + 0.5 - g.nu / 2 - fu[:, None]) * g.du
+    dV = (np.arange(g.nv)[None, :] + 0.5 - g.nv / 2 - fv[:, None]) * g.dv
+    UU, VV = dU[:, :, None], dV[:, None, :]
+    S, Z = UU * c - VV * sn, UU * sn + VV * c
+    iu = i0[:, None] + np.arange(g.nu)[None, :]
+    jv = j0[:, None] + np.arange(g.nv)[None, :]
+    ins = ((iu >= 0) & (iu < g.n_u))[:, :, None] & ((jv >= 0) & (jv < g.n_v))[:, None, :]
+    return _gap(geom, S, Z), _gap(geom, S, Z, defect.depth), ins, (fu, fv)
 
 
 class IntactForce:
@@ -193,20 +208,20 @@ def ratio_curve_skewed(defect: Defect, geom: RaceGeometry, delta: float, *, cell
 
     def solve_round(ks, starts):
         todo, gaps, p0, f_int = [], [], [], []
-        for k, start in zip(ks, starts):
-            gi, gf, ins = window(defect, geom, g, k * step)
-            ins &= gi < delta
-            if not np.any(ins):
+        gi, gf, ins, (fu, fv) = windows(defect, geom, g, np.asarray(ks) * step)
+        ins &= gi < delta
+        gap = np.where(ins, gf, gi)
+        for i, (k, start) in enumerate(zip(ks, starts)):
+            if not np.any(ins[i]):
                 solved[k] = (1.0, p_ref)
                 continue
-            gap = np.where(ins, gf, gi)
-            if np.all(gap >= delta):
+            if np.all(gap[i] >= delta):
                 solved[k] = (0.0, np.zeros_like(p_ref))
                 continue
             todo.append(k)
-            gaps.append(gap)
+            gaps.append(gap[i])
             p0.append(start)
-            f_int.append(intact(*_anchor(defect, g, k * step)[2:]))
+            f_int.append(intact(fu[i], fv[i]))
         if todo:
             p, its = hs.solve_batch(np.array(gaps), delta, tol=tol, p0=np.array(p0))
             stats["solves"] += len(gaps)
