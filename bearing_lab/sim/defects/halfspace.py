@@ -66,6 +66,10 @@ SOLVE_TOL = 1e-4
 REFINE_TOL = 1e-3
 #: first pass: one ball position every COARSE_STEP cells along the track
 COARSE_STEP = 4
+#: a CG step that moved at most this many cells off the straight step updates the displacement
+#: by direct summation over them instead of a transform; every REFRESH_EVERY-th is transformed
+DIRECT_UPDATE_CELLS = 32
+REFRESH_EVERY = 16
 
 
 def _stable_sum(t, s):
@@ -106,6 +110,7 @@ class HalfSpace:
         full[:nx, self.my - ny + 1:] = k[:, :0:-1]
         full[self.mx - nx + 1:, self.my - ny + 1:] = k[:0:-1, :0:-1]
         self.k00 = float(k[0, 0])          # a cell's displacement under its own pressure
+        self.kern = k                      # for direct sums over a few cells (m/Pa)
         # single precision in the transforms (~1e-7 relative error in the displacement, far
         # below the solver's tolerance) at a third of the cost; the kernel is scaled to
         # order one so that no product falls into float32's subnormal range (~1e-38),
@@ -146,7 +151,7 @@ class HalfSpace:
         arithmetic, dominates on these small grids); each problem keeps its own step
         sizes and stops on its own.
         """
-        from ._halfspace_kernels import cg_direction, cg_step
+        from ._halfspace_kernels import cg_direction, cg_step, update_displacement
         h = np.asarray(gaps, dtype=float)
         allowed = h < approach
         if p0 is None:
@@ -164,11 +169,18 @@ class HalfSpace:
         g_old = np.ones(act.size)
         restart = np.ones(act.size, dtype=bool)
         stalled, exact, done = (np.zeros(act.size, dtype=bool) for _ in range(3))
+        tau, extra = np.zeros(act.size), np.zeros_like(p)
+        n_extra = np.zeros(act.size, dtype=np.int64)
+        u = np.ascontiguousarray(self.displacement(p))
         for it in range(1, maxiter + 1):
-            g = np.ascontiguousarray(self.displacement(p))
+            g = u.copy()
             cg_direction(p, g, hd, t, allowed, restart, g_old, floor, self.k00, stalled, exact)
             r = np.ascontiguousarray(self.displacement(t))
-            cg_step(p, g, t, r, allowed, stalled, exact, restart, tol, done)
+            cg_step(p, g, t, r, allowed, stalled, exact, restart, tol, done, tau, extra, n_extra)
+            # u(p) for the next iteration: updated, unless many cells left the straight step
+            # (or entered while stalled, or the periodic refresh bounds the drift): transformed
+            fresh = stalled | (n_extra > DIRECT_UPDATE_CELLS) | (it % REFRESH_EVERY == 0)
+            update_displacement(u, r, tau, extra, n_extra, self.kern, fresh)
             if np.any(done):
                 out[act[done]] = p[done]
                 iters[act[done]] = it
@@ -176,8 +188,11 @@ class HalfSpace:
                 act, p, t, hd, floor = act[keep], p[keep], t[keep], hd[keep], floor[keep]
                 allowed, g_old, restart = allowed[keep], g_old[keep], restart[keep]
                 stalled, exact, done = stalled[keep], exact[keep], done[keep]
+                u, fresh, tau, extra, n_extra = u[keep], fresh[keep], tau[keep], extra[keep], n_extra[keep]
                 if act.size == 0:
                     break
+            if np.any(fresh):
+                u[fresh] = self.displacement(p[fresh])
         out[act] = p
         return out, iters
 
