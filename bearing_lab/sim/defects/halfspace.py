@@ -285,6 +285,20 @@ def pressure_semi_axes(p: np.ndarray, Z: np.ndarray, S: np.ndarray, dx: float, d
     return math.sqrt(5 * z2), math.sqrt(5 * s2)
 
 
+def hertz_start(hs: HalfSpace, geom: RaceGeometry, gap: np.ndarray, Z: np.ndarray, S: np.ndarray,
+                delta: float) -> np.ndarray:
+    """A start for the intact solve: Hertz's ellipsoidal pressure on the cells (semi-axes of
+    :func:`.geometry.hertz_semi_axes`), scaled to the gap in the least-squares sense.  It
+    saves about a third of the iterations from a uniform start (33 -> 22 at tol 1e-6)."""
+    from .geometry import hertz_semi_axes
+    a, b = hertz_semi_axes(geom, delta)
+    q = np.sqrt(np.maximum(1.0 - (Z / a) ** 2 - (S / b) ** 2, 0.0))
+    u = hs.displacement(q[None])[0]
+    m = q > 0
+    den = float((u[m] ** 2).sum())
+    return q * (float(((delta - gap)[m] * u[m]).sum()) / den) if den > 0 else q
+
+
 def intact_contact(geom: RaceGeometry, delta: float, *, cells=TABLE_CELLS,
                    e_star: float | None = None, tol: float = 1e-8, defect: Defect | None = None):
     """Intact half-space contact at approach ``delta`` on the grid the tables use.
@@ -296,7 +310,7 @@ def intact_contact(geom: RaceGeometry, delta: float, *, cells=TABLE_CELLS,
     grid = contact_grid(defect, geom, delta, cells)
     Z, S, g0, gf = _gaps(geom, grid, 0.0 if defect is None else defect.depth)
     hs = HalfSpace(*grid.shape, grid.dx, grid.dy, e_star)
-    p, it = hs.solve(g0, delta, tol=tol)
+    p, it = hs.solve(g0, delta, tol=tol, p0=hertz_start(hs, geom, g0, Z, S, delta))
     a, b = pressure_semi_axes(p, Z, S, grid.dx, grid.dy)
     return {"force": float(p.sum()) * grid.dx * grid.dy, "a": a, "b": b, "p": p, "grid": grid,
             "Z": Z, "S": S, "gap": g0, "gap_floor": gf, "solver": hs, "iterations": it}

@@ -187,13 +187,14 @@ def ratio_curve_skewed(defect: Defect, geom: RaceGeometry, delta: float, *, cell
     returns, computed on the defect-anchored rotated grid.  Ball positions are whole
     numbers of the track-aligned grid's along-track cells from the defect centre."""
     from .halfspace import (TABLE_CELLS, HalfSpace, _curve, _refine, _symmetry, contact_grid,
-                            e_star_of)
+                            e_star_of, hertz_start)
     e_star = e_star_of() if e_star is None else e_star
     step = contact_grid(None, geom, delta, cells).dy
     g = skewed_grid(defect, geom, delta, cells)
     hs = HalfSpace(g.nu, g.nv, g.du, g.dv, e_star)
     g0, _, _ = window(defect, geom, g, 0.0)
-    p_ref, _ = hs.solve(g0, delta, tol=tol)
+    S0, Z0 = _track_coords(defect.skew, g, *_anchor(defect, g, 0.0)[2:])
+    p_ref, _ = hs.solve(g0, delta, tol=tol, p0=hertz_start(hs, geom, g0, Z0, S0, delta))
     force, axes = _intact_diagnostics(defect, g, p_ref)
     b_r = geom.reach(delta)[0]
     s0, s1, _, _ = defect.track_extent()
