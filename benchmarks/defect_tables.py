@@ -34,8 +34,16 @@ Prints (markdown):
 10. paper-slot's peak acceleration (1 s at 20 and 100 kHz, as a user runs it) with the default
    table and with a converged one (64 x 48 cells, 32 approach nodes per loaded range, and above it
    nodes 1/32 of it apart instead of 1/10).
+11. cold build before/after a change of the table code: per defect of section 9, the
+   "halfspace" table as the simulation builds it (loaded range and above the deepest drop),
+   built by the table code of a git revision (``--before REV``, default the commit before the
+   cheaper-tables work; its ``sim/defects`` modules are extracted into a temporary directory and
+   imported from there, nothing is written to the tree) and by the working tree's: cold CPU
+   time (cache off, one core, numba compiled, minimum of 3), half-space solves, and the largest
+   difference of the carried share G/δ^1.5 over the whole table (every ψ, every δ > 0),
+   relative to the intact contact.
 ``--quick`` skips 3, 7 and 10 (the converged tables take several minutes); ``--range`` runs 9
-only, ``--slot`` 10 only.
+only, ``--slot`` 10 only, ``--before [REV]`` 11 only.
 """
 from __future__ import annotations
 
@@ -274,6 +282,78 @@ def slot_with_converged_table(fs_list=(20_000.0, 100_000.0), duration=1.0) -> No
               f"{build:.1f} |", flush=True)
 
 
+#: the table code before the cheaper-tables work (section 11's default ``--before``)
+BEFORE_REV = "70e2388"
+
+
+def _tables_module_at(rev: str):
+    """The ``sim/defects`` package of git revision ``rev``, imported under another name from a
+    temporary directory (removed at exit), with its numba kernels compiled."""
+    import atexit
+    import importlib
+    import io
+    import shutil
+    import subprocess
+    import tarfile
+    import tempfile
+    from pathlib import Path
+    root = Path(__file__).resolve().parents[1]
+    blob = subprocess.run(["git", "-C", str(root), "archive", rev, "bearing_lab/sim/defects"],
+                          check=True, capture_output=True).stdout
+    tmp = Path(tempfile.mkdtemp(prefix="defects_before_"))
+    atexit.register(shutil.rmtree, tmp, ignore_errors=True)
+    with tarfile.open(fileobj=io.BytesIO(blob)) as tar:
+        tar.extractall(tmp, filter="data")
+    name = f"defects_{rev}"
+    shutil.move(str(tmp / "bearing_lab" / "sim" / "defects"), str(tmp / name))
+    sys.path.insert(0, str(tmp))
+    try:
+        mod = importlib.import_module(f"{name}.contact")
+        importlib.import_module(f"{name}._halfspace_kernels").warm_up()
+    finally:
+        sys.path.remove(str(tmp))
+    return mod
+
+
+def before_after(rev: str = BEFORE_REV) -> None:
+    """Section 11: cold CPU time and share difference, table code of ``rev`` -> working tree."""
+    old = _tables_module_at(rev)
+    print(f"\n## Cold half-space tables, table code of {rev} -> this tree (CPU s, cache off, one core, "
+          "minimum of 3)\n")
+    print("| defect | kind | table (ψ x δ) | solves before / after | CPU s before / after | speed-up "
+          "| largest share difference |")
+    print("|---|---|---|---|---|---|---|")
+    worst = 0.0
+    for label, name, ov in RANGE_CASES:
+        sc = load_scene(name, **ov)
+        d, b = sc.defects[0], sc.bearing
+        dmax = assemble(sc).tables[0].info["loaded_range_m"]
+        mat = sc.data["material"]
+        kw = dict(model="halfspace", clearance=sc.clearance, delta_max=dmax, above_drop=dmax,
+                  material=(mat["youngs_modulus_gpa"] * 1e9, mat["poisson_ratio"]), cache=False)
+
+        def cold(fn, memory):
+            best, out = math.inf, None
+            for _ in range(3):
+                memory.clear()
+                c = time.process_time()
+                out = fn()
+                best = min(best, time.process_time() - c)
+            return best, out
+        t_b, Tb = cold(lambda: old.contact_table(d, b, **kw), old._MEMORY)
+        t_a, Ta = cold(lambda: contact_table(d, b, **kw), _MEMORY)
+        assert Ta.G.shape == Tb.G.shape and np.array_equal(Ta.delta, Tb.delta)
+        d15 = Ta.delta[1:] ** 1.5
+        diff = float(np.max(np.abs(Ta.G[:, 1:] - Tb.G[:, 1:]) / d15))
+        worst = max(worst, diff)
+        kind = ("slot" if d.width > 10 * d.length else "skewed" if d.skew % (math.pi / 2) else
+                "pit" if name.startswith("cwru") else "aligned")
+        print(f"| {label} | {kind} | {Ta.G.shape[0]} x {Ta.G.shape[1]} | "
+              f"{Tb.info.get('halfspace_solves', 0)} / {Ta.info.get('halfspace_solves', 0)} | "
+              f"{t_b:.3f} / {t_a:.3f} | {t_b / t_a:.1f}x | {diff:.5f} |", flush=True)
+    print(f"\nlargest share difference over every table: {worst:.5f} of the intact load")
+
+
 def main(quick: bool = False) -> None:
     warm_up()
     drops()
@@ -287,7 +367,11 @@ def main(quick: bool = False) -> None:
 
 
 if __name__ == "__main__":
-    if "--range" in sys.argv:
+    if "--before" in sys.argv:
+        warm_up()
+        i = sys.argv.index("--before")
+        before_after(sys.argv[i + 1] if len(sys.argv) > i + 1 else BEFORE_REV)
+    elif "--range" in sys.argv:
         warm_up()
         table_range()
     elif "--slot" in sys.argv:

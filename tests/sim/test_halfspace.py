@@ -110,10 +110,11 @@ def test_skewed_share_against_brute_force_boussinesq(skewed_table, s_ball):
 
 @pytest.mark.parametrize("cells", [(32, 24), (16, 12)])
 def test_skewed_intact_force_read_from_its_offset_lattice(cells):
-    """The intact force on the rotated window, read from the 5 x 5 lattice of ball offsets,
-    against direct solves at 16 other offsets (each from scratch): within 0.3 of the force's spread over the
-    offsets (a single solve, m = 1, misses by about the spread itself), and the spread is
-    a real one (> 1e-4 of the force), so the check can tell."""
+    """The intact force on the rotated window, read from the lattice of ball offsets the tables
+    use on that grid (3 x 3 on the tables' cells, 5 x 5 on the coarse Richardson partner), against
+    direct solves at 16 other offsets (each from scratch): within 0.4 (3 x 3) or 0.3 (5 x 5) of the
+    force's spread over the offsets (a single solve, m = 1, misses by about the spread itself), and the spread
+    is a real one (> 1e-4 of the force), so the check can tell."""
     from bearing_lab.sim.defects import halfspace_skewed as hsk
     from bearing_lab.sim.defects.halfspace import SOLVE_TOL, HalfSpace, e_star_of
     geom = RaceGeometry.from_bearing(B6308, "outer")
@@ -126,11 +127,13 @@ def test_skewed_intact_force_read_from_its_offset_lattice(cells):
     p0, offsets, direct = direct[0], offsets[1:], direct[1:].sum(axis=(1, 2))
     spread = np.ptp(direct) / direct.mean()
     assert spread > 1e-4
+    lattice = hsk.INTACT_LATTICE[0] if cells == (32, 24) else hsk.INTACT_LATTICE[1]
     err = {}
-    for m in (1, hsk.INTACT_LATTICE):
+    for m in (1, lattice):
         force = hsk.IntactForce(hs, geom, d.skew, g, delta, m, SOLVE_TOL, p0)
         err[m] = np.abs([force(*o) for o in offsets] - direct).max() / direct.mean()
-    assert err[hsk.INTACT_LATTICE] < 0.3 * spread
+    # measured: 0.30 of the spread (3 x 3, 1.0e-4 of the force), 0.15 (5 x 5)
+    assert err[lattice] < (0.4 if lattice == 3 else 0.3) * spread
     assert err[1] > 0.5 * spread
 
 

@@ -49,7 +49,7 @@ tested cases).  The ball stays on the track centre line (z = 0), so at H = B/2 t
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 import math
 
 import numpy as np
@@ -67,6 +67,8 @@ class RaceGeometry:
     ball_radius: float      # r_b
     groove_radius: float    # r_g = f * D_b
     track_radius: float     # R, groove-bottom radius
+    #: reach() by approach (a cache, not part of the geometry)
+    _reach_memo: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     @classmethod
     def from_bearing(cls, bearing, race: str, *, clearance: float = 0.0) -> "RaceGeometry":
@@ -138,12 +140,21 @@ class RaceGeometry:
     def reach(self, delta: float) -> tuple[float, float]:
         """(along, across) half-extents (m) of the region where h < delta, exact torus.
 
-        Found by bisection on the axes (h is monotone along each axis from the ball).
+        Found by bisection on the axes (h is monotone along each axis from the ball), until
+        the midpoint is one of the ends (the interval is then a float's width: more steps
+        change nothing).  Remembered per approach: a table asks for the same ones often.
         """
+        key = float(delta)
+        hit = self._reach_memo.get(key)
+        if hit is not None:
+            return hit
+
         def solve(f, hi):
             lo = 0.0
             for _ in range(100):
                 mid = 0.5 * (lo + hi)
+                if mid <= lo or mid >= hi:
+                    break
                 if f(mid) < delta:
                     lo = mid
                 else:
@@ -152,6 +163,8 @@ class RaceGeometry:
         along = solve(lambda s: float(self.approach(s / self.track_radius, 0.0)),
                       0.5 * math.pi * self.track_radius)
         across = solve(lambda z: float(self.approach(0.0, z)), self.z_limit)
+        if len(self._reach_memo) < 4096:
+            self._reach_memo[key] = (along, across)
         return along, across
 
 

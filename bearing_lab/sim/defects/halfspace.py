@@ -66,6 +66,10 @@ SOLVE_TOL = 1e-4
 REFINE_TOL = 1e-3
 #: first pass: one ball position every COARSE_STEP cells along the track
 COARSE_STEP = 4
+#: a CG step that moved at most this many cells off the straight step updates the displacement
+#: by direct summation over them instead of a transform; every REFRESH_EVERY-th is transformed
+DIRECT_UPDATE_CELLS = 32
+REFRESH_EVERY = 16
 
 
 def _stable_sum(t, s):
@@ -106,6 +110,7 @@ class HalfSpace:
         full[:nx, self.my - ny + 1:] = k[:, :0:-1]
         full[self.mx - nx + 1:, self.my - ny + 1:] = k[:0:-1, :0:-1]
         self.k00 = float(k[0, 0])          # a cell's displacement under its own pressure
+        self.kern = k                      # for direct sums over a few cells (m/Pa)
         # single precision in the transforms (~1e-7 relative error in the displacement, far
         # below the solver's tolerance) at a third of the cost; the kernel is scaled to
         # order one so that no product falls into float32's subnormal range (~1e-38),
@@ -146,7 +151,7 @@ class HalfSpace:
         arithmetic, dominates on these small grids); each problem keeps its own step
         sizes and stops on its own.
         """
-        from ._halfspace_kernels import cg_direction, cg_step
+        from ._halfspace_kernels import cg_direction, cg_step, update_displacement
         h = np.asarray(gaps, dtype=float)
         allowed = h < approach
         if p0 is None:
@@ -164,11 +169,18 @@ class HalfSpace:
         g_old = np.ones(act.size)
         restart = np.ones(act.size, dtype=bool)
         stalled, exact, done = (np.zeros(act.size, dtype=bool) for _ in range(3))
+        tau, extra = np.zeros(act.size), np.zeros_like(p)
+        n_extra = np.zeros(act.size, dtype=np.int64)
+        u = np.ascontiguousarray(self.displacement(p))
         for it in range(1, maxiter + 1):
-            g = np.ascontiguousarray(self.displacement(p))
+            g = u.copy()
             cg_direction(p, g, hd, t, allowed, restart, g_old, floor, self.k00, stalled, exact)
             r = np.ascontiguousarray(self.displacement(t))
-            cg_step(p, g, t, r, allowed, stalled, exact, restart, tol, done)
+            cg_step(p, g, t, r, allowed, stalled, exact, restart, tol, done, tau, extra, n_extra)
+            # u(p) for the next iteration: updated, unless many cells left the straight step
+            # (or entered while stalled, or the periodic refresh bounds the drift): transformed
+            fresh = stalled | (n_extra > DIRECT_UPDATE_CELLS) | (it % REFRESH_EVERY == 0)
+            update_displacement(u, r, tau, extra, n_extra, self.kern, fresh)
             if np.any(done):
                 out[act[done]] = p[done]
                 iters[act[done]] = it
@@ -176,8 +188,11 @@ class HalfSpace:
                 act, p, t, hd, floor = act[keep], p[keep], t[keep], hd[keep], floor[keep]
                 allowed, g_old, restart = allowed[keep], g_old[keep], restart[keep]
                 stalled, exact, done = stalled[keep], exact[keep], done[keep]
+                u, fresh, tau, extra, n_extra = u[keep], fresh[keep], tau[keep], extra[keep], n_extra[keep]
                 if act.size == 0:
                     break
+            if np.any(fresh):
+                u[fresh] = self.displacement(p[fresh])
         out[act] = p
         return out, iters
 
@@ -270,6 +285,20 @@ def pressure_semi_axes(p: np.ndarray, Z: np.ndarray, S: np.ndarray, dx: float, d
     return math.sqrt(5 * z2), math.sqrt(5 * s2)
 
 
+def hertz_start(hs: HalfSpace, geom: RaceGeometry, gap: np.ndarray, Z: np.ndarray, S: np.ndarray,
+                delta: float) -> np.ndarray:
+    """A start for the intact solve: Hertz's ellipsoidal pressure on the cells (semi-axes of
+    :func:`.geometry.hertz_semi_axes`), scaled to the gap in the least-squares sense.  It
+    saves about a third of the iterations from a uniform start (33 -> 22 at tol 1e-6)."""
+    from .geometry import hertz_semi_axes
+    a, b = hertz_semi_axes(geom, delta)
+    q = np.sqrt(np.maximum(1.0 - (Z / a) ** 2 - (S / b) ** 2, 0.0))
+    u = hs.displacement(q[None])[0]
+    m = q > 0
+    den = float((u[m] ** 2).sum())
+    return q * (float(((delta - gap)[m] * u[m]).sum()) / den) if den > 0 else q
+
+
 def intact_contact(geom: RaceGeometry, delta: float, *, cells=TABLE_CELLS,
                    e_star: float | None = None, tol: float = 1e-8, defect: Defect | None = None):
     """Intact half-space contact at approach ``delta`` on the grid the tables use.
@@ -281,7 +310,7 @@ def intact_contact(geom: RaceGeometry, delta: float, *, cells=TABLE_CELLS,
     grid = contact_grid(defect, geom, delta, cells)
     Z, S, g0, gf = _gaps(geom, grid, 0.0 if defect is None else defect.depth)
     hs = HalfSpace(*grid.shape, grid.dx, grid.dy, e_star)
-    p, it = hs.solve(g0, delta, tol=tol)
+    p, it = hs.solve(g0, delta, tol=tol, p0=hertz_start(hs, geom, g0, Z, S, delta))
     a, b = pressure_semi_axes(p, Z, S, grid.dx, grid.dy)
     return {"force": float(p.sum()) * grid.dx * grid.dy, "a": a, "b": b, "p": p, "grid": grid,
             "Z": Z, "S": S, "gap": g0, "gap_floor": gf, "solver": hs, "iterations": it}

@@ -37,8 +37,10 @@ import numpy as np
 from .geometry import RaceGeometry
 from .model import Defect
 
-#: odd size of the lattice of the ball's sub-cell offsets on which the intact force is solved
-INTACT_LATTICE = 5
+#: odd sizes of the lattice of the ball's sub-cell offsets on which the intact force is solved:
+#: on grids of at least the tables' cells, and on the coarser Richardson partner (where the force
+#: spreads several times more over the offsets)
+INTACT_LATTICE = (3, 5)
 
 
 @dataclass(frozen=True)
@@ -112,12 +114,27 @@ def _gap(geom: RaceGeometry, S, Z, depth=0.0):
 def window(defect: Defect, geom: RaceGeometry, g: SkewedGrid, s_ball: float):
     """Intact gap, floor gap (m) and the in-outline mask on the window of cells around the
     ball at track position ``s_ball`` (m from the defect centre); arrays (nu, nv)."""
-    i0, j0, fu, fv = _anchor(defect, g, s_ball)
-    S, Z = _track_coords(defect.skew, g, fu, fv)
-    iu = i0 + np.arange(g.nu)
-    jv = j0 + np.arange(g.nv)
-    ins = ((iu >= 0) & (iu < g.n_u))[:, None] & ((jv >= 0) & (jv < g.n_v))[None, :]
-    return _gap(geom, S, Z), _gap(geom, S, Z, defect.depth), ins
+    gi, gf, ins, _ = windows(defect, geom, g, np.array([s_ball]))
+    return gi[0], gf[0], ins[0]
+
+
+def windows(defect: Defect, geom: RaceGeometry, g: SkewedGrid, s_balls: np.ndarray):
+    """:func:`window` for K ball positions at once (one pass of the gap formula): arrays
+    (K, nu, nv), and the ball's sub-cell offsets (fu, fv) (each (K,), see :func:`_anchor`)."""
+    c, sn = math.cos(defect.skew), math.sin(defect.skew)
+    s_balls = np.asarray(s_balls, dtype=float)
+    xu = ((s_balls * c - defect.offset * sn) + defect.length / 2) / g.du - g.nu / 2
+    xv = ((-s_balls * sn - defect.offset * c) + defect.width / 2) / g.dv - g.nv / 2
+    i0, j0 = np.floor(xu), np.floor(xv)
+    fu, fv = xu - i0, xv - j0
+    dU = (np.arange(g.nu)[None, :] + 0.5 - g.nu / 2 - fu[:, None]) * g.du
+    dV = (np.arange(g.nv)[None, :] + 0.5 - g.nv / 2 - fv[:, None]) * g.dv
+    UU, VV = dU[:, :, None], dV[:, None, :]
+    S, Z = UU * c - VV * sn, UU * sn + VV * c
+    iu = i0[:, None] + np.arange(g.nu)[None, :]
+    jv = j0[:, None] + np.arange(g.nv)[None, :]
+    ins = ((iu >= 0) & (iu < g.n_u))[:, :, None] & ((jv >= 0) & (jv < g.n_v))[:, None, :]
+    return _gap(geom, S, Z), _gap(geom, S, Z, defect.depth), ins, (fu, fv)
 
 
 class IntactForce:
@@ -129,8 +146,11 @@ class IntactForce:
     from the intact pressure ``p0`` at another offset) and read between them by
     trigonometric interpolation, instead of one intact solve per ball position (which
     doubled a table's solves).  On the tables' grids the force spreads by 0.03 % (fine) to
-    0.17 % (coarse) over the offsets; a 5 x 5 lattice reads it within about a quarter of
-    that."""
+    0.17 % (coarse) over the offsets (up to 0.3 % on paper-O2's coarse grids); the lattice
+    (:data:`INTACT_LATTICE`: 3 x 3 on the fine grid, whose solves cost three times the coarse
+    grid's, 5 x 5 on the coarse one) reads it within 1.5e-4 (fine) and 4.6e-4 (coarse) of a
+    solve at the ball's own offset (paper-O2 at 30 and 60 degrees, 5-150 % of the loaded
+    range)."""
 
     def __init__(self, hs, geom: RaceGeometry, skew: float, g: SkewedGrid, delta: float,
                  m: int, tol: float, p0: np.ndarray):
@@ -149,19 +169,33 @@ class IntactForce:
         return float((eu @ self.coef @ ev).real)
 
 
+def _intact_diagnostics(defect: Defect, g: SkewedGrid, p: np.ndarray):
+    """Intact force (N) and semi-axes (a across, b along the track; m, from the pressure's
+    moments) of the intact pressure ``p`` on the window of the ball at the defect centre."""
+    from .halfspace import pressure_semi_axes
+    fu, fv = _anchor(defect, g, 0.0)[2:]
+    S, Z = _track_coords(defect.skew, g, fu, fv)
+    c, sn = math.cos(defect.skew), math.sin(defect.skew)
+    # a rotated cell's own second moments across and along the track
+    dz, ds = math.hypot(sn * g.du, c * g.dv), math.hypot(c * g.du, sn * g.dv)
+    return float(p.sum()) * g.du * g.dv, pressure_semi_axes(p, Z, S, dz, ds)
+
+
 def ratio_curve_skewed(defect: Defect, geom: RaceGeometry, delta: float, *, cells, e_star,
                        tol, refine_tol, coarse_step):
     """:func:`.halfspace.ratio_curve` for a rectangle inclined to the track: the same
     returns, computed on the defect-anchored rotated grid.  Ball positions are whole
     numbers of the track-aligned grid's along-track cells from the defect centre."""
-    from .halfspace import HalfSpace, _curve, _refine, _symmetry, e_star_of, intact_contact
+    from .halfspace import (TABLE_CELLS, HalfSpace, _curve, _refine, _symmetry, contact_grid,
+                            e_star_of, hertz_start)
     e_star = e_star_of() if e_star is None else e_star
-    base = intact_contact(geom, delta, cells=cells, e_star=e_star, tol=min(tol, 1e-6))
-    step = base["grid"].dy
+    step = contact_grid(None, geom, delta, cells).dy
     g = skewed_grid(defect, geom, delta, cells)
     hs = HalfSpace(g.nu, g.nv, g.du, g.dv, e_star)
     g0, _, _ = window(defect, geom, g, 0.0)
-    p_ref, _ = hs.solve(g0, delta, tol=tol)
+    S0, Z0 = _track_coords(defect.skew, g, *_anchor(defect, g, 0.0)[2:])
+    p_ref, _ = hs.solve(g0, delta, tol=tol, p0=hertz_start(hs, geom, g0, Z0, S0, delta))
+    force, axes = _intact_diagnostics(defect, g, p_ref)
     b_r = geom.reach(delta)[0]
     s0, s1, _, _ = defect.track_extent()
     k_lo = math.floor((s0 - 1.05 * b_r) / step) - 1
@@ -169,25 +203,26 @@ def ratio_curve_skewed(defect: Defect, geom: RaceGeometry, delta: float, *, cell
     if _symmetry(defect):
         k_lo = max(k_lo, 0)
     solved: dict[int, tuple[float, np.ndarray]] = {}
-    intact = IntactForce(hs, geom, defect.skew, g, delta, INTACT_LATTICE, tol, p_ref)
+    m = INTACT_LATTICE[0] if cells[0] >= TABLE_CELLS[0] else INTACT_LATTICE[1]
+    intact = IntactForce(hs, geom, defect.skew, g, delta, m, tol, p_ref)
     stats = {"solves": intact.solves, "iterations": intact.iterations}
 
     def solve_round(ks, starts):
         todo, gaps, p0, f_int = [], [], [], []
-        for k, start in zip(ks, starts):
-            gi, gf, ins = window(defect, geom, g, k * step)
-            ins &= gi < delta
-            if not np.any(ins):
+        gi, gf, ins, (fu, fv) = windows(defect, geom, g, np.asarray(ks) * step)
+        ins &= gi < delta
+        gap = np.where(ins, gf, gi)
+        for i, (k, start) in enumerate(zip(ks, starts)):
+            if not np.any(ins[i]):
                 solved[k] = (1.0, p_ref)
                 continue
-            gap = np.where(ins, gf, gi)
-            if np.all(gap >= delta):
+            if np.all(gap[i] >= delta):
                 solved[k] = (0.0, np.zeros_like(p_ref))
                 continue
             todo.append(k)
-            gaps.append(gap)
+            gaps.append(gap[i])
             p0.append(start)
-            f_int.append(intact(*_anchor(defect, g, k * step)[2:]))
+            f_int.append(intact(fu[i], fv[i]))
         if todo:
             p, its = hs.solve_batch(np.array(gaps), delta, tol=tol, p0=np.array(p0))
             stats["solves"] += len(gaps)
@@ -197,7 +232,7 @@ def ratio_curve_skewed(defect: Defect, geom: RaceGeometry, delta: float, *, cell
 
     _refine(solve_round, solved, p_ref, k_lo, k_hi, coarse_step, refine_tol)
     s_nodes, ratio = _curve(solved, step, defect)
-    info = {"intact_force_n": base["force"], "semi_axes_m": (base["a"], base["b"]),
+    info = {"intact_force_n": force, "semi_axes_m": axes,
             "cells": (g.nu, g.nv), "cell_m": (g.du, g.dv), "aligned": True, "skewed": True,
             **stats}
     return s_nodes, ratio, info
