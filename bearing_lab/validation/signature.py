@@ -133,19 +133,28 @@ def impact_signature(x, fs, times, *, band, window_s=WINDOW_S, period=None) -> S
                      None if period is None else float(period))
 
 
+def _inside(sim, meas) -> np.ndarray:
+    """The samples a misfit compares: one period around the impact when either signature knows its
+    period (:data:`ONE_PERIOD`), else the whole window."""
+    periods = [p for p in (sim.period_s, meas.period_s) if p]
+    if not periods:
+        return np.ones(meas.time.size, bool)
+    p = min(periods)
+    return (meas.time > ONE_PERIOD[0] * p) & (meas.time < ONE_PERIOD[1] * p)
+
+
 def _logs(sim, meas, floor):
-    """The two log-envelopes, each normalised to its peak and clipped at ``floor``; NaN outside one period
-    around the impact when either signature knows its period."""
+    """The two log-envelopes, each normalised to its peak and clipped at ``floor``.  When either signature
+    knows its period, only one period around the impact counts: the peaks are taken there and the
+    samples outside are NaN."""
     if sim.time.size != meas.time.size:
         raise AnalysisError("impact signature misfit: the two signatures have different windows")
-    a = 20 * np.log10(np.maximum(sim.envelope / max(sim.peak, 1e-300), floor))
-    b = 20 * np.log10(np.maximum(meas.envelope / max(meas.peak, 1e-300), floor))
-    periods = [p for p in (sim.period_s, meas.period_s) if p]
-    if periods:
-        p = min(periods)
-        out = (meas.time <= ONE_PERIOD[0] * p) | (meas.time >= ONE_PERIOD[1] * p)
-        a, b = np.where(out, np.nan, a), np.where(out, np.nan, b)
-    return a, b
+    inside = _inside(sim, meas)
+    out = []
+    for sig in (sim, meas):
+        peak = max(float(np.max(sig.envelope[inside])), 1e-300)
+        out.append(np.where(inside, 20 * np.log10(np.maximum(sig.envelope / peak, floor)), np.nan))
+    return out[0], out[1]
 
 
 def _shifted(la, lb, s):
@@ -193,7 +202,9 @@ def misfit(sim: Signature, meas: Signature, *, level_weight=1.0, level_tolerance
                                 f"signature {lb.size}")
         lb = lb + r
     fs = 1.0 / float(sim.time[1] - sim.time[0])
-    level = 20.0 * np.log10(max(sim.peak, 1e-300) / max(meas.peak, 1e-300))
+    inside = _inside(sim, meas)
+    level = 20.0 * np.log10(max(float(np.max(sim.envelope[inside])), 1e-300)
+                            / max(float(np.max(meas.envelope[inside])), 1e-300))
     best, lag = _best_lag(la, lb, int(round(max_lag_s * fs)))
     score = float(best + level_weight * max(abs(level) - level_tolerance_db, 0.0))
     return {"score_db": score, "shape_db": best, "level_db": float(level), "lag_s": lag / fs}
