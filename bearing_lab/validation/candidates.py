@@ -97,12 +97,12 @@ def _level_weight(prep, path, level_weight):
     return 1.0, f"the structural path is independent of this recording ({path.source})"
 
 
-def _halves_noise(x, fs, times, band):
+def _halves_noise(x, fs, times, band, period=None):
     """Misfit between the signatures of the odd and the even impacts: the score's own noise."""
     if times.size < 6:
         return float("nan")
-    a = impact_signature(x, fs, times[0::2], band=band)
-    b = impact_signature(x, fs, times[1::2], band=band)
+    a = impact_signature(x, fs, times[0::2], band=band, period=period)
+    b = impact_signature(x, fs, times[1::2], band=band, period=period)
     return float(misfit(a, b, level_weight=1.0)["score_db"])
 
 
@@ -156,7 +156,7 @@ def setting_for(prep, path, background, *, level_weight=None, band_hz=None, seed
     x = prep.recording.segment(prep.n)
     times = impact_times(x, prep.fs, period, band=band)
     try:
-        meas = impact_signature(x, prep.fs, times, band=band)
+        meas = impact_signature(x, prep.fs, times, band=band, period=period)
     except AnalysisError as exc:
         raise ValidationCaseError(f"validation case {prep.case.name!r}: {exc}") from None
     w, why = _level_weight(prep, path, level_weight)
@@ -172,7 +172,7 @@ def setting_for(prep, path, background, *, level_weight=None, band_hz=None, seed
     residual, note = _path_residual(prep, path, meas)
     notes += [note] if note else []
     return Setting(prep, path, background, period, band, meas, w, why, tol,
-                   _halves_noise(x, prep.fs, times, band), seed, notes, residual)
+                   _halves_noise(x, prep.fs, times, band, period), seed, notes, residual)
 
 
 def _path_residual(prep, path, meas) -> tuple:
@@ -198,7 +198,7 @@ def candidate_signature(setting: Setting, x):
     if setting.background is not None:
         y = y + setting.background.synthesize(y.size, seed=setting.seed)
     times = impact_times(y, prep.fs, setting.period_s, band=setting.band_hz)
-    return impact_signature(y, prep.fs, times, band=setting.band_hz, window_s=WINDOW_S)
+    return impact_signature(y, prep.fs, times, band=setting.band_hz, window_s=WINDOW_S, period=setting.period_s)
 
 
 def score_candidates(prep, path, background, candidates: dict, *, level_weight=None, band_hz=None) -> dict:

@@ -115,8 +115,8 @@ def _shape_residual(path, trial, x, bg, rec, fs, period, band):
     from ..analysis.impacts import impact_times
     from .signature import impact_signature, shape_residual
     y = trial.apply(x, fs) + bg
-    sim = impact_signature(y, fs, impact_times(y, fs, period, band=band), band=band)
-    meas = impact_signature(rec.x, fs, impact_times(rec.x, fs, period, band=band), band=band)
+    sim = impact_signature(y, fs, impact_times(y, fs, period, band=band), band=band, period=period)
+    meas = impact_signature(rec.x, fs, impact_times(rec.x, fs, period, band=band), band=band, period=period)
     r = shape_residual(sim, meas)
     path.fit["signature_residual_db"] = [float(v) for v in r]
     path.fit["signature_residual_fs_hz"] = float(fs)
