@@ -129,7 +129,7 @@ def resolve(scene) -> dict:
     kind = scene_kind(scene, defects)
     rules = load_rules()
     rule = rules.get(kind) or (rules.get("defect") if kind == "defect-slow" else None)
-    fid = (rule or DEFAULT)["fidelity"]
+    fid = (rule or DEFAULT).get("fidelity", DEFAULT["fidelity"])
     if scene.fidelity == "auto" and fid != DEFAULT["fidelity"] and track.startswith("3-D"):
         defects, track = track_defects(scene, fid)
         kind = scene_kind(scene, defects)
