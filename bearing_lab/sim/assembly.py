@@ -259,6 +259,31 @@ def _track_offset(defect, st, race, psi0, bearing):
     return dataclasses.replace(defect, offset=turn(defect.offset)), alpha
 
 
+def race_contacts(scene):
+    """The Hertz contacts (inner, outer) of the scene's bearing and material."""
+    b, mat = scene.bearing, scene.data["material"]
+    kw = dict(contact_angle=b.contact_angle, youngs_modulus=mat["youngs_modulus_gpa"] * 1e9,
+              poisson_ratio=mat["poisson_ratio"])
+    return (race_contact(b.ball_diameter, b.pitch_diameter, b.inner_conformity, "inner", **kw),
+            race_contact(b.ball_diameter, b.pitch_diameter, b.outer_conformity, "outer", **kw))
+
+
+def static_3d(scene: Scene, fid: str) -> dict:
+    """The 3-D bearing's static equilibrium at the start of a run of fidelity ``fid`` (cage with a
+    ball at the load-zone centre, at the starting speed): the one :func:`assemble` starts from and
+    the one ``fidelity``/``solver.method = "auto"`` decide the contact track on.  Solved once per
+    scene and fidelity and kept on the scene (a scene is not changed after it is built)."""
+    cache = scene.__dict__.setdefault("_static_3d", {})
+    if fid not in cache:
+        hi, ho = race_contacts(scene)
+        _, rpm = scene.speed_profile()
+        omega_c0 = scene.bearing.frequency_factors()["ftf"] * rpm[0] * 2 * math.pi / 60
+        cache[fid] = static_equilibrium_3d(scene, load_zone_angle(scene), hi.stiffness, ho.stiffness,
+                                           ball_mass=0.0 if fid == "quasi-static" else scene.masses()[2],
+                                           omega_cage=omega_c0, exponent=scene.data["contact"]["exponent"])
+    return cache[fid]
+
+
 def _defect_tables(scene: Scene, lz: float, delta_max: float, material, delta_top=None, st3d=None):
     """Each defect's contact table, packed for the kernels: a ball defect gets one table per
     race it meets.  Returns (models, tables, entries, dint, dflt, hbuf, gbuf, table_time_s)."""
@@ -473,10 +498,7 @@ def assemble(scene: Scene, *, fidelity: str | None = None, delta_top=None) -> As
     z = b.n_balls
     mat = d["material"]
     E, nu = mat["youngs_modulus_gpa"] * 1e9, mat["poisson_ratio"]
-    hi = race_contact(b.ball_diameter, b.pitch_diameter, b.inner_conformity, "inner",
-                      contact_angle=b.contact_angle, youngs_modulus=E, poisson_ratio=nu)
-    ho = race_contact(b.ball_diameter, b.pitch_diameter, b.outer_conformity, "outer",
-                      contact_angle=b.contact_angle, youngs_modulus=E, poisson_ratio=nu)
+    hi, ho = race_contacts(scene)
     k_eff = series_stiffness(hi.stiffness, ho.stiffness)
     m_i, m_o, m_b = scene.masses()
     ftf = b.frequency_factors()["ftf"]
@@ -495,9 +517,7 @@ def assemble(scene: Scene, *, fidelity: str | None = None, delta_top=None) -> As
                              "only (its balls' traction and pocket forces are planar). Set cage.model = "
                              "'kinematic' to keep the axial load, or remove the axial load to run the dynamic "
                              "cage in the planar bearing")
-        st = static_equilibrium_3d(scene, phi_c0, hi.stiffness, ho.stiffness,
-                                   ball_mass=0.0 if fid == "quasi-static" else m_b, omega_cage=omega_c0,
-                                   exponent=d["contact"]["exponent"])
+        st = static_3d(scene, fid)
     else:
         st = static_equilibrium(scene, phi_c0, hi.stiffness, ho.stiffness,
                                 ball_mass=0.0 if fid == "quasi-static" else m_b, omega_cage=omega_c0,

@@ -7,7 +7,10 @@ that stayed within 1 % peak-acceleration and 0.1 % period error against a conver
 reference on EVERY bench scene of its kind:
 
 - ``healthy``: no defect, or every defect misses the ball track (no defect geometry is
-  built then);
+  built then).  The track is the one the scene runs on: the groove bottom in the planar model;
+  under an axial load or preload (the 3-D model) the track at the static contact angle, where
+  each race defect is met as its contact table sees it (turned across the groove by that
+  angle), so a defect the displaced track leaves is missed and one it moves onto is struck;
 - ``defect-slow``: a defect at shaft speeds up to the slow bench scene's (300 r/min);
 - ``defect``: any other defect.
 
@@ -24,8 +27,11 @@ for a kind the conservative default is used (multibody, dp54, rtol 1e-5).
 from __future__ import annotations
 
 from functools import lru_cache
+import math
 from pathlib import Path
 import tomllib
+
+import numpy as np
 
 RULES_FILE = Path(__file__).with_name("auto_rules.toml")
 DEFAULT = {"fidelity": "multibody", "method": "dp54", "rtol": 1e-5, "max_step_s": 2.5e-5,
@@ -44,8 +50,57 @@ def load_rules() -> dict:
 MISS_DELTA = 20e-6  # an approach no bench scene reaches: beyond it a defect cannot be touched
 
 
-def scene_kind(scene) -> str:
-    if all(d.misses_track(scene.bearing, MISS_DELTA, clearance=scene.clearance) for d in scene.defects):
+def _track_3d(scene, fid):
+    """(each defect as the 3-D contact track meets it, what the track is): a race defect turned across
+    the groove by the static contact angle at its position, as its contact table is built
+    (:func:`.assembly._track_offset`); a ball defect as it is."""
+    from ..errors import BearingLabError, SolverError
+    from .assembly import _track_offset, load_zone_angle, static_3d
+    from .bearing3d import groove_offsets
+    from .defects.geometry import RaceGeometry
+    try:
+        with np.errstate(all="ignore"):
+            st = static_3d(scene, fid)
+    except (ValueError, ArithmeticError, RuntimeError) as exc:
+        if isinstance(exc, BearingLabError):
+            raise
+        raise SolverError(f"scene {scene.name!r}: no 3-D static equilibrium found to place the contact track "
+                          f"({type(exc).__name__}: {exc})") from exc
+    b, lz = scene.bearing, load_zone_angle(scene)
+    out, parts = [], []
+    for k, d in enumerate(scene.defects):
+        if d.race == "ball":
+            out.append(d)
+            parts.append(f"defect {k} (ball): as on the planar track")
+            continue
+        met, alpha = _track_offset(d, st, d.race, lz + d.angle, b)
+        r_g = groove_offsets(b)[0 if d.race == "inner" else 1] + b.ball_diameter / 2
+        gap = max(float(RaceGeometry.from_bearing(b, d.race, clearance=scene.clearance)
+                        .approach(0.0, met.min_abs_axial())), 0.0)
+        parts.append(f"defect {k} ({d.race}): contact angle {math.degrees(alpha):.2f} deg, track "
+                     f"{r_g * math.sin(alpha) * 1e3:+.3f} mm across the groove from its bottom, the defect's "
+                     f"nearest point {met.min_abs_axial() * 1e3:.3f} mm from the track ({gap * 1e6:.3g} um "
+                     f"from the ball: {'missed' if gap >= MISS_DELTA else 'met'} at {MISS_DELTA * 1e6:g} um)")
+        out.append(met)
+    return out, f"3-D contact track at the static contact angles ({fid}): " + "; ".join(parts)
+
+
+def track_defects(scene, fid=None):
+    """(the defects as the scene's contact track meets them, which track): the planar track (groove
+    bottom) for a planar scene; for a 3-D scene (axial load or preload) the track at the static
+    contact angles of fidelity ``fid`` (default: the scene's, multibody for "auto")."""
+    from .bearing3d import needs_3d
+    if not scene.defects or not needs_3d(scene):
+        return scene.defects, "planar contact track (groove bottom)"
+    fid = fid or (scene.fidelity if scene.fidelity != "auto" else DEFAULT["fidelity"])
+    return _track_3d(scene, fid)
+
+
+def scene_kind(scene, defects=None) -> str:
+    """The rule kind; ``defects`` as the contact track meets them (:func:`track_defects`; default:
+    the scene's, on the groove bottom)."""
+    defects = scene.defects if defects is None else defects
+    if all(d.misses_track(scene.bearing, MISS_DELTA, clearance=scene.clearance) for d in defects):
         return "healthy"
     return "defect-slow" if scene.nominal_rpm <= SLOW_RPM else "defect"
 
@@ -65,10 +120,20 @@ def rate_rule(rule: dict, fs: float) -> tuple[dict, str]:
 
 
 def resolve(scene) -> dict:
-    """The settings auto picks for ``scene``: fidelity, method, rtol, max_step_s, kind, reason."""
-    kind = scene_kind(scene)
+    """The settings auto picks for ``scene``: fidelity, method, rtol, max_step_s, kind, reason, track.
+
+    The kind is decided on the contact track the scene runs on (:func:`track_defects`); with
+    ``fidelity = "auto"`` the 3-D track is that of the rule's fidelity (decided again on it if the
+    rule's fidelity is not the one first assumed)."""
+    defects, track = track_defects(scene)
+    kind = scene_kind(scene, defects)
     rules = load_rules()
     rule = rules.get(kind) or (rules.get("defect") if kind == "defect-slow" else None)
+    fid = (rule or DEFAULT).get("fidelity", DEFAULT["fidelity"])
+    if scene.fidelity == "auto" and fid != DEFAULT["fidelity"] and track.startswith("3-D"):
+        defects, track = track_defects(scene, fid)
+        kind = scene_kind(scene, defects)
+        rule = rules.get(kind) or (rules.get("defect") if kind == "defect-slow" else None)
     out = dict(DEFAULT)
     if rule:
         rule, how = rate_rule(rule, float(scene.fs_out))
@@ -79,4 +144,5 @@ def resolve(scene) -> dict:
     else:
         out["reason"] = f"no measured rule for '{kind}': conservative default"
     out["kind"] = kind
+    out["track"] = track
     return out

@@ -394,8 +394,9 @@ def simulate(scene, *, fidelity: str | None = None, duration: float | None = Non
         "solver_rtol": float(rtol_),
         "solver_max_step_s": float(max_step),
         "fidelity_requested": sc.fidelity,
-        "auto_choice": (choice["reason"] + f"; kind {choice['kind']}; expected peak-acceleration error "
-                        f"{choice['expected_peak_error']}") if "auto" in (sc.fidelity, d["solver"]["method"]) else "",
+        "auto_choice": (choice["reason"] + f"; kind {choice['kind']}, decided on the {choice['track']}; expected "
+                        f"peak-acceleration error {choice['expected_peak_error']}")
+        if "auto" in (sc.fidelity, d["solver"]["method"]) else "",
         "bearing_model": _bearing_model(d, asm.static) if res["angles"] is not None else "planar (no axial load)",
         **({"axial_force_n": float(asm.static["axial_force_n"])} if res["angles"] is not None else {}),
         "defect_table_top_um": ",".join(f"{1e6 * t.delta_max:.4g}" for t in asm.tables) if asm.tables else "none",

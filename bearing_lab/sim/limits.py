@@ -80,15 +80,23 @@ def _check_supports(scene) -> None:
 
 
 def warn_off_track(scene) -> None:
-    """A defect the balls never touch makes a healthy bearing: say so (a 5 for a 0.5?)."""
-    from .auto import MISS_DELTA
+    """A defect the balls never touch makes a healthy bearing: say so (a 5 for a 0.5?).  Judged on
+    the track the scene runs on (:func:`.auto.track_defects`: under an axial load, the 3-D track at
+    the static contact angle; a 3-D start that is not found is reported by the run, not here)."""
+    from ..errors import BearingLabError
+    from .auto import MISS_DELTA, track_defects
     from .scene import SceneWarning
-    for i, defect in enumerate(scene.defects):
+    try:
+        defects, track = track_defects(scene)
+    except BearingLabError:
+        return
+    for i, defect in enumerate(defects):
         if not defect.misses_track(scene.bearing, MISS_DELTA, clearance=scene.clearance):
             continue
         where = "defect" if len(scene.defects) == 1 else f"defect[{i}]"
         raw = scene.data["defect"][i]
-        warnings.warn(f"{where} misses the ball track: no part of it comes within reach of the "
+        on = "" if track.startswith("planar") else " at the contact angle of the axial load"
+        warnings.warn(f"{where} misses the ball track{on}: no part of it comes within reach of the "
                       f"balls (offset_mm={raw.get('offset_mm', 0)}, width_mm="
                       f"{raw.get('width_mm', '-')}, skew_deg={raw.get('skew_deg', 0)}), so "
                       "this simulates a healthy bearing; check defect.offset_mm",
