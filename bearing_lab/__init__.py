@@ -21,7 +21,7 @@ name at import (a check that they all exist).
 """
 import lazy_loader as _lazy
 
-__version__ = "0.1.0"
+from ._version import __version__
 
 _SUBPACKAGES = ["analysis", "datasets", "io", "report", "sim", "validation"]
 __getattr__, __dir__, __all__ = _lazy.attach(

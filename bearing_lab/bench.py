@@ -32,6 +32,7 @@ import numpy as np
 import xarray as xr
 
 from ._files import savefig, write_text
+from ._version import __version__
 from .sim import load_scene
 from .sim.assembly import assemble
 from .sim.integrate import METHODS, _decimate_acc, _run, _warm_up, anti_alias_taps
@@ -337,7 +338,7 @@ def run_bench(out_dir="reports/performance", *, duration=0.3, scipy_duration=0.1
                      "reference": f"multibody + {REF_CONTACT} contact, dp54 rtol 1e-9, max step 2e-6 s",
                      "reference_self_check": repr(notes), "tolerance_peak": TOL_PEAK,
                      "tolerance_period": TOL_PERIOD, "sampling_rate_hz": 0.0,
-                     "bearing_lab_version": __import__("bearing_lab").__version__})
+                     "bearing_lab_version": __version__})
     from .io_netcdf import write_netcdf
     write_netcdf(ds, out / "performance.nc")
     rules = _rules(rows)

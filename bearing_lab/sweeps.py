@@ -64,7 +64,7 @@ import uuid
 
 import numpy as np
 
-from . import __version__
+from ._version import __version__
 from .errors import BearingLabError, SceneError
 from ._sweep_store import (CacheWarning, _checksum_path, _from_cache, _METRIC_SIGNAL, _METRICS,  # noqa: F401
                            _Stack, _write_cache)

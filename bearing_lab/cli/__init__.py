@@ -18,6 +18,7 @@ import importlib
 import io
 import sys
 
+from .._version import __version__
 from ..errors import BearingLabError
 
 # one line per command module; a module registers one or more sub-commands
@@ -49,7 +50,6 @@ def build_parser() -> argparse.ArgumentParser:
                "prints results) prints them as JSON; an existing -o file is kept unless --force. Exit status: "
                "0 done; 1 a result that fails (validate: a row fails unexplained; see its --help); 2 bad "
                "input, said in one line on stderr.")
-    from .. import __version__
     parser.add_argument("--version", action="version", version=f"bearing_lab {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     for name in COMMAND_MODULES:

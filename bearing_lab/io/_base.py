@@ -50,6 +50,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._version import __version__
 from ..errors import BearingLabError, RecordingError
 from .. import units as _units
 
@@ -460,8 +461,6 @@ class RecordingBuilder:
         data : an mmap/bytes of the whole file to hash (avoids reading it again).
         channels : channel selection (see :meth:`select`).
         """
-        from .. import __version__
-
         if isinstance(self.units, dict):
             extra = set(self.units) - self._used_units
             if extra:

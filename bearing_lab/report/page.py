@@ -6,6 +6,7 @@ import json
 import re
 from pathlib import Path
 
+from .._version import __version__
 from ..errors import check_choice
 from .html import (css, esc, figure_html, kv_html, notice_html, rows_table, table_html, template,
                    index_rows)
@@ -15,11 +16,6 @@ __all__ = ["Report", "write_index"]
 
 def _now() -> str:
     return _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M:%S UTC")
-
-
-def _version() -> str:
-    from .. import __version__
-    return __version__
 
 
 def _anchor(title: str, used: set) -> str:
@@ -137,7 +133,7 @@ class Report:
             title=esc(self.title), subtitle=esc(self.subtitle), css=css(), toc=" ".join(toc),
             sections="\n".join(secs), n_pass=n_pass, n_rows=len(self.rows), status_class=cls, status_text=text,
             known=f" ({n_known} failing as limitations the case declares)" if n_known else "", date=_now(),
-            version=_version())
+            version=__version__)
 
     def save(self, path, *, overwrite=True):
         """Write ``.html`` (self-contained page) or ``.json`` (sections, rows, info: reloadable), atomically."""
@@ -175,7 +171,7 @@ def write_index(path, entries: list, *, title="bearing_lab validation", notes=()
     """
     from .._files import atomic_open
     notes_html = "".join(f'<p class="note">{esc(n)}</p>' for n in notes)
-    page = template("index.html").substitute(title=esc(title), css=css(), date=_now(), version=_version(),
+    page = template("index.html").substitute(title=esc(title), css=css(), date=_now(), version=__version__,
                                               rows=index_rows(entries), notes=notes_html,
                                               verdicts=opening)
     path = Path(path)

@@ -25,6 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._version import __version__
 from ..errors import BearingLabError, RecordingError
 
 __all__ = ["StandIn", "make_standin_recording", "default_tones", "FORMATS"]
@@ -71,7 +72,6 @@ def _write_testlab_mat(path, x, fs, channel):
 
 def _dataset(x, fs, channel, hidden):
     import xarray as xr
-    from .. import __version__
     t = np.arange(x.size) / fs
     return xr.Dataset({channel: ("time", x, {"units": "m s-2", "quantity": "acceleration", "original_units": "m/s2",
                                              "long_name": "housing acceleration (stand-in)"})},
