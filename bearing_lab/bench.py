@@ -37,7 +37,6 @@ from .sim import load_scene
 from .sim.assembly import assemble
 from .sim.integrate import METHODS, _decimate_acc, _run, _warm_up, anti_alias_taps
 
-G0 = 9.80665
 TOL_PEAK = 0.01
 TOL_PERIOD = 0.001
 #: the defect-contact model of the reference and of the solver rows (the default); the

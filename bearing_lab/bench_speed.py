@@ -28,6 +28,8 @@ import time
 
 import numpy as np
 
+from .units import G
+
 TOL_PEAK = 0.01
 TOL_PERIOD = 0.001
 
@@ -202,7 +204,7 @@ def default_cost(label, base, ov, *, duration=1.0, repeats=3):
                        method=ds.attrs["solver_method"], rtol=float(ds.attrs["solver_rtol"]),
                        fidelity=ds.attrs["fidelity"], steps=int(ds.attrs["solver_steps"]),
                        rejected=int(ds.attrs["solver_rejected_steps"]),
-                       peak_g=float(np.max(np.abs(ds.outer_ring_acc_y.values))) / 9.80665)
+                       peak_g=float(np.max(np.abs(ds.outer_ring_acc_y.values))) / G)
             if best is None or row["loop_cpu_s_per_s"] < best["loop_cpu_s_per_s"]:
                 best = row
     finally:

@@ -27,11 +27,10 @@ import xarray as xr
 
 from .analysis.impacts import impact_times, impulse_strength  # noqa: F401  (older import path)
 from .analysis.measurement import measure  # noqa: F401  (older import path)
+from .units import G
 
-__all__ = ["compare", "ComparisonResult", "align_by_impulse_phase", "shift", "table_dataset", "G0",
+__all__ = ["compare", "ComparisonResult", "align_by_impulse_phase", "shift", "table_dataset",
            "measure", "impact_times", "impulse_strength", "apply_sensor", "sensor_response"]
-
-G0 = 9.80665
 
 _TEXT_KEYS = ("quantity", "label", "units", "tolerance", "rule", "reason", "known_limitation", "declared_by",
               "note", "reference_label", "simulated_signal", "experiment_span", "status")
@@ -145,7 +144,7 @@ class ComparisonResult:
         """Waveforms on the common time base (impacts aligned); ``window_s`` (start, stop)."""
         ax = self._ax(ax)
         ds = self.dataset
-        scale = G0 if acceleration_units == "g" else 1.0
+        scale = G if acceleration_units == "g" else 1.0
         t = ds["time"].values
         sel = slice(None)
         if window_s is not None:
@@ -164,7 +163,7 @@ class ComparisonResult:
         """Amplitude spectra on the common frequency axis."""
         ax = self._ax(ax)
         ds = self.dataset
-        scale = G0 if acceleration_units == "g" else 1.0
+        scale = G if acceleration_units == "g" else 1.0
         f = ds["frequency"].values
         sel = f <= (fmax or f[-1])
         for s in signals or list(ds["signal"].values):

@@ -42,6 +42,8 @@ import warnings
 
 import numpy as np
 
+from ..units import G
+
 VERDICTS = ("ok", "renamed", "refused", "uncaught", "silent", "invalid", "crash", "hang", "memory")
 BAD = ("uncaught", "silent", "invalid", "crash", "hang", "memory")
 
@@ -114,7 +116,7 @@ def _build_wav(mirror: Path, tmp: Path) -> Path:
     import scipy.io.wavfile
     from . import open_recording
     ds = open_recording(mirror / "cwru" / "130_OR007@6_0.mat")
-    x = np.stack([ds["DE"].values, ds["FE"].values], axis=1)[:40000] / 9.80665 / 10.0
+    x = np.stack([ds["DE"].values, ds["FE"].values], axis=1)[:40000] / G / 10.0
     p = tmp / "cwru130_de_fe.wav"
     scipy.io.wavfile.write(p, 12000, np.round(np.clip(x, -1, 1) * 32767).astype(np.int16))
     return p
@@ -144,7 +146,7 @@ def _build_testlab_text(mirror: Path, tmp: Path) -> Path:
     head = ("Name\tRun 1\nProject\tIMS set 2\nSection\tSection1\nIncrement\t"
             f"{1.0 / ds.attrs['sampling_rate_hz']:.10g}\n" + "b1\tb2\ng\tg\nReal\tReal\n")
     rows = "\n".join(f"{a:.6f}\t{b:.6f}".replace(".", ",") for a, b in
-                     zip(ds["b1"].values[:3000] / 9.80665, ds["b2"].values[:3000] / 9.80665))
+                     zip(ds["b1"].values[:3000] / G, ds["b2"].values[:3000] / G))
     p = tmp / "ims_export.txt"
     p.write_bytes((head + rows + "\n").encode("latin-1"))
     return p

@@ -28,13 +28,13 @@ import warnings
 
 import numpy as np
 
+from ..units import G
 from . import _fuzz
 from ._fuzz import _Worker, _exception_verdict, _limit_address_space, _scratch
 
 STRUCT_KINDS = ("mat5", "v73", "netcdf", "wav", "uff", "special")
 STRUCT_VERDICTS = ("ok", "refused", "unverified", "uncaught", "silent", "invalid", "crash", "hang",
                    "refcrash")
-G = 9.80665
 
 
 def _field(rng, fields: dict):

@@ -48,7 +48,8 @@ import numpy as np
 
 from ..bearings import BearingGeometry, CATALOG, get_bearing
 from ..errors import SceneError, check_choice
-from .scene_keys import _NUM, DEFECT_KEYS, G0, SCHEMA, STEEL_DENSITY  # noqa: F401  (the table of scene keys)
+from ..units import G
+from .scene_keys import _NUM, DEFECT_KEYS, SCHEMA, STEEL_DENSITY  # noqa: F401  (the table of scene keys)
 
 
 #: the shortest settling time of a scene with an axial load (the 3-D bearing), s
@@ -72,7 +73,7 @@ _UNITS = {
     "mass": {"kg": 1.0, "g": 1e-3},
     "pressure": {"gpa": 1.0, "pa": 1e-9, "mpa": 1e-3},
     "density": {"kg/m3": 1.0, "kg/m^3": 1.0},
-    "acceleration": {"m/s2": 1.0, "m/s^2": 1.0, "g": G0},
+    "acceleration": {"m/s2": 1.0, "m/s^2": 1.0, "g": G},
 }
 # unit kind and the scale of the key's own unit in that kind's base unit
 _SUFFIX = {

@@ -14,9 +14,10 @@ from pathlib import Path
 
 import numpy as np
 
+from ..units import G as G0
+
 __all__ = ["landscape", "figures", "write_identification", "add_to_case_report"]
 
-G0 = 9.80665
 _VARS = {"score_db": "misfit score (shape + weight x |level|)",
          "shape_db": "shape misfit (RMS log-envelope difference)",
          "level_db": "level: 20 log10(simulated / measured signature peak)"}
