@@ -32,7 +32,7 @@ def _write_cache(ds, path: Path) -> None:
     ~0.12 s per 1 s scene, a third of its simulation, to save a third of 3.5 MB), then its
     checksum file ``<hash>.nc.sha256`` (``sha256sum -c`` format).  Both are written
     atomically; an entry without its checksum is incomplete and is never read."""
-    from ._files import atomic_open, atomic_path, sha256_file
+    from .utils._files import atomic_open, atomic_path, sha256_file
     path.parent.mkdir(parents=True, exist_ok=True)
     out = ds.copy(deep=False)
     out.attrs = {k: (int(v) if isinstance(v, (bool, np.bool_)) else "" if v is None else v)
@@ -70,7 +70,7 @@ def _read_cache(path: Path, digest: str, expect: dict):
     (a damaged file never reaches the C library), then the content is validated.
     """
     import xarray as xr
-    from ._files import sha256_file
+    from .utils._files import sha256_file
     if not path.is_file():
         return None, None
     sums = _checksum_path(path)

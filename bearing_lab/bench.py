@@ -22,8 +22,6 @@ tolerance per kind of scene, which ``fidelity = "auto"`` reads when it is copied
 """
 from __future__ import annotations
 
-import base64
-import io
 import math
 from pathlib import Path
 import time
@@ -31,11 +29,11 @@ import time
 import numpy as np
 import xarray as xr
 
-from ._files import savefig, write_text
 from ._version import __version__
 from .sim import load_scene
 from .sim.assembly import assemble
 from .sim.integrate import METHODS, _decimate_acc, _run, _warm_up, anti_alias_taps
+from .utils._files import savefig, write_text
 
 TOL_PEAK = 0.01
 TOL_PERIOD = 0.001
@@ -407,14 +405,8 @@ def _rules(rows) -> str:
     return "\n".join(lines)
 
 
-def _png(fig):
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=90)
-    return base64.b64encode(buf.getvalue()).decode()
-
-
 def _report(out, rows, notes, speed_md=""):
-    from .figures import new_figure
+    from .utils.figures import figure_png, new_figure
     scenes = list(dict.fromkeys(r["scene"] for r in rows))
     html = ["<!DOCTYPE html><html><head><meta charset='utf-8'><title>bearing_lab: speed against error"
             "</title><style>body{font-family:sans-serif;max-width:1100px;margin:auto}table{border-collapse:"
@@ -460,7 +452,7 @@ def _report(out, rows, notes, speed_md=""):
         if best:
             html.append(f"<p><b>Fastest within tolerance:</b> {best['fidelity']}, {best['contact']}, "
                         f"{best['setting']}: {best['cost']:.4f} s/s, peak error {best['err_peak']:.2e}</p>")
-        html.append(f"<img src='data:image/png;base64,{_png(fig)}'>")
+        html.append(f"<img src='data:image/png;base64,{figure_png(fig, dpi=90)}'>")
         html.append("<table><tr><th>fidelity</th><th>contact</th><th>setting</th><th>s/s</th><th>peak err</th>"
                     "<th>RMS err</th><th>period err</th><th>duration err</th></tr>")
         for r in sorted(rs, key=lambda r: r["cost"]):

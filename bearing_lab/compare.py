@@ -211,7 +211,7 @@ class ComparisonResult:
     # ---- save / load
     def to_netcdf(self, path):
         """Write the Dataset (atomically: a crash leaves the old file or none)."""
-        from ._files import atomic_path
+        from .utils._files import atomic_path
         from .io_netcdf import write_netcdf
         with atomic_path(path) as tmp:
             write_netcdf(self.dataset, tmp)

@@ -2,7 +2,7 @@
 
 Why one writer: every ``.nc`` bearing_lab writes must survive a failure, a kill or a
 second process writing the same name (the file is written beside the target and
-renamed over it in one step, :func:`bearing_lab._files.atomic_path`), must carry
+renamed over it in one step, :func:`bearing_lab.utils._files.atomic_path`), must carry
 checksums (HDF5's Fletcher-32 on every numeric chunk, so a damaged chunk cannot be
 read as data), and must read back bit for bit.
 """
@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from . import _xarray  # noqa: F401  (xarray writes without importing dask)
-from ._files import atomic_path
+from .utils._files import atomic_path
 from .errors import BearingLabError
 
 

@@ -37,8 +37,6 @@ Measurement (the same everywhere):
 """
 from __future__ import annotations
 
-import base64
-import io
 import math
 from pathlib import Path
 import time
@@ -46,9 +44,9 @@ import time
 import numpy as np
 import xarray as xr
 
-from ._files import savefig, write_text
-from .figures import new_figure
 from .units import G
+from .utils._files import savefig, write_text
+from .utils.figures import figure_png, new_figure
 
 STUDY_FS = 100_000.0
 
@@ -291,12 +289,6 @@ def _table(rows, total):
                "measurement": __doc__.split("Measurement (the same everywhere):")[1].strip()})
 
 
-def _png(fig) -> str:
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=90)
-    return base64.b64encode(buf.getvalue()).decode()
-
-
 def _findings(s, rs):
     """One paragraph of numbers for study s (rows rs in order): what changes and why."""
     def seq(key, fmt):
@@ -349,8 +341,8 @@ def _write_html(out, names, rows, figs):
                          f"<td>{r['min_intact']:.3f}</td><td>{r['contact_model']}</td></tr>")
         parts.append("</table>")
         parts.append(f"<p>{_findings(s, rs)}</p>")
-        parts.append(f"<img src='data:image/png;base64,{_png(figs[s])}'>")
+        parts.append(f"<img src='data:image/png;base64,{figure_png(figs[s], dpi=90)}'>")
     parts.append("<h2>Mechanism</h2>")
-    parts.append(f"<img src='data:image/png;base64,{_png(figs['mechanism'])}'>")
+    parts.append(f"<img src='data:image/png;base64,{figure_png(figs['mechanism'], dpi=90)}'>")
     parts.append("</body></html>")
     write_text(out / "index.html", "\n".join(parts))

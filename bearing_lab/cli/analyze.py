@@ -204,7 +204,7 @@ def run(args) -> int:
               f"finite (the largest |value| is {np.max(np.abs(x)):.3g} {units}): reported as null",
               file=sys.stderr)
     if args.json:
-        from .._json import dumps
+        from ..utils._json import dumps
         print(dumps(result, indent=1))  # no NaN/Infinity tokens: strict parsers read it
         return 0
     if args.quiet:

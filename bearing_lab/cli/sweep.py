@@ -46,7 +46,7 @@ def _sweep(args) -> int:
     write_netcdf(ds, out)
     dims = " x ".join(f"{d}={ds.sizes[d]}" for d in ds.attrs["sweep_dims"].split())
     if args.json:
-        from .._json import dumps
+        from ..utils._json import dumps
         print(dumps({"file": str(out), "dims": {d: ds.sizes[d] for d in ds.attrs["sweep_dims"].split()},
                      **{k: ds.attrs[k] for k in ("sweep_n_scenes", "sweep_computed", "sweep_cache_hits",
                                                  "sweep_wall_time_s", "sweep_scheduler")}}, indent=1))

@@ -164,7 +164,7 @@ def to_uff58b(ds, path, *, channels=None, units: str = "si", id1=None, id2=None,
         out.append("".join(text).encode("utf-8"))
         out.append(y.astype(bo_char + "f8").tobytes())
         out.append(b"%6i\n" % -1)
-    from .._files import atomic_open
+    from ..utils._files import atomic_open
     try:
         with atomic_open(path, "wb") as fh:  # an existing file survives any failure
             for chunk in out:

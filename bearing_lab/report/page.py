@@ -69,7 +69,7 @@ class Report:
         """A :class:`~bearing_lab.compare.ComparisonResult`: its table, and its figures."""
         self.add_rows(result.rows, title, intro=intro, tags=tags)
         if figures:
-            from ..figures import new_figure
+            from ..utils.figures import new_figure
             fig = new_figure(figsize=(10, 9), layout="constrained")
             axes = fig.subplots(3, 1)
             result.plot_waveforms(ax=axes[0], window_s=(0, 0.1))
@@ -137,7 +137,7 @@ class Report:
 
     def save(self, path, *, overwrite=True):
         """Write ``.html`` (self-contained page) or ``.json`` (sections, rows, info: reloadable), atomically."""
-        from .._files import atomic_open
+        from ..utils._files import atomic_open
         path = Path(path)
         if path.exists() and not overwrite:
             raise FileExistsError(f"{path} exists (pass overwrite=True)")
@@ -169,7 +169,7 @@ def write_index(path, entries: list, *, title="bearing_lab validation", notes=()
     (relative, or None), ``reason`` (for skipped or errored cases); optionally ``verdict``,
     ``verdict_text`` and ``declared_by``.  ``opening``: HTML shown above the table.
     """
-    from .._files import atomic_open
+    from ..utils._files import atomic_open
     notes_html = "".join(f'<p class="note">{esc(n)}</p>' for n in notes)
     page = template("index.html").substitute(title=esc(title), css=css(), date=_now(), version=__version__,
                                               rows=index_rows(entries), notes=notes_html,

@@ -13,7 +13,7 @@ __all__ = ["waveforms", "spectra", "envelope_spectra", "structural_path", "psd_o
 
 
 def _fig(h=3.2, n=1, w=10):
-    from ..figures import new_figure
+    from ..utils.figures import new_figure
     fig = new_figure(figsize=(w, h * n), layout="constrained")
     return fig, fig.subplots(n, 1, squeeze=False)[:, 0]
 

@@ -126,15 +126,15 @@ def add_to_case_report(result, case_dir):
 
 
 def write_identification(result, out, *, report=False) -> dict:
-    from .._files import atomic_open
-    from .._json import clean
+    from ..utils._files import atomic_open
+    from ..utils._json import clean
     from ..report import Report
     d = Path(out) / result.case
     d.mkdir(parents=True, exist_ok=True)
     paths = {"json": d / "identification.json", "nc": d / "identification.nc", "html": d / "identification.html"}
     with atomic_open(paths["json"], "w", encoding="utf-8") as fh:
         json.dump(clean(result.to_dict()), fh, indent=1, allow_nan=False)
-    from .._files import atomic_path
+    from ..utils._files import atomic_path
     with atomic_path(paths["nc"]) as tmp:
         landscape(result).to_netcdf(tmp)
     rep = Report(f"{result.case}: defect identification")

@@ -158,7 +158,7 @@ def run_paper_case(case, out_dir, *, steps):
     result = compare(signals, fs, rows, n=n, ses_fmax=1000.0,
                      attrs={"case": case.name, "kind": "paper", "bpfo_hz": kin["bpfo"], "bpfi_hz": kin["bpfi"],
                             "shaft_hz": rpm / 60.0})
-    from .._files import sha256_bytes
+    from ..utils._files import sha256_bytes
     prov["reference file sha256"] = sha256_bytes(case.data["_reference_text"].encode("utf-8"))
     sections = [("rows", "Comparison table", {"rows": rows, "show_reference": True, "show_paper": True, "intro": (
         "Experiment: what the paper measured. Reference: the kinematic value at the paper's stated speed (not "

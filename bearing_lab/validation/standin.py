@@ -152,7 +152,7 @@ def make_standin_recording(path, *, scene="paper-O2", overrides=None, rpm=1793.0
 
 
 def _write(path, ds, x, fs, channel):
-    from .._files import atomic_path
+    from ..utils._files import atomic_path
     from ..io import to_uff58b
     try:
         with atomic_path(path) as tmp:
@@ -179,7 +179,7 @@ def make_sample_recording(path) -> Path:
     import tempfile
 
     import xarray as xr
-    from .._files import atomic_path
+    from ..utils._files import atomic_path
     from ..io import to_uff58b
     s = SAMPLE
     with tempfile.TemporaryDirectory() as tmp:

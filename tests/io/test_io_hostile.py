@@ -386,7 +386,7 @@ def test_long_output_name_up_to_the_limit(tmp_path, datafile, capsys):
 def test_stale_temporaries_of_long_names_are_found(tmp_path):
     """The cut-and-hashed temporary prefix is the same in every process, so a killed writer's
     temporary of a long name is removed by the next write."""
-    from bearing_lab import _files
+    from bearing_lab.utils import _files
     name = "b" * 250 + ".nc"
     stale = tmp_path / (_files._tmp_prefix(name, ".nc").replace(f"-{os.getpid()}.", "-4194303.")
                         + "zzzzzzzz.nc")
