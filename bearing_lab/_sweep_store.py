@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from .errors import BearingLabError, SceneError
+from .io.export import checksum_path as _checksum_path, to_netcdf
 from .schema import DEFAULT_CHANNEL
 
 _METRICS = ("rms", "peak", "crest_factor", "kurtosis")   # the analysis METRICS stored per scene
@@ -23,28 +24,16 @@ class CacheWarning(UserWarning):
 
 
 # ---------------------------------------------------------------- the cache
-def _checksum_path(path: Path) -> Path:
-    return path.with_name(path.name + ".sha256")
-
-
 def _write_cache(ds, path: Path) -> None:
     """Write one scene to the cache: netCDF4, float64 as is, *uncompressed* (zlib costs
     ~0.12 s per 1 s scene, a third of its simulation, to save a third of 3.5 MB), then its
     checksum file ``<hash>.nc.sha256`` (``sha256sum -c`` format).  Both are written
     atomically; an entry without its checksum is incomplete and is never read."""
-    from .utils._files import atomic_open, atomic_path, sha256_file
     path.parent.mkdir(parents=True, exist_ok=True)
-    out = ds.copy(deep=False)
-    out.attrs = {k: (int(v) if isinstance(v, (bool, np.bool_)) else "" if v is None else v)
-                 for k, v in ds.attrs.items()}
     try:
-        with atomic_path(path) as tmp:
-            out.to_netcdf(tmp, engine="netcdf4", format="NETCDF4")
-            digest = sha256_file(tmp)
-        with atomic_open(_checksum_path(path), "w") as fh:
-            fh.write(f"{digest}  {path.name}\n")
-    except (OSError, ValueError, RuntimeError) as exc:
-        raise BearingLabError(f"sweep: cannot write the cache file {path}: {exc}") from None
+        to_netcdf(ds, path, complevel=0, checksum_file=True, error=BearingLabError)
+    except BearingLabError as exc:
+        raise BearingLabError(f"sweep cache: {exc}") from None
 
 
 def _cache_problem(ds, digest: str, expect: dict) -> str | None:

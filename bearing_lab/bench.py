@@ -336,8 +336,9 @@ def run_bench(out_dir="reports/performance", *, duration=0.3, scipy_duration=0.1
                      "reference_self_check": repr(notes), "tolerance_peak": TOL_PEAK,
                      "tolerance_period": TOL_PERIOD, "sampling_rate_hz": 0.0,
                      "bearing_lab_version": __version__})
-    from .io_netcdf import write_netcdf
-    write_netcdf(ds, out / "performance.nc")
+    from .errors import BearingLabError
+    from .io.export import to_netcdf
+    to_netcdf(ds, out / "performance.nc", error=BearingLabError)
     rules = _rules(rows)
     if rates:
         rate_rows = run_rate_study(out, duration=rate_duration, scenes=scenes, progress=progress)

@@ -211,11 +211,9 @@ class ComparisonResult:
     # ---- save / load
     def to_netcdf(self, path):
         """Write the Dataset (atomically: a crash leaves the old file or none)."""
-        from .utils._files import atomic_path
-        from .io_netcdf import write_netcdf
-        with atomic_path(path) as tmp:
-            write_netcdf(self.dataset, tmp)
-        return path
+        from .errors import BearingLabError
+        from .io.export import to_netcdf
+        return to_netcdf(self.dataset, path, error=BearingLabError)
 
     @classmethod
     def load(cls, path) -> "ComparisonResult":

@@ -214,8 +214,9 @@ def run_paper_studies(out_dir="reports/studies", *, progress=True, studies=None)
     for name, fig in figs.items():
         savefig(fig, out / f"{name}.png", dpi=110 if name != "mechanism" else 100)
     table = _table(rows, time.perf_counter() - t0)
-    from .io_netcdf import write_netcdf
-    write_netcdf(table, out / "studies.nc")
+    from .errors import BearingLabError
+    from .io.export import to_netcdf
+    to_netcdf(table, out / "studies.nc", error=BearingLabError)
     _write_html(out, names, rows, figs)
     return table
 

@@ -16,7 +16,9 @@ from __future__ import annotations
 import argparse
 import importlib
 import io
+import os
 import sys
+from pathlib import Path
 
 from .._version import __version__
 from ..errors import BearingLabError
@@ -40,6 +42,26 @@ class _Parser(argparse.ArgumentParser):
 
     def error(self, message):
         self.exit(2, f"{self.prog}: error: {message}\n")
+
+
+def check_output_path(text: str, *, force: bool = False, suffixes=(".nc", ".nc4")) -> Path:
+    """The CLI's ``-o FILE``: refuse a wrong suffix, a missing directory or (without ``force``) an
+    existing file before any work."""
+    out = Path(text)
+    if out.suffix not in suffixes:
+        what = "a netCDF file ending in .nc" if ".nc" in suffixes else "a file ending in " + " or ".join(suffixes)
+        raise BearingLabError(f"-o {text}: the output must be {what}")
+    if not out.parent.exists():
+        raise BearingLabError(f"-o {text}: directory {out.parent} does not exist")
+    size = len(os.fsencode(out.name))
+    if size > 255:
+        raise BearingLabError(f"-o {text}: the file name has {size} bytes; a file name has at most "
+                              "255")
+    if out.is_dir():
+        raise BearingLabError(f"-o {text}: is a directory; give a file name ending in {suffixes[0]}")
+    if out.exists() and not force:
+        raise BearingLabError(f"-o {text}: exists; pass --force to overwrite it")
+    return out
 
 
 def build_parser() -> argparse.ArgumentParser:

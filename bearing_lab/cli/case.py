@@ -41,7 +41,7 @@ def _cmd_new(args) -> int:
 
 
 def _cmd_standin(args) -> int:
-    from ..io_netcdf import check_output_path
+    from . import check_output_path
     from ..sim.scene import parse_set
     from ..validation.standin import make_standin_recording
     check_output_path(args.output, force=args.force, suffixes=(".uff", ".mat"))

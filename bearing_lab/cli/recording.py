@@ -74,7 +74,7 @@ def _open(args, arrays_only=False):
 
 def _cmd_import(args) -> int:
     from ..io import get_warnings, to_netcdf
-    from ..io_netcdf import check_output_path
+    from . import check_output_path
     check_output_path(args.output, force=args.force)  # before reading: a bad -o is said at once
     ds = _open(args)
     if args.rpm is not None:
@@ -224,7 +224,7 @@ def _cmd_fetch(args) -> int:
 def _cmd_sample(args) -> int:
     import shutil
     from importlib import resources
-    from ..io_netcdf import check_output_path
+    from . import check_output_path
     out = check_output_path(args.output, force=args.force, suffixes=(".uff",))
     src = resources.files("bearing_lab").joinpath("data", "sample_recording.uff")
     with resources.as_file(src) as p:

@@ -32,7 +32,7 @@ def _sweep(args) -> int:
     from ..sim.scene import parse_set
     params = parse_params(args.param)
     overrides = parse_set(args.set)
-    from ..io_netcdf import check_output_path
+    from . import check_output_path
     out = check_output_path(args.output, force=args.force)
     cache = False if args.no_cache else args.cache_dir
     import warnings
@@ -42,8 +42,9 @@ def _sweep(args) -> int:
         ds = sweep(args.scene, params, scheduler=args.scheduler, n_workers=args.workers,
                    cache_dir=cache, progress=not (args.quiet or args.json), duration=args.duration, fs=args.fs,
                    **overrides)
-    from ..io_netcdf import write_netcdf
-    write_netcdf(ds, out)
+    from ..errors import BearingLabError
+    from ..io.export import to_netcdf
+    to_netcdf(ds, out, error=BearingLabError)
     dims = " x ".join(f"{d}={ds.sizes[d]}" for d in ds.attrs["sweep_dims"].split())
     if args.json:
         from ..utils._json import dumps

@@ -410,7 +410,7 @@ def test_full_disk_is_named_as_such(tmp_path, monkeypatch):
     import shutil
     import xarray as xr
     from bearing_lab.errors import BearingLabError
-    from bearing_lab.io_netcdf import write_netcdf
+    from bearing_lab.io import to_netcdf
 
     def denied(self, path, **kw):
         raise PermissionError(13, "Permission denied", str(path))
@@ -421,10 +421,10 @@ def test_full_disk_is_named_as_such(tmp_path, monkeypatch):
     monkeypatch.setattr(shutil, "disk_usage", lambda p: real(p)._replace(free=4096))
     with pytest.raises(BearingLabError, match=r"o.nc: cannot write netCDF4 \(no space left on the "
                                               r"device: 0.0041 MB free in .*, the data take up to 1.6 MB\)"):
-        write_netcdf(ds, tmp_path / "o.nc")
+        to_netcdf(ds, tmp_path / "o.nc")
     monkeypatch.setattr(shutil, "disk_usage", real)  # space enough: the library's own words
     with pytest.raises(BearingLabError, match=r"PermissionError: \[Errno 13\] Permission denied"):
-        write_netcdf(ds, tmp_path / "o.nc")
+        to_netcdf(ds, tmp_path / "o.nc")
 
 
 def test_column_name_that_netcdf_refuses_is_cleaned_at_read(write, tmp_path, capsys):
