@@ -80,7 +80,7 @@ QS_SETTINGS = ([("dp54", r, None, m) for r in (1e-4, 1e-5) for m in (2.5e-5, 1e-
                + [("bs32", r, None, m) for r in (1e-3, 1e-4) for m in (2.5e-5, 1e-4)])
 
 
-def _scene(base, ov, duration, fidelity="multibody", model=None, cage="kinematic"):
+def bench_scene(base, ov, duration, fidelity="multibody", model=None, cage="kinematic"):
     sc = load_scene(base, fidelity=fidelity, **ov, **{"output.duration_s": duration, "cage.model": cage})
     if model is not None and sc.data["defect"]:
         raw = dict(sc.data)
@@ -89,7 +89,7 @@ def _scene(base, ov, duration, fidelity="multibody", model=None, cage="kinematic
     return sc
 
 
-def _measures(acc, fs, scene):
+def measures(acc, fs, scene):
     """peak, RMS, excitation period, median impulse duration of an acceleration record."""
     from .analysis import excitation_period, impulses
     b = scene.bearing
@@ -128,7 +128,7 @@ def _t_end(asm):
     return asm.scene.settle - m_pad * dt_f + (m_pad + (n_out - 1) * R + m_pad + 0.5) * dt_f + 1e-9
 
 
-def _scipy_acc(asm, method, rtol, max_step=2.5e-5):
+def scipy_acc(asm, method, rtol, max_step=2.5e-5):
     """scipy's solve_ivp integrating the same compiled right-hand side over the same record as
     ``_run``: (accelerometer Y, CPU seconds of the solve) -- (None, seconds) if it failed."""
     from scipy.integrate import solve_ivp
@@ -184,15 +184,15 @@ def run_rate_study(out_dir="reports/performance", *, duration=1.0, rates=RATES_H
     rows = []
     jobs = [(fs, sc) for fs in rates for sc in chosen]
     for fs, (label, base, ov) in tqdm(jobs, desc="rate study", disable=not progress):
-        sc = _scene(base, {**ov, "output.sample_rate_hz": float(fs)}, duration, "multibody", REF_CONTACT)
+        sc = bench_scene(base, {**ov, "output.sample_rate_hz": float(fs)}, duration, "multibody", REF_CONTACT)
         asm = assemble(sc)
         ref, ref_cost = _timed(asm, "dp54", 1e-9, None, 2e-6)
         ref2, _ = _timed(asm, "dp54", 1e-10, None, 1e-6)
-        m_ref = _measures(ref["acc"][:, 1], fs, sc)
-        m_ref2 = _measures(ref2["acc"][:, 1], fs, sc)
+        m_ref = measures(ref["acc"][:, 1], fs, sc)
+        m_ref2 = measures(ref2["acc"][:, 1], fs, sc)
         for method, rtol in RATE_SETTINGS:
             res, cost = _timed(asm, method, rtol, None, None)
-            m = _measures(res["acc"][:, 1], fs, sc)
+            m = measures(res["acc"][:, 1], fs, sc)
             rows.append(dict(kind=RATE_KIND, scene=label, rate_hz=float(fs), method=method, rtol=float(rtol),
                              max_step=2.5e-5, cost=cost, peak=m["peak"], ref_peak=m_ref["peak"],
                              ref_period=m_ref["period"], err_peak=_err(m["peak"], m_ref["peak"]),
@@ -295,13 +295,13 @@ def run_bench(out_dir="reports/performance", *, duration=0.3, scipy_duration=0.1
     notes = {}
     speed_rows, speed_infos = [], []
     for label, base, ov, kind in tqdm(chosen, desc="bench scenes", disable=not progress):
-        sc_ref = _scene(base, ov, duration, "multibody", REF_CONTACT if kind != "healthy" else None)
+        sc_ref = bench_scene(base, ov, duration, "multibody", REF_CONTACT if kind != "healthy" else None)
         asm = assemble(sc_ref)
         fs = sc_ref.fs_out
         ref, _ = _timed(asm, "dp54", 1e-9, None, 2e-6)
         ref2, _ = _timed(asm, "dp54", 1e-10, None, 1e-6)
-        m_ref = _measures(ref["acc"][:, 1], fs, sc_ref)
-        m_ref2 = _measures(ref2["acc"][:, 1], fs, sc_ref)
+        m_ref = measures(ref["acc"][:, 1], fs, sc_ref)
+        m_ref2 = measures(ref2["acc"][:, 1], fs, sc_ref)
         notes[label] = {k: _err(m_ref2[k], m_ref[k]) for k in m_ref}
         jobs = [("multibody", REF_CONTACT, *s) for s in MB_SETTINGS]
         jobs += [("quasi-static", REF_CONTACT, *s) for s in QS_SETTINGS]
@@ -311,10 +311,10 @@ def run_bench(out_dir="reports/performance", *, duration=0.3, scipy_duration=0.1
             jobs += [("multibody", m, "dp54", 1e-5, None, None) for m in CHEAP_CONTACTS]
         for fid, model, method, rtol, step, mx in jobs:
             cage = "dynamic" if fid.endswith("dynamic cage") else "kinematic"
-            sc = _scene(base, ov, duration, fid.split("+")[0], model if kind != "healthy" else None, cage)
+            sc = bench_scene(base, ov, duration, fid.split("+")[0], model if kind != "healthy" else None, cage)
             asm_j = assemble(sc)
             res, cost = _timed(asm_j, method, rtol, step, mx)
-            m = _measures(res["acc"][:, 1], fs, sc)
+            m = measures(res["acc"][:, 1], fs, sc)
             setting = (f"{method} " + (f"h={step:g}" if step else f"rtol={rtol:g}")
                        + (f" max_step={mx:g}" if mx else ""))
             rows.append(dict(scene=label, kind=kind, fidelity=fid, contact=model if kind != "healthy" else "none",

@@ -8,7 +8,7 @@ from ..errors import SceneError
 
 def parse_params(items) -> dict:
     """``["speed_rpm=900,1800", "defect.offset_mm=0,0.5"]`` -> ``{key: [values]}``."""
-    from ..sim.scene import _parse_value
+    from ..sim.scene import parse_value
     out = {}
     for item in items or []:
         if "=" not in item:
@@ -21,7 +21,7 @@ def parse_params(items) -> dict:
         vals = [v.strip() for v in text.split(",")]
         if not text.strip() or any(v == "" for v in vals):
             raise SceneError(f"--param {key}: empty value in {text!r}; expected {key}=V1,V2,...")
-        out[key] = [_parse_value(v) for v in vals]
+        out[key] = [parse_value(v) for v in vals]
     if not out:
         raise SceneError("sweep: give at least one --param KEY=V1,V2,...")
     return out

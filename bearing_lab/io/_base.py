@@ -526,7 +526,7 @@ class RecordingBuilder:
             if v is not None and k not in attrs:
                 attrs[k] = _attr_value(v)
         rec = RecordingArrays(t, self.channels, attrs)
-        if _ARRAYS_ONLY.get():
+        if ARRAYS_ONLY.get():
             return rec
         try:
             return rec.to_dataset()
@@ -536,7 +536,7 @@ class RecordingBuilder:
 
 #: Set by :func:`bearing_lab.io.read_arrays`: :meth:`RecordingBuilder.build` then returns the
 #: :class:`RecordingArrays` instead of the Dataset (no xarray import, for ``bearing-lab info``).
-_ARRAYS_ONLY = contextvars.ContextVar("bearing_lab_io_arrays_only", default=False)
+ARRAYS_ONLY = contextvars.ContextVar("bearing_lab_io_arrays_only", default=False)
 
 
 class _Channel:

@@ -92,7 +92,7 @@ def _suffix(key: str):
     return None
 
 
-def _convert(value, key: str, where: str):
+def convert_value(value, key: str, where: str):
     """Convert a "1 mm"-style string to the unit the key names."""
     if not isinstance(value, str):
         return value
@@ -122,7 +122,7 @@ bearing, yet small enough that the physics (squares, products of keys) stays fin
 
 def _check(value, key, spec, where):
     default, typ, check, _ = spec
-    value = _convert(value, key, where)
+    value = convert_value(value, key, where)
     if typ is bool:
         if not isinstance(value, bool):
             raise SceneError(f"{where}: {value!r} must be true or false")
@@ -222,7 +222,7 @@ class Scene:
         defects = []
         for i, m in enumerate(d["defect"]):
             where = "defect" if len(d["defect"]) == 1 else f"defect[{i}]"
-            m = {k: _convert(v, k, f"{where}.{k}") for k, v in m.items()}
+            m = {k: convert_value(v, k, f"{where}.{k}") for k, v in m.items()}
             from .defects.contact import CONTACT_MODELS  # the registry names the allowed models
             check_choice(m.pop("contact_model", "auto"), ("auto", *CONTACT_MODELS),
                          f"{where}.contact_model", SceneError)
@@ -372,7 +372,7 @@ def _bearing_from(d: dict) -> BearingGeometry:
 
 
 # ---------------------------------------------------------------- overrides
-_ALIASES = {"speed_rpm": "speed.rpm", "rpm": "speed.rpm", "duration": "output.duration_s",
+SET_ALIASES = {"speed_rpm": "speed.rpm", "rpm": "speed.rpm", "duration": "output.duration_s",
             "fs": "output.sample_rate_hz"}
 
 
@@ -384,7 +384,7 @@ def _key_type(parts):
     return spec[1] if spec else None
 
 
-def _parse_value(text, typ=None, key=""):
+def parse_value(text, typ=None, key=""):
     """A ``--set`` value: the text itself for a text key (``bearing=6205``), a TOML array for a
     list key (``speed.profile=[[0, 1000], [0.05, 1800]]``), else a bool, int, float or text."""
     if not isinstance(text, str):
@@ -414,9 +414,9 @@ def _parse_value(text, typ=None, key=""):
 
 
 def _apply_override(raw: dict, key: str, value):
-    key = _ALIASES.get(key, key)
+    key = SET_ALIASES.get(key, key)
     parts = key.split(".")
-    value = _parse_value(value, _key_type(parts), key)
+    value = parse_value(value, _key_type(parts), key)
     if parts[0] in ("defect", "defects"):
         if len(parts) != 2:
             raise SceneError(f"--set {key}: use defect.<key>, e.g. defect.length_mm=1")
@@ -455,7 +455,7 @@ def parse_set(items) -> dict:
         k = k.strip()
         if not k:
             raise SceneError(f"--set {item!r}: no key before '='")
-        key = _ALIASES.get(k, k)
+        key = SET_ALIASES.get(k, k)
         if key in out:
             raise SceneError(f"--set {k}: the key {key} is already given (--set {given[key]}); give "
                              "it once")
@@ -470,14 +470,14 @@ def merge_overrides(overrides: dict, **named) -> dict:
     """
     out = {}
     for k, v in overrides.items():
-        key = _ALIASES.get(k, k)
+        key = SET_ALIASES.get(k, k)
         if key in out and out[key] != v:
             raise SceneError(f"{k}={v!r}: the key {key} is already set to {out[key]!r}")
         out[key] = v
     for key, v in named.items():
         if v is None:
             continue
-        if key in out and _parse_value(out[key]) != _parse_value(v):
+        if key in out and parse_value(out[key]) != parse_value(v):
             raise SceneError(f"{key} is given twice, as {out[key]!r} and {v!r}; give it once")
         out[key] = v
     return out

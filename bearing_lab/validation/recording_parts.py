@@ -39,9 +39,9 @@ def context(case, prep, path, background=None) -> dict:
 
 def ratio_companion(case, prep, path, *, mirror=None) -> dict:
     """Impulse strength of the ``[ratio]`` companion: its recording, and its scene through the same path."""
-    from .case import _ratio_spec
+    from .case import ratio_spec
     cfg = case.section("ratio")
-    spec = _ratio_spec(case, cfg)
+    spec = ratio_spec(case, cfg)
     spec.duration_s, spec.start_s = case.recording.duration_s, case.recording.start_s
     rec = open_spec(spec, case.name, mirror)
     speed = resolve_speed(spec.speed, rec.dataset, rec.x, bearing=prep.bearing, case_name=case.name,
