@@ -9,10 +9,11 @@ from pathlib import Path
 import numpy as np
 
 from .errors import BearingLabError, SceneError
+from .io.export import checksum_path, to_netcdf
 from .schema import DEFAULT_CHANNEL
 
-_METRICS = ("rms", "peak", "crest_factor", "kurtosis")   # the analysis METRICS stored per scene
-_METRIC_SIGNAL = DEFAULT_CHANNEL  # the simulator's accelerometer signal
+SWEEP_METRICS = ("rms", "peak", "crest_factor", "kurtosis")   # the analysis METRICS stored per scene
+METRIC_SIGNAL = DEFAULT_CHANNEL  # the simulator's accelerometer signal
 # variables a cached scene must hold to be used
 _REQUIRED = ("outer_ring_acc_y", "outer_ring_acc_x", "outer_ring_disp_y", "outer_ring_disp_x",
              "inner_ring_disp_y", "inner_ring_disp_x")
@@ -23,28 +24,16 @@ class CacheWarning(UserWarning):
 
 
 # ---------------------------------------------------------------- the cache
-def _checksum_path(path: Path) -> Path:
-    return path.with_name(path.name + ".sha256")
-
-
-def _write_cache(ds, path: Path) -> None:
+def write_cache(ds, path: Path) -> None:
     """Write one scene to the cache: netCDF4, float64 as is, *uncompressed* (zlib costs
     ~0.12 s per 1 s scene, a third of its simulation, to save a third of 3.5 MB), then its
     checksum file ``<hash>.nc.sha256`` (``sha256sum -c`` format).  Both are written
     atomically; an entry without its checksum is incomplete and is never read."""
-    from ._files import atomic_open, atomic_path, sha256_file
     path.parent.mkdir(parents=True, exist_ok=True)
-    out = ds.copy(deep=False)
-    out.attrs = {k: (int(v) if isinstance(v, (bool, np.bool_)) else "" if v is None else v)
-                 for k, v in ds.attrs.items()}
     try:
-        with atomic_path(path) as tmp:
-            out.to_netcdf(tmp, engine="netcdf4", format="NETCDF4")
-            digest = sha256_file(tmp)
-        with atomic_open(_checksum_path(path), "w") as fh:
-            fh.write(f"{digest}  {path.name}\n")
-    except (OSError, ValueError, RuntimeError) as exc:
-        raise BearingLabError(f"sweep: cannot write the cache file {path}: {exc}") from None
+        to_netcdf(ds, path, complevel=0, checksum_file=True, error=BearingLabError)
+    except BearingLabError as exc:
+        raise BearingLabError(f"sweep cache: {exc}") from None
 
 
 def _cache_problem(ds, digest: str, expect: dict) -> str | None:
@@ -70,10 +59,10 @@ def _read_cache(path: Path, digest: str, expect: dict):
     (a damaged file never reaches the C library), then the content is validated.
     """
     import xarray as xr
-    from ._files import sha256_file
+    from .utils._files import sha256_file
     if not path.is_file():
         return None, None
-    sums = _checksum_path(path)
+    sums = checksum_path(path)
     try:
         recorded = sums.read_text().split()[0] if sums.is_file() else None
     except (OSError, IndexError, UnicodeDecodeError):
@@ -90,14 +79,14 @@ def _read_cache(path: Path, digest: str, expect: dict):
 
 
 def _drop_entry(path: Path) -> None:
-    for p in (path, _checksum_path(path)):
+    for p in (path, checksum_path(path)):
         try:
             p.unlink()
         except OSError:
             pass
 
 
-def _from_cache(cdir, scenes, digests, acc):
+def from_cache(cdir, scenes, digests, acc):
     """Put every valid cached scene into ``acc``; return (hits, indices to compute, rejected).
 
     A damaged or incomplete entry is deleted, listed in ``rejected`` and warned about
@@ -129,7 +118,7 @@ def _metrics(x: np.ndarray) -> dict:
     """The sweep's metrics (the analysis table's functions; NaN where undefined)."""
     from .analysis._metrics import METRICS
     out = {}
-    for name in _METRICS:
+    for name in SWEEP_METRICS:
         try:
             out[name] = float(METRICS[name].func(x))
         except BearingLabError:
@@ -142,14 +131,14 @@ _PER_SCENE_ATTRS = {"title", "scene_toml", "wall_time_s", "table_time_s", "compi
                     "solver_rejected_steps", "sweep_scene_hash", "scene_name"}
 
 
-class _Stack:
+class Stack:
     """Places each scene's variables at its grid index as results arrive (any order)."""
 
     def __init__(self, shape, n):
         self.shape, self.n = shape, n
         self.arrays = None
         self.template = None
-        self.metrics = {m: np.full(n, np.nan) for m in _METRICS}
+        self.metrics = {m: np.full(n, np.nan) for m in SWEEP_METRICS}
         self.wall = np.full(n, np.nan)
         self.steps = np.zeros(n, dtype=np.int64)
         self.cached = np.zeros(n, dtype=bool)
@@ -179,8 +168,8 @@ class _Stack:
                 raise BearingLabError(f"sweep: variable {name} has shape {v.shape} in one scene "
                                       f"and {arr.shape[1:]} in another")
             arr[i] = v
-        if _METRIC_SIGNAL in ds:
-            for k, val in _metrics(np.asarray(ds[_METRIC_SIGNAL].values)).items():
+        if METRIC_SIGNAL in ds:
+            for k, val in _metrics(np.asarray(ds[METRIC_SIGNAL].values)).items():
                 self.metrics[k][i] = val
         for k, v in ds.attrs.items():
             if k not in _PER_SCENE_ATTRS and isinstance(v, (str, int, float, np.number)):

@@ -22,8 +22,6 @@ tolerance per kind of scene, which ``fidelity = "auto"`` reads when it is copied
 """
 from __future__ import annotations
 
-import base64
-import io
 import math
 from pathlib import Path
 import time
@@ -31,12 +29,12 @@ import time
 import numpy as np
 import xarray as xr
 
-from ._files import savefig, write_text
+from ._version import __version__
 from .sim import load_scene
 from .sim.assembly import assemble
 from .sim.integrate import METHODS, _decimate_acc, _run, _warm_up, anti_alias_taps
+from .utils._files import savefig, write_text
 
-G0 = 9.80665
 TOL_PEAK = 0.01
 TOL_PERIOD = 0.001
 #: the defect-contact model of the reference and of the solver rows (the default); the
@@ -82,7 +80,7 @@ QS_SETTINGS = ([("dp54", r, None, m) for r in (1e-4, 1e-5) for m in (2.5e-5, 1e-
                + [("bs32", r, None, m) for r in (1e-3, 1e-4) for m in (2.5e-5, 1e-4)])
 
 
-def _scene(base, ov, duration, fidelity="multibody", model=None, cage="kinematic"):
+def bench_scene(base, ov, duration, fidelity="multibody", model=None, cage="kinematic"):
     sc = load_scene(base, fidelity=fidelity, **ov, **{"output.duration_s": duration, "cage.model": cage})
     if model is not None and sc.data["defect"]:
         raw = dict(sc.data)
@@ -91,7 +89,7 @@ def _scene(base, ov, duration, fidelity="multibody", model=None, cage="kinematic
     return sc
 
 
-def _measures(acc, fs, scene):
+def measures(acc, fs, scene):
     """peak, RMS, excitation period, median impulse duration of an acceleration record."""
     from .analysis import excitation_period, impulses
     b = scene.bearing
@@ -130,7 +128,7 @@ def _t_end(asm):
     return asm.scene.settle - m_pad * dt_f + (m_pad + (n_out - 1) * R + m_pad + 0.5) * dt_f + 1e-9
 
 
-def _scipy_acc(asm, method, rtol, max_step=2.5e-5):
+def scipy_acc(asm, method, rtol, max_step=2.5e-5):
     """scipy's solve_ivp integrating the same compiled right-hand side over the same record as
     ``_run``: (accelerometer Y, CPU seconds of the solve) -- (None, seconds) if it failed."""
     from scipy.integrate import solve_ivp
@@ -186,15 +184,15 @@ def run_rate_study(out_dir="reports/performance", *, duration=1.0, rates=RATES_H
     rows = []
     jobs = [(fs, sc) for fs in rates for sc in chosen]
     for fs, (label, base, ov) in tqdm(jobs, desc="rate study", disable=not progress):
-        sc = _scene(base, {**ov, "output.sample_rate_hz": float(fs)}, duration, "multibody", REF_CONTACT)
+        sc = bench_scene(base, {**ov, "output.sample_rate_hz": float(fs)}, duration, "multibody", REF_CONTACT)
         asm = assemble(sc)
         ref, ref_cost = _timed(asm, "dp54", 1e-9, None, 2e-6)
         ref2, _ = _timed(asm, "dp54", 1e-10, None, 1e-6)
-        m_ref = _measures(ref["acc"][:, 1], fs, sc)
-        m_ref2 = _measures(ref2["acc"][:, 1], fs, sc)
+        m_ref = measures(ref["acc"][:, 1], fs, sc)
+        m_ref2 = measures(ref2["acc"][:, 1], fs, sc)
         for method, rtol in RATE_SETTINGS:
             res, cost = _timed(asm, method, rtol, None, None)
-            m = _measures(res["acc"][:, 1], fs, sc)
+            m = measures(res["acc"][:, 1], fs, sc)
             rows.append(dict(kind=RATE_KIND, scene=label, rate_hz=float(fs), method=method, rtol=float(rtol),
                              max_step=2.5e-5, cost=cost, peak=m["peak"], ref_peak=m_ref["peak"],
                              ref_period=m_ref["period"], err_peak=_err(m["peak"], m_ref["peak"]),
@@ -297,13 +295,13 @@ def run_bench(out_dir="reports/performance", *, duration=0.3, scipy_duration=0.1
     notes = {}
     speed_rows, speed_infos = [], []
     for label, base, ov, kind in tqdm(chosen, desc="bench scenes", disable=not progress):
-        sc_ref = _scene(base, ov, duration, "multibody", REF_CONTACT if kind != "healthy" else None)
+        sc_ref = bench_scene(base, ov, duration, "multibody", REF_CONTACT if kind != "healthy" else None)
         asm = assemble(sc_ref)
         fs = sc_ref.fs_out
         ref, _ = _timed(asm, "dp54", 1e-9, None, 2e-6)
         ref2, _ = _timed(asm, "dp54", 1e-10, None, 1e-6)
-        m_ref = _measures(ref["acc"][:, 1], fs, sc_ref)
-        m_ref2 = _measures(ref2["acc"][:, 1], fs, sc_ref)
+        m_ref = measures(ref["acc"][:, 1], fs, sc_ref)
+        m_ref2 = measures(ref2["acc"][:, 1], fs, sc_ref)
         notes[label] = {k: _err(m_ref2[k], m_ref[k]) for k in m_ref}
         jobs = [("multibody", REF_CONTACT, *s) for s in MB_SETTINGS]
         jobs += [("quasi-static", REF_CONTACT, *s) for s in QS_SETTINGS]
@@ -313,10 +311,10 @@ def run_bench(out_dir="reports/performance", *, duration=0.3, scipy_duration=0.1
             jobs += [("multibody", m, "dp54", 1e-5, None, None) for m in CHEAP_CONTACTS]
         for fid, model, method, rtol, step, mx in jobs:
             cage = "dynamic" if fid.endswith("dynamic cage") else "kinematic"
-            sc = _scene(base, ov, duration, fid.split("+")[0], model if kind != "healthy" else None, cage)
+            sc = bench_scene(base, ov, duration, fid.split("+")[0], model if kind != "healthy" else None, cage)
             asm_j = assemble(sc)
             res, cost = _timed(asm_j, method, rtol, step, mx)
-            m = _measures(res["acc"][:, 1], fs, sc)
+            m = measures(res["acc"][:, 1], fs, sc)
             setting = (f"{method} " + (f"h={step:g}" if step else f"rtol={rtol:g}")
                        + (f" max_step={mx:g}" if mx else ""))
             rows.append(dict(scene=label, kind=kind, fidelity=fid, contact=model if kind != "healthy" else "none",
@@ -337,9 +335,10 @@ def run_bench(out_dir="reports/performance", *, duration=0.3, scipy_duration=0.1
                      "reference": f"multibody + {REF_CONTACT} contact, dp54 rtol 1e-9, max step 2e-6 s",
                      "reference_self_check": repr(notes), "tolerance_peak": TOL_PEAK,
                      "tolerance_period": TOL_PERIOD, "sampling_rate_hz": 0.0,
-                     "bearing_lab_version": __import__("bearing_lab").__version__})
-    from .io_netcdf import write_netcdf
-    write_netcdf(ds, out / "performance.nc")
+                     "bearing_lab_version": __version__})
+    from .errors import BearingLabError
+    from .io.export import to_netcdf
+    to_netcdf(ds, out / "performance.nc", error=BearingLabError)
     rules = _rules(rows)
     if rates:
         rate_rows = run_rate_study(out, duration=rate_duration, scenes=scenes, progress=progress)
@@ -407,14 +406,8 @@ def _rules(rows) -> str:
     return "\n".join(lines)
 
 
-def _png(fig):
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=90)
-    return base64.b64encode(buf.getvalue()).decode()
-
-
 def _report(out, rows, notes, speed_md=""):
-    from .figures import new_figure
+    from .utils.figures import figure_png, new_figure
     scenes = list(dict.fromkeys(r["scene"] for r in rows))
     html = ["<!DOCTYPE html><html><head><meta charset='utf-8'><title>bearing_lab: speed against error"
             "</title><style>body{font-family:sans-serif;max-width:1100px;margin:auto}table{border-collapse:"
@@ -460,7 +453,7 @@ def _report(out, rows, notes, speed_md=""):
         if best:
             html.append(f"<p><b>Fastest within tolerance:</b> {best['fidelity']}, {best['contact']}, "
                         f"{best['setting']}: {best['cost']:.4f} s/s, peak error {best['err_peak']:.2e}</p>")
-        html.append(f"<img src='data:image/png;base64,{_png(fig)}'>")
+        html.append(f"<img src='data:image/png;base64,{figure_png(fig, dpi=90)}'>")
         html.append("<table><tr><th>fidelity</th><th>contact</th><th>setting</th><th>s/s</th><th>peak err</th>"
                     "<th>RMS err</th><th>period err</th><th>duration err</th></tr>")
         for r in sorted(rs, key=lambda r: r["cost"]):

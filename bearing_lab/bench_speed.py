@@ -28,6 +28,8 @@ import time
 
 import numpy as np
 
+from .units import G
+
 TOL_PEAK = 0.01
 TOL_PERIOD = 0.001
 
@@ -72,10 +74,10 @@ def _ok(row, ref_period):
 
 def equal_accuracy(label, base, ov, *, duration=0.1, scipy=True, repeats=2, progress=None):
     """Rows (one per setting) of ours and scipy's methods against one converged reference."""
-    from .bench import _measures, _scene, _scipy_acc
+    from .bench import measures, bench_scene, scipy_acc
     from .sim.assembly import assemble
     from .sim.integrate import METHODS, _run
-    sc = _scene(base, ov, duration)
+    sc = bench_scene(base, ov, duration)
     asm = assemble(sc)
     fs = sc.fs_out
 
@@ -84,14 +86,14 @@ def equal_accuracy(label, base, ov, *, duration=0.1, scipy=True, repeats=2, prog
 
     ref, ref_cpu = _cpu(ours, "dp54", 1e-9, None, 2e-6)
     ref2, _ = _cpu(ours, "dp54", 1e-10, None, 1e-6)
-    m_ref = _measures(ref["acc"][:, 1], fs, sc)
-    m_ref2 = _measures(ref2["acc"][:, 1], fs, sc)
+    m_ref = measures(ref["acc"][:, 1], fs, sc)
+    m_ref2 = measures(ref2["acc"][:, 1], fs, sc)
     check = {k: _err(m_ref2[k], m_ref[k]) for k in ("peak", "period")}
     t_sim = ref["t_end"]
     rows = []
 
     def add(solver, method, setting, acc, cpu, extra=None):
-        m = _measures(acc, fs, sc) if acc is not None else {"peak": math.nan, "period": math.nan}
+        m = measures(acc, fs, sc) if acc is not None else {"peak": math.nan, "period": math.nan}
         row = dict(scene=label, solver=solver, method=method, setting=setting, cost=cpu / t_sim,
                    err_peak=_err(m["peak"], m_ref["peak"]), err_period=_err(m["period"], m_ref["period"]),
                    **(extra or {}))
@@ -114,7 +116,7 @@ def equal_accuracy(label, base, ov, *, duration=0.1, scipy=True, repeats=2, prog
     if scipy:
         for method, rtols in SCIPY.items():
             for rtol in rtols:
-                acc, cpu = _scipy_acc(asm, method, rtol, MAX_STEP)
+                acc, cpu = scipy_acc(asm, method, rtol, MAX_STEP)
                 if add("scipy", method, f"rtol={rtol:g}", acc, cpu)["ok"]:
                     break
     info = dict(scene=label, duration_s=duration, simulated_s=t_sim, ref_cost=ref_cpu / t_sim,
@@ -131,19 +133,19 @@ QS_SETTINGS = [("bs32", 1e-3, 1e-4), ("bs32", 1e-4, 1e-4), ("dp54", 1e-4, 1e-4),
 def quasi_static(label, base, ov, *, duration=0.1, repeats=2):
     """Quasi-static rows: CPU s/s, and the error against the multibody reference (what a user
     gets: model plus numerical error) and against its own converged run (numerical error)."""
-    from .bench import _measures, _scene
+    from .bench import measures, bench_scene
     from .sim.assembly import assemble
     from .sim.integrate import _run
-    sc_mb = _scene(base, ov, duration)
-    sc = _scene(base, ov, duration, "quasi-static")
+    sc_mb = bench_scene(base, ov, duration)
+    sc = bench_scene(base, ov, duration, "quasi-static")
     asm = assemble(sc)
-    ref_mb = _measures(_run(assemble(sc_mb), 0, 1e-9, progress=False, max_step=2e-6)["acc"][:, 1], sc.fs_out, sc_mb)
-    ref_qs = _measures(_run(asm, 0, 1e-9, progress=False, max_step=2e-6)["acc"][:, 1], sc.fs_out, sc)
+    ref_mb = measures(_run(assemble(sc_mb), 0, 1e-9, progress=False, max_step=2e-6)["acc"][:, 1], sc.fs_out, sc_mb)
+    ref_qs = measures(_run(asm, 0, 1e-9, progress=False, max_step=2e-6)["acc"][:, 1], sc.fs_out, sc)
     rows = []
     from .sim.integrate import METHODS
     for method, rtol, mx in QS_SETTINGS:
         res, cpu = _cpu(_run, asm, METHODS[method], rtol, progress=False, max_step=mx, repeats=repeats)
-        m = _measures(res["acc"][:, 1], sc.fs_out, sc)
+        m = measures(res["acc"][:, 1], sc.fs_out, sc)
         row = dict(scene=label, setting=f"{method} rtol={rtol:g} max_step={mx:g}", cost=cpu / res["t_end"],
                    err_peak=_err(m["peak"], ref_mb["peak"]), err_period=_err(m["period"], ref_mb["period"]),
                    num_err_peak=_err(m["peak"], ref_qs["peak"]), steps=int(res["stats"][0]),
@@ -202,7 +204,7 @@ def default_cost(label, base, ov, *, duration=1.0, repeats=3):
                        method=ds.attrs["solver_method"], rtol=float(ds.attrs["solver_rtol"]),
                        fidelity=ds.attrs["fidelity"], steps=int(ds.attrs["solver_steps"]),
                        rejected=int(ds.attrs["solver_rejected_steps"]),
-                       peak_g=float(np.max(np.abs(ds.outer_ring_acc_y.values))) / 9.80665)
+                       peak_g=float(np.max(np.abs(ds.outer_ring_acc_y.values))) / G)
             if best is None or row["loop_cpu_s_per_s"] < best["loop_cpu_s_per_s"]:
                 best = row
     finally:
@@ -228,18 +230,18 @@ def default_costs_as_users_get_them(chosen, *, duration=1.0):
 
 def default_accuracy(label, base, ov, *, duration=0.1):
     """The default's settings on the equal-accuracy record: its error against the reference."""
-    from .bench import _measures, _scene
+    from .bench import measures, bench_scene
     from .sim.assembly import assemble
     from .sim.auto import resolve
     from .sim.integrate import METHODS, _run
-    sc = _scene(base, ov, duration)
+    sc = bench_scene(base, ov, duration)
     ch = resolve(load_auto(base, ov, duration))
     ref = _run(assemble(sc), METHODS["dp54"], 1e-9, progress=False, max_step=2e-6)
-    asm = assemble(_scene(base, ov, duration, ch["fidelity"]))
+    asm = assemble(bench_scene(base, ov, duration, ch["fidelity"]))
     res = _run(asm, METHODS[ch["method"]], ch["rtol"], progress=False, max_step=ch["max_step_s"],
                step=ch.get("step_s") or None)
-    m_ref = _measures(ref["acc"][:, 1], sc.fs_out, sc)
-    m = _measures(res["acc"][:, 1], sc.fs_out, sc)
+    m_ref = measures(ref["acc"][:, 1], sc.fs_out, sc)
+    m = measures(res["acc"][:, 1], sc.fs_out, sc)
     return dict(scene=label, err_peak=_err(m["peak"], m_ref["peak"]), err_period=_err(m["period"], m_ref["period"]),
                 method=ch["method"], rtol=ch["rtol"])
 

@@ -16,7 +16,7 @@ ComparisonResult                    -- .dataset, .rows, .passed, plot_waveforms/
 align_by_impulse_phase(exp, sim, fs, period, *, band) -- samples that put the simulation's impacts on the experiment's
 shift(x, shift, n)                  -- x delayed by ``shift`` samples into n samples (NaN before)
 table_dataset(rows)                 -- the rows as Dataset variables along ``quantity``
-measure, impact_times, impulse_strength, apply_sensor, sensor_response -- kept here for older scripts
+SIGNAL_COLORS                       -- one colour per compared signal in every figure
 """
 from __future__ import annotations
 
@@ -25,13 +25,10 @@ import json
 import numpy as np
 import xarray as xr
 
-from .analysis.impacts import impact_times, impulse_strength  # noqa: F401  (older import path)
-from .analysis.measurement import measure  # noqa: F401  (older import path)
+from .analysis.impacts import impact_times
+from .units import G
 
-__all__ = ["compare", "ComparisonResult", "align_by_impulse_phase", "shift", "table_dataset", "G0",
-           "measure", "impact_times", "impulse_strength", "apply_sensor", "sensor_response"]
-
-G0 = 9.80665
+__all__ = ["compare", "ComparisonResult", "align_by_impulse_phase", "shift", "table_dataset", "SIGNAL_COLORS"]
 
 _TEXT_KEYS = ("quantity", "label", "units", "tolerance", "rule", "reason", "known_limitation", "declared_by",
               "note", "reference_label", "simulated_signal", "experiment_span", "status")
@@ -49,18 +46,6 @@ def _f(v) -> float:
         return float(v) if v is not None else float("nan")
     except (TypeError, ValueError):
         return float("nan")
-
-
-def sensor_response(f, frequency_hz, damping_ratio, gain=1.0):
-    """The simulator's ``[sensor]`` resonator as a frequency response (a one-mode structural path)."""
-    from .analysis.structural_path import transmissibility
-    return gain * transmissibility(f, frequency_hz, damping_ratio)
-
-
-def apply_sensor(x, fs, frequency_hz, damping_ratio, gain=1.0):
-    """Filter a sensor-off simulation through the ``[sensor]`` resonator (a one-mode structural path)."""
-    from .analysis.structural_path import Resonance, StructuralPath
-    return StructuralPath((Resonance(frequency_hz, damping_ratio),), gain).apply(x, fs)
 
 
 def align_by_impulse_phase(experiment, simulation, fs, period, *, band=None, periods=10):
@@ -151,7 +136,7 @@ class ComparisonResult:
         """Waveforms on the common time base (impacts aligned); ``window_s`` (start, stop)."""
         ax = self._ax(ax)
         ds = self.dataset
-        scale = G0 if acceleration_units == "g" else 1.0
+        scale = G if acceleration_units == "g" else 1.0
         t = ds["time"].values
         sel = slice(None)
         if window_s is not None:
@@ -170,7 +155,7 @@ class ComparisonResult:
         """Amplitude spectra on the common frequency axis."""
         ax = self._ax(ax)
         ds = self.dataset
-        scale = G0 if acceleration_units == "g" else 1.0
+        scale = G if acceleration_units == "g" else 1.0
         f = ds["frequency"].values
         sel = f <= (fmax or f[-1])
         for s in signals or list(ds["signal"].values):
@@ -218,11 +203,9 @@ class ComparisonResult:
     # ---- save / load
     def to_netcdf(self, path):
         """Write the Dataset (atomically: a crash leaves the old file or none)."""
-        from ._files import atomic_path
-        from .io_netcdf import write_netcdf
-        with atomic_path(path) as tmp:
-            write_netcdf(self.dataset, tmp)
-        return path
+        from .errors import BearingLabError
+        from .io.export import to_netcdf
+        return to_netcdf(self.dataset, path, error=BearingLabError)
 
     @classmethod
     def load(cls, path) -> "ComparisonResult":

@@ -144,7 +144,7 @@ def data_dir() -> Path:
 
 
 def _sha256(path: Path) -> str:
-    from ._files import sha256_file
+    from .utils._files import sha256_file
     return sha256_file(path)
 
 
@@ -206,7 +206,7 @@ def _install(src_copy, target: Path, rec: Recording, verify: bool, where: str) -
     """Copy ``src_copy`` (a path) to ``target`` atomically after checking its hash."""
     import shutil
     import warnings
-    from ._files import atomic_path
+    from .utils._files import atomic_path
     if verify and rec.sha256:
         _check(rec, Path(src_copy), where)
     elif verify:

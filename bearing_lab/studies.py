@@ -37,8 +37,6 @@ Measurement (the same everywhere):
 """
 from __future__ import annotations
 
-import base64
-import io
 import math
 from pathlib import Path
 import time
@@ -46,10 +44,10 @@ import time
 import numpy as np
 import xarray as xr
 
-from ._files import savefig, write_text
-from .figures import new_figure
+from .units import G
+from .utils._files import savefig, write_text
+from .utils.figures import figure_png, new_figure
 
-G0 = 9.80665
 STUDY_FS = 100_000.0
 
 # study -> (scene, [(label, overrides)], paper's figure, what the paper reports)
@@ -150,8 +148,8 @@ def _one(scene_name, overrides):
         "min_load": float(np.min(load)), "min_share": float(np.min(share)),
         "min_intact": float(np.min(intact)),
         "peak_disp_um": float(np.max(np.abs(pulse)) * 1e6),
-        "peak_acc_g": float(np.max(np.abs(acc)) / G0),
-        "p2p_acc_g": float((np.max(acc) - np.min(acc)) / G0),
+        "peak_acc_g": float(np.max(np.abs(acc)) / G),
+        "p2p_acc_g": float((np.max(acc) - np.min(acc)) / G),
         "duration_ms": duration * 1e3,
         "crossing_ms": t_cross * 1e3,
         "wall_s": ds.attrs["wall_time_s"],
@@ -216,8 +214,9 @@ def run_paper_studies(out_dir="reports/studies", *, progress=True, studies=None)
     for name, fig in figs.items():
         savefig(fig, out / f"{name}.png", dpi=110 if name != "mechanism" else 100)
     table = _table(rows, time.perf_counter() - t0)
-    from .io_netcdf import write_netcdf
-    write_netcdf(table, out / "studies.nc")
+    from .errors import BearingLabError
+    from .io.export import to_netcdf
+    to_netcdf(table, out / "studies.nc", error=BearingLabError)
     _write_html(out, names, rows, figs)
     return table
 
@@ -228,7 +227,7 @@ def _pulse_figure(s, results):
     for lab, _ in STUDIES[s][1]:
         r = results[(s, lab)]
         ax[0].plot(r["t"] * 1e3, r["pulse"] * 1e6, label=lab)
-        ax[1].plot(r["t"] * 1e3, r["acc"] / G0, label=lab, lw=0.8)
+        ax[1].plot(r["t"] * 1e3, r["acc"] / G, label=lab, lw=0.8)
     ax[0].set_ylabel("outer-ring displacement Y\nminus baseline (µm)")
     ax[1].set_ylabel("outer-ring acceleration Y (g)")
     ax[1].set_xlabel("time from the ball centre crossing the defect centre (ms)")
@@ -266,8 +265,8 @@ def _mechanism_figure(names, results):
 
 _COLUMNS = (  # row key -> (variable, scale to SI, units, long name)
     ("peak_disp_um", "peak_displacement", 1e-6, "m", "largest |displacement pulse|"),
-    ("peak_acc_g", "peak_acceleration", G0, "m s-2", "largest |acceleration| in the window"),
-    ("p2p_acc_g", "acceleration_peak_to_peak", G0, "m s-2", "max a - min a in the window"),
+    ("peak_acc_g", "peak_acceleration", G, "m s-2", "largest |acceleration| in the window"),
+    ("p2p_acc_g", "acceleration_peak_to_peak", G, "m s-2", "max a - min a in the window"),
     ("duration_ms", "excitation_duration", 1e-3, "s", "width of the displacement pulse at 10 %"),
     ("crossing_ms", "crossing_time", 1e-3, "s", "defect extent along the track / surface speed"),
     ("min_load", "minimum_ball_load", 1.0, "N", "defected ball's smallest outer-race load"),
@@ -289,12 +288,6 @@ def _table(rows, total):
                 "contact_model": ("case", [r["contact_model"] for r in rows])},
         attrs={"sampling_rate_hz": STUDY_FS, "total_wall_time_s": total,
                "measurement": __doc__.split("Measurement (the same everywhere):")[1].strip()})
-
-
-def _png(fig) -> str:
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=90)
-    return base64.b64encode(buf.getvalue()).decode()
 
 
 def _findings(s, rs):
@@ -349,8 +342,8 @@ def _write_html(out, names, rows, figs):
                          f"<td>{r['min_intact']:.3f}</td><td>{r['contact_model']}</td></tr>")
         parts.append("</table>")
         parts.append(f"<p>{_findings(s, rs)}</p>")
-        parts.append(f"<img src='data:image/png;base64,{_png(figs[s])}'>")
+        parts.append(f"<img src='data:image/png;base64,{figure_png(figs[s], dpi=90)}'>")
     parts.append("<h2>Mechanism</h2>")
-    parts.append(f"<img src='data:image/png;base64,{_png(figs['mechanism'])}'>")
+    parts.append(f"<img src='data:image/png;base64,{figure_png(figs['mechanism'], dpi=90)}'>")
     parts.append("</body></html>")
     write_text(out / "index.html", "\n".join(parts))

@@ -64,10 +64,11 @@ import uuid
 
 import numpy as np
 
-from . import __version__
+from ._version import __version__
 from .errors import BearingLabError, SceneError
-from ._sweep_store import (CacheWarning, _checksum_path, _from_cache, _METRIC_SIGNAL, _METRICS,  # noqa: F401
-                           _Stack, _write_cache)
+from ._sweep_store import (CacheWarning, checksum_path as _checksum_path,  # noqa: F401
+                           from_cache as _from_cache, METRIC_SIGNAL as _METRIC_SIGNAL,
+                           SWEEP_METRICS as _METRICS, Stack as _Stack, write_cache as _write_cache)
 
 __all__ = ["sweep", "scene_hash", "code_fingerprint", "default_cache_dir", "dim_name", "key_units",
            "CacheWarning"]
@@ -103,7 +104,7 @@ def key_units(key: str) -> str | None:
 
 
 def _canonical(key: str) -> str:
-    from .sim.scene import _ALIASES
+    from .sim.scene import SET_ALIASES as _ALIASES
     return _ALIASES.get(key, key)
 
 
@@ -139,7 +140,7 @@ def scene_hash(scene_toml: str, simulate_kwargs: dict | None = None) -> str:
 
 def _values(key, values) -> list:
     """The swept values of one key as a list (strings with units converted)."""
-    from .sim.scene import _convert, _parse_value
+    from .sim.scene import convert_value as _convert, parse_value as _parse_value
     if isinstance(values, (str, bytes)) or not hasattr(values, "__iter__"):
         raise SceneError(f"sweep parameter {key!r}: give a list of values, got {values!r}")
     out = []

@@ -32,7 +32,7 @@ def test_bench_writes_report_rules_and_rows(tmp_path):
     assert "paper-slot" in summary_table(ds)
     # `bench --json`: strict JSON with every row and the scene's fastest setting within tolerance
     import json
-    from bearing_lab._json import dumps
+    from bearing_lab.utils._json import dumps
     from bearing_lab.cli.bench import json_summary
     js = json.loads(dumps(json_summary(ds, tmp_path)))
     assert len(js["rows"]) == len(rows) and js["tolerance"]["peak"] > 0

@@ -29,6 +29,6 @@ def test_analyze_json_with_one_huge_sample(tmp_path):
 
 
 def test_info_json_is_strict(tmp_path):
-    from bearing_lab._json import dumps
+    from bearing_lab.utils._json import dumps
     assert _strict(dumps({"a": float("inf"), "b": [np.float64("nan"), np.int64(3)]})) == \
         {"a": None, "b": [None, 3]}

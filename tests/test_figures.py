@@ -4,7 +4,7 @@ from pathlib import Path
 
 import matplotlib.pyplot as plt
 
-from bearing_lab.figures import new_figure
+from bearing_lab.utils.figures import new_figure
 
 PKG = Path(__file__).resolve().parents[1] / "bearing_lab"
 
@@ -30,5 +30,5 @@ def test_no_backend_switch_and_no_pyplot_figures_in_library_code():
         # compare.py: plot methods that return an Axes keep pyplot's figure, as pandas and
         # xarray do, so that Jupyter shows it when the cell ends
         if creates.search(text) and p.name not in ("figures.py", "compare.py"):
-            bad.append(f"{p.name}: creates a pyplot figure (use bearing_lab.figures.new_figure)")
+            bad.append(f"{p.name}: creates a pyplot figure (use bearing_lab.utils.figures.new_figure)")
     assert not bad, bad

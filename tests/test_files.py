@@ -8,7 +8,7 @@ import textwrap
 
 import pytest
 
-from bearing_lab._files import atomic_open, atomic_path, cache_dir, sha256_file
+from bearing_lab.utils._files import atomic_open, atomic_path, cache_dir, sha256_file
 
 
 def test_atomic_path_replaces_on_success(tmp_path):
@@ -49,7 +49,7 @@ def test_killed_writer_leaves_old_file(tmp_path):
     target.write_bytes(b"PRECIOUS")
     code = textwrap.dedent(f"""
         import os, signal
-        from bearing_lab._files import atomic_path
+        from bearing_lab.utils._files import atomic_path
         with atomic_path({str(target)!r}) as tmp:
             tmp.write_bytes(b"x" * 100000)
             os.kill(os.getpid(), signal.SIGKILL)
@@ -90,7 +90,7 @@ def test_temporaries_of_killed_writers_are_removed_by_the_next_write(tmp_path):
     target = tmp_path / "out.nc"
     code = textwrap.dedent(f"""
         import os, signal
-        from bearing_lab._files import atomic_path
+        from bearing_lab.utils._files import atomic_path
         with atomic_path({str(target)!r}) as tmp:
             tmp.write_bytes(b"partial")
             os.kill(os.getpid(), signal.SIGKILL)

@@ -51,9 +51,9 @@ def test_info_reads_without_xarray(datafile):
 def test_a_dataset_is_made_and_written_without_dask(tmp_path):
     """A simulation made and written (the ``simulate -o`` path) imports no dask.array, no
     distributed: 0.6 s of CPU that xarray would spend only to learn that nothing is dask."""
-    code = ("import bearing_lab\nfrom bearing_lab.io_netcdf import write_netcdf\n"
+    code = ("import bearing_lab\nfrom bearing_lab.io import to_netcdf\n"
             "ds = bearing_lab.simulate('paper-healthy', duration=0.005, progress=False)\n"
-            f"write_netcdf(ds, {str(tmp_path / 'a.nc')!r})\n")
+            f"to_netcdf(ds, {str(tmp_path / 'a.nc')!r})\n")
     # xarray imports dask's core (0.1 s) to ask dask.base; not dask.array, not distributed
     out = subprocess.run([sys.executable, "-c", code + "import sys\n"
                           "print('dask.array' in sys.modules, 'distributed' in sys.modules)"],
@@ -66,11 +66,11 @@ def test_dask_still_works_through_xarray_after_the_hooks(tmp_path):
     import numpy as np
     import xarray as xr
     from bearing_lab import _xarray  # noqa: F401  (the hooks)
-    from bearing_lab.io_netcdf import write_netcdf
+    from bearing_lab.io import to_netcdf
     from xarray.namedarray.pycompat import array_type
     ds = xr.Dataset({"a": ("time", np.arange(1000.0))}, coords={"time": np.arange(1000) / 1e3},
                     attrs={"sampling_rate_hz": 1000.0}).chunk({"time": 250})
     assert ds["a"].chunks is not None and isinstance(ds["a"].data, array_type("dask"))
-    p = write_netcdf(ds, tmp_path / "chunked.nc")
+    p = to_netcdf(ds, tmp_path / "chunked.nc")
     back = xr.load_dataset(p)
     np.testing.assert_array_equal(back["a"].values, np.arange(1000.0))

@@ -212,8 +212,8 @@ def test_damaged_cache_entry_is_recomputed_and_reported(serial, cache, tmp_path,
 def test_sweep_output_reads_back_through_info(serial, tmp_path, capsys):
     """`bearing-lab info` refused sweep files: per-scene variables had no units."""
     from bearing_lab.cli import main
-    from bearing_lab.io_netcdf import write_netcdf
-    p = write_netcdf(serial, tmp_path / "sweep.nc")
+    from bearing_lab.io import to_netcdf
+    p = to_netcdf(serial, tmp_path / "sweep.nc")
     assert main(["info", str(p)]) == 0
     out = capsys.readouterr().out
     assert "sweep of scene 'paper-O1'" in out and "dims (defect_offset_mm, speed_rpm, time)" in out

@@ -56,7 +56,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import AnalysisError
-from ._faults import FUNDAMENTAL_SNR_DB, HARMONIC_SNR_DB, MIN_HARMONICS, _shaft_mask
+from ._faults import FUNDAMENTAL_SNR_DB, HARMONIC_SNR_DB, MIN_HARMONICS, shaft_mask
 from ._speed import line_floor_db
 
 __all__ = ["CyclicSpectrum", "family_evidence", "route_verdict", "search_families", "decoy_ratios",
@@ -131,7 +131,7 @@ class CyclicSpectrum:
         """
         out = CyclicSpectrum(None, None, _base=self)
         out.shaft_hz = shaft_hz
-        mask = _shaft_mask(self.f, shaft_hz, self.df)
+        mask = shaft_mask(self.f, shaft_hz, self.df)
         if cage_hz:
             n = np.rint(self.f / cage_hz)
             near = (n >= 1) & (np.abs(self.f - n * cage_hz) <= np.maximum(self.df, 5e-4 * self.f))

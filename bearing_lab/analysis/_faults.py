@@ -55,7 +55,7 @@ def _parabolic(y, k):
     return 0.0 if den >= 0 else float(np.clip(0.5 * (a - c) / den, -0.5, 0.5))
 
 
-def _shaft_mask(f, shaft_hz, df):
+def shaft_mask(f, shaft_hz, df):
     if not shaft_hz:
         return np.zeros(f.shape, bool)
     h = np.rint(f / shaft_hz)
@@ -133,7 +133,7 @@ def fault_line(f, ses, expected_hz, *, shaft_hz=None, tolerance=0.02, n_harmonic
     df = f[1] - f[0]
     if snr_db is None:
         snr_db = line_floor_db(ses, width=max(21, int(round(floor_width_hz / df))))
-    usable = ~_shaft_mask(f, shaft_hz, df)
+    usable = ~shaft_mask(f, shaft_hz, df)
     usable[0] = False
     out = {"expected_hz": float(expected_hz), "measured_hz": None, "snr_db": 0.0, "harmonics": 0,
            "sidebands": 0, "evidence_score": 0.0, "detected": False,

@@ -33,7 +33,7 @@ import numpy as np
 
 from ..errors import AnalysisError, check_choice
 from ._spectral import envelope_band, fast_kurtogram, squared_envelope
-from ._speed import _harmonic_family
+from ._speed import harmonic_family
 from ._util import check_fs, check_signal
 
 __all__ = ["excitation_period", "excitation_duration", "impulses", "Impulses", "DETECTION_FACTOR"]
@@ -361,7 +361,7 @@ def excitation_period(x, fs, *, frequency_range, band=None, method="ses", n_harm
     # a demodulation band must hold several harmonics of the impact rate
     band = _band_arg(x, fs, band, "excitation_period", min_bandwidth=4 * hi, frequency_range=(lo, hi))
     se = squared_envelope(x, fs, band=band)
-    f0, nl, best = _harmonic_family(se, fs, lo, hi, n_harmonics=n_harmonics, method="quinn", fmin=lo,
+    f0, nl, best = harmonic_family(se, fs, lo, hi, n_harmonics=n_harmonics, method="quinn", fmin=lo,
                                     harmonic_weight=HARMONIC_WEIGHT, details=True)
     if nl == 0 or (nl < 3 and best < SINGLE_LINE_SNR_DB):
         raise AnalysisError(f"excitation_period: no impact line (three harmonics 10 dB, or one "

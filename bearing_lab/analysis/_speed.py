@@ -201,11 +201,11 @@ def shaft_frequency(x, fs, *, window, rpm=None, prior_tolerance=0.05, fmin=5.0, 
         raise AnalysisError(f"shaft_frequency: x lasts {n / fs:.3g} s; its 1/T = {df:.3g} Hz "
                             f"bins cannot resolve a shaft line at {lo:.3g} Hz (record at least "
                             f"{4 / lo:.3g} s)")
-    return _harmonic_family(x, fs, lo, hi, n_harmonics=n_harmonics, method=method,
+    return harmonic_family(x, fs, lo, hi, n_harmonics=n_harmonics, method=method,
                             mains_hz=mains_hz, rpm_given=rpm is not None, fmin=fmin)
 
 
-def _harmonic_family(x, fs, lo, hi, *, n_harmonics, method, mains_hz=(), rpm_given=False, fmin=None,
+def harmonic_family(x, fs, lo, hi, *, n_harmonics, method, mains_hz=(), rpm_given=False, fmin=None,
                      harmonic_weight=2, details=False):
     """Family search in [lo, hi] + interpolated refinement; returns (f0, n_lines[, best_snr_db]).
 

@@ -459,7 +459,7 @@ def plot_analysis(x, fs, *, bearing, rpm=None, shaft_hz=None, channel="", units=
     3
     """
     if fig is None:
-        from ..figures import new_figure   # detached from pyplot, shown inline as a cell's value
+        from ..utils.figures import new_figure   # detached from pyplot, shown inline as a cell's value
         fig = new_figure(figsize=(10, 9), layout="constrained")
     result, ex = _run(x, fs, bearing=bearing, rpm=rpm, shaft_hz=shaft_hz, units=units, **kwargs)
     result["channel"], result["units"] = str(channel), str(units)
@@ -482,7 +482,7 @@ def plot_analysis(x, fs, *, bearing, rpm=None, shaft_hz=None, channel="", units=
             xlim=(0, fs / 2))
     _plot_envelope(ax3, ex, result, units)
     if path is not None:
-        from .._files import savefig
+        from ..utils._files import savefig
         savefig(fig, path, dpi=110)  # atomic: an existing figure survives a failed write
     return fig, result
 

@@ -196,7 +196,7 @@ class StructuralPath:
 
     def save(self, path):
         """Write the path as JSON (atomically); :meth:`load` reads it back."""
-        from .._files import atomic_open
+        from ..utils._files import atomic_open
         with atomic_open(path, "w", encoding="utf-8") as fh:
             json.dump(_jsonable(self.to_dict()), fh, indent=1)
         return path

@@ -16,8 +16,11 @@ from __future__ import annotations
 import argparse
 import importlib
 import io
+import os
 import sys
+from pathlib import Path
 
+from .._version import __version__
 from ..errors import BearingLabError
 
 # one line per command module; a module registers one or more sub-commands
@@ -41,6 +44,26 @@ class _Parser(argparse.ArgumentParser):
         self.exit(2, f"{self.prog}: error: {message}\n")
 
 
+def check_output_path(text: str, *, force: bool = False, suffixes=(".nc", ".nc4"), flag: str = "-o") -> Path:
+    """The CLI's ``-o FILE`` (or another output option, ``flag``): refuse a wrong suffix, a missing
+    directory or (without ``force``) an existing file before any work."""
+    out = Path(text)
+    if out.suffix not in suffixes:
+        what = "a netCDF file ending in .nc" if ".nc" in suffixes else "a file ending in " + " or ".join(suffixes)
+        raise BearingLabError(f"{flag} {text}: the output must be {what}")
+    if not out.parent.exists():
+        raise BearingLabError(f"{flag} {text}: directory {out.parent} does not exist")
+    size = len(os.fsencode(out.name))
+    if size > 255:
+        raise BearingLabError(f"{flag} {text}: the file name has {size} bytes; a file name has at most "
+                              "255")
+    if out.is_dir():
+        raise BearingLabError(f"{flag} {text}: is a directory; give a file name ending in {suffixes[0]}")
+    if out.exists() and not force:
+        raise BearingLabError(f"{flag} {text}: exists; pass --force to overwrite it")
+    return out
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(
         prog="bearing-lab",
@@ -49,7 +72,6 @@ def build_parser() -> argparse.ArgumentParser:
                "prints results) prints them as JSON; an existing -o file is kept unless --force. Exit status: "
                "0 done; 1 a result that fails (validate: a row fails unexplained; see its --help); 2 bad "
                "input, said in one line on stderr.")
-    from .. import __version__
     parser.add_argument("--version", action="version", version=f"bearing_lab {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     for name in COMMAND_MODULES:

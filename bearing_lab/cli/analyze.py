@@ -177,7 +177,7 @@ def run(args) -> int:
 
     path = Path(args.file)
     if args.plot:  # before reading: a bad or existing figure path is said at once
-        from ..io_netcdf import check_output_path
+        from . import check_output_path
         check_output_path(args.plot, force=args.force, suffixes=PLOT_SUFFIXES, flag="--plot")
     ds, fs, note = _open(path, args.fs)
     name = _pick_channel(ds, args.channel, path)
@@ -212,7 +212,7 @@ def run(args) -> int:
               f"finite (the largest |value| is {np.max(np.abs(x)):.3g} {units}): reported as null",
               file=sys.stderr)
     if args.json:
-        from .._json import dumps
+        from ..utils._json import dumps
         print(dumps(result, indent=1))  # no NaN/Infinity tokens: strict parsers read it
         return 0
     if args.quiet:

@@ -28,7 +28,7 @@ def _bench(args) -> int:
                    scipy_duration=args.scipy_duration, rates=not args.no_rates,
                    rate_duration=args.rate_duration)
     if args.json:
-        from .._json import dumps
+        from ..utils._json import dumps
         print(dumps(json_summary(ds, args.output), indent=1))
         return 0
     if args.quiet:

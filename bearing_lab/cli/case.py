@@ -24,12 +24,12 @@ def _cmd_new(args) -> int:
         raise ValidationCaseError(f"-o {out}: directory {out.parent} does not exist")
     text = new_case_text(args.recording, name=args.name, bearing=args.bearing, speed=args.speed,
                          channel=args.channel, fmt=args.format, case_dir=out.parent)
-    from .._files import atomic_open
+    from ..utils._files import atomic_open
     with atomic_open(out, "w", encoding="utf-8") as fh:
         fh.write(text)
     notes = [line[len("# NOTE: "):] for line in text.splitlines() if line.startswith("# NOTE: ")]
     if args.json:
-        from .._json import dumps
+        from ..utils._json import dumps
         print(dumps({"case": str(out), "recording": args.recording, "notes": notes}, indent=1))
         return 0
     for note in notes:
@@ -41,7 +41,7 @@ def _cmd_new(args) -> int:
 
 
 def _cmd_standin(args) -> int:
-    from ..io_netcdf import check_output_path
+    from . import check_output_path
     from ..sim.scene import parse_set
     from ..validation.standin import make_standin_recording
     check_output_path(args.output, force=args.force, suffixes=(".uff", ".mat"))
@@ -50,7 +50,7 @@ def _cmd_standin(args) -> int:
                                resonance_hz=args.resonance_hz, noise_g=args.noise_g, seed=args.seed)
     h = s.hidden
     if args.json:
-        from .._json import dumps
+        from ..utils._json import dumps
         print(dumps({"file": str(s.path), "hidden": h}, indent=1))
         return 0
     if args.quiet:

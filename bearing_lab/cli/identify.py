@@ -82,7 +82,7 @@ def run(args) -> int:
                    mirror=args.mirror, cache_dir=args.cache or False)
     paths = write_identification(res, args.output, report=args.report)
     if args.json:
-        from .._json import clean
+        from ..utils._json import clean
         print(json.dumps(clean(res.to_dict()), allow_nan=False))
         return 0
     if args.quiet:

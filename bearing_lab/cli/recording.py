@@ -74,7 +74,7 @@ def _open(args, arrays_only=False):
 
 def _cmd_import(args) -> int:
     from ..io import get_warnings, to_netcdf
-    from ..io_netcdf import check_output_path
+    from . import check_output_path
     check_output_path(args.output, force=args.force)  # before reading: a bad -o is said at once
     ds = _open(args)
     if args.rpm is not None:
@@ -93,7 +93,7 @@ def _cmd_import(args) -> int:
     n = ds.sizes["time"]
     fs = ds.attrs["sampling_rate_hz"]
     if args.json:
-        from .._json import dumps
+        from ..utils._json import dumps
         print(dumps({**describe(ds, args.file), "output": args.output}, indent=1))
     elif not args.quiet:
         print(f"{args.output}: {len(ds.data_vars)} channel(s) {', '.join(ds.data_vars)}, {n} samples "
@@ -171,7 +171,7 @@ def _cmd_info(args) -> int:
     if args.formats:
         from ..io import list_engines
         if args.json:
-            from .._json import dumps
+            from ..utils._json import dumps
             print(dumps(list_engines(), indent=1))
             return 0
         for name, desc in list_engines().items():
@@ -183,7 +183,7 @@ def _cmd_info(args) -> int:
     ds = _open(args, arrays_only=True)  # no Dataset: info prints without importing xarray
     d = describe(ds, args.file)
     if args.json:
-        from .._json import dumps
+        from ..utils._json import dumps
         print(dumps(d, indent=1))
         return 0
     if args.quiet:   # the file reads: exit status 0, nothing printed
@@ -216,7 +216,7 @@ def _cmd_fetch(args) -> int:
         if not (args.quiet or args.json):
             print(f"{name}: {got[name]}")
     if args.json:
-        from .._json import dumps
+        from ..utils._json import dumps
         print(dumps(got, indent=1))
     return 0
 
@@ -224,13 +224,13 @@ def _cmd_fetch(args) -> int:
 def _cmd_sample(args) -> int:
     import shutil
     from importlib import resources
-    from ..io_netcdf import check_output_path
+    from . import check_output_path
     out = check_output_path(args.output, force=args.force, suffixes=(".uff",))
     src = resources.files("bearing_lab").joinpath("data", "sample_recording.uff")
     with resources.as_file(src) as p:
         shutil.copyfile(p, out)
     if args.json:
-        from .._json import dumps
+        from ..utils._json import dumps
         from ..validation.standin import SAMPLE
         print(dumps({"file": str(out), **SAMPLE}, indent=1))
     elif not args.quiet:
@@ -256,7 +256,7 @@ def _cmd_list(args) -> int:
                                      f"{r.fs_hz:g} Hz" if r.fs_hz else "") if x)
         print(f"{r.name:34s} {'sha256' if r.sha256 else 'no-hash':7s} {cond}")
     if args.json:
-        from .._json import dumps
+        from ..utils._json import dumps
         print(dumps(rows, indent=1))
     return 0
 

@@ -8,7 +8,7 @@ def _scenes(args) -> int:
     from ..sim import list_scenes
     scenes = list_scenes()
     if args.json:
-        from .._json import dumps
+        from ..utils._json import dumps
         print(dumps(scenes, indent=1))
         return 0
     if args.quiet:
@@ -25,7 +25,7 @@ def _simulate(args) -> int:
     from ..sim.scene import merge_overrides, parse_set
     overrides = merge_overrides(parse_set(args.set), **{"output.duration_s": args.duration,
                                                         "output.sample_rate_hz": args.fs})
-    from ..io_netcdf import check_output_path
+    from . import check_output_path
     out = check_output_path(args.output, force=args.force)
     import math
     if args.noise_g is not None and not (math.isfinite(args.noise_g) and args.noise_g >= 0):
@@ -34,8 +34,9 @@ def _simulate(args) -> int:
     ds = simulate(args.scene, progress=not (args.quiet or args.json), **overrides)
     if args.noise_g:
         ds = add_measurement_noise(ds, args.noise_g, seed=args.seed, color=args.noise_color)
-    from ..io_netcdf import write_netcdf
-    write_netcdf(ds, out)
+    from ..errors import BearingLabError
+    from ..io.export import to_netcdf
+    to_netcdf(ds, out, error=BearingLabError)
     info = {"file": str(out), "samples": int(ds.sizes["time"]), "sampling_rate_hz": float(ds.attrs["sampling_rate_hz"]),
             "fidelity": ds.attrs["fidelity"], "defect_contact_models": ds.attrs["defect_contact_models"],
             "wall_time_s": float(ds.attrs["wall_time_s"]), "table_time_s": float(ds.attrs["table_time_s"]),
@@ -43,7 +44,7 @@ def _simulate(args) -> int:
             "noise": ({"rms_g": args.noise_g, "color": args.noise_color, "seed": args.seed,
                        "channel": ds.attrs["measurement_noise_channel"]} if args.noise_g else None)}
     if args.json:
-        from .._json import dumps
+        from ..utils._json import dumps
         print(dumps(info, indent=1))
     elif not args.quiet:
         noise = (f", {args.noise_color} noise {args.noise_g:g} g rms on {ds.attrs['measurement_noise_channel']} "

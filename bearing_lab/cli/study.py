@@ -4,6 +4,7 @@ from __future__ import annotations
 import sys
 
 from ..errors import BearingLabError, check_choice
+from ..units import G
 
 
 def _study(args) -> int:
@@ -15,7 +16,7 @@ def _study(args) -> int:
         check_choice(n, STUDIES, "--only")
     table = run_paper_studies(args.output, progress=not (args.quiet or args.json), studies=names)
     if args.json:
-        from .._json import dumps
+        from ..utils._json import dumps
         print(dumps({"output": args.output, "rows": table.to_dataframe().reset_index().to_dict("records"),
                      "total_wall_time_s": table.attrs["total_wall_time_s"]}, indent=1))
         return 0
@@ -23,7 +24,7 @@ def _study(args) -> int:
         return 0
     for r in table.to_dataframe().itertuples():
         print(f"{r.study:7s} {r.label:12s} peak disp {r.peak_displacement*1e6:7.4f} µm  "
-              f"peak acc {r.peak_acceleration/9.80665:7.2f} g  p-p {r.acceleration_peak_to_peak/9.80665:7.2f} g  "
+              f"peak acc {r.peak_acceleration/G:7.2f} g  p-p {r.acceleration_peak_to_peak/G:7.2f} g  "
               f"duration {r.excitation_duration*1e3:6.3f} ms (L/v {r.crossing_time*1e3:6.3f} ms)")
     print(f"wrote {args.output}/index.html, studies.nc and PNG figures "
           f"({table.attrs['total_wall_time_s']:.1f} s)", file=sys.stderr)

@@ -8,7 +8,7 @@ from ..errors import SceneError
 
 def parse_params(items) -> dict:
     """``["speed_rpm=900,1800", "defect.offset_mm=0,0.5"]`` -> ``{key: [values]}``."""
-    from ..sim.scene import _parse_value
+    from ..sim.scene import parse_value
     out = {}
     for item in items or []:
         if "=" not in item:
@@ -21,7 +21,7 @@ def parse_params(items) -> dict:
         vals = [v.strip() for v in text.split(",")]
         if not text.strip() or any(v == "" for v in vals):
             raise SceneError(f"--param {key}: empty value in {text!r}; expected {key}=V1,V2,...")
-        out[key] = [_parse_value(v) for v in vals]
+        out[key] = [parse_value(v) for v in vals]
     if not out:
         raise SceneError("sweep: give at least one --param KEY=V1,V2,...")
     return out
@@ -32,7 +32,7 @@ def _sweep(args) -> int:
     from ..sim.scene import parse_set
     params = parse_params(args.param)
     overrides = parse_set(args.set)
-    from ..io_netcdf import check_output_path
+    from . import check_output_path
     out = check_output_path(args.output, force=args.force)
     cache = False if args.no_cache else args.cache_dir
     import warnings
@@ -42,11 +42,12 @@ def _sweep(args) -> int:
         ds = sweep(args.scene, params, scheduler=args.scheduler, n_workers=args.workers,
                    cache_dir=cache, progress=not (args.quiet or args.json), duration=args.duration, fs=args.fs,
                    **overrides)
-    from ..io_netcdf import write_netcdf
-    write_netcdf(ds, out)
+    from ..errors import BearingLabError
+    from ..io.export import to_netcdf
+    to_netcdf(ds, out, error=BearingLabError)
     dims = " x ".join(f"{d}={ds.sizes[d]}" for d in ds.attrs["sweep_dims"].split())
     if args.json:
-        from .._json import dumps
+        from ..utils._json import dumps
         print(dumps({"file": str(out), "dims": {d: ds.sizes[d] for d in ds.attrs["sweep_dims"].split()},
                      **{k: ds.attrs[k] for k in ("sweep_n_scenes", "sweep_computed", "sweep_cache_hits",
                                                  "sweep_wall_time_s", "sweep_scheduler")}}, indent=1))

@@ -83,7 +83,7 @@ def run(args) -> int:
     from ..validation import load_case, run_validation, shipped_cases
     if args.list:
         if args.json:
-            from .._json import dumps
+            from ..utils._json import dumps
             print(dumps([{"case": n, "default": load_case(n).default, "title": load_case(n).title}
                          for n in shipped_cases()], indent=1))
             return 0
@@ -97,7 +97,7 @@ def run(args) -> int:
     outcomes, status = run_validation(args.cases or None, args.output, strict=args.strict,
                                       progress=progress, mirror=args.mirror)
     if args.json:
-        from .._json import dumps
+        from ..utils._json import dumps
         print(dumps(_json(outcomes, args.output, status), indent=1))
     elif not args.quiet:
         for o in outcomes:

@@ -26,7 +26,7 @@ from pathlib import Path
 import stat
 
 from ..errors import BearingLabError, RecordingError, check_choice
-from ._base import (_ARRAYS_ONLY, ENGINES, RecordingArrays, RecordingReader,  # noqa: F401
+from ._base import (ARRAYS_ONLY, ENGINES, RecordingArrays, RecordingReader,  # noqa: F401
                     RecordingWarning, get_warnings)
 
 #: The built-in readers (one module each, named like the format), in sniffing order: the first
@@ -237,7 +237,7 @@ def open_recording(path, format=None, **options):
         except OSError as exc:
             raise RecordingError(f"{path}: cannot read the file ({exc.strerror or exc})") from None
     check_choice(format, ENGINES, f"{path}: format", RecordingError)
-    if not _ARRAYS_ONLY.get():
+    if not ARRAYS_ONLY.get():
         from .. import _accessor  # noqa: F401  (registers da.bearing on the recordings; imports xarray)
     reader = ENGINES[format]()
     missing = reader.available()
@@ -276,8 +276,8 @@ def read_arrays(path, format=None, **options):
     their channels (all but ``netcdf``, which returns its Dataset).  For a quick summary
     (``bearing-lab info``): xarray and pandas are not imported.
     """
-    token = _ARRAYS_ONLY.set(True)
+    token = ARRAYS_ONLY.set(True)
     try:
         return open_recording(path, format=format, **options)
     finally:
-        _ARRAYS_ONLY.reset(token)
+        ARRAYS_ONLY.reset(token)

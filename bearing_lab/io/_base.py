@@ -50,6 +50,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._version import __version__
 from ..errors import BearingLabError, RecordingError
 from .. import units as _units
 
@@ -460,8 +461,6 @@ class RecordingBuilder:
         data : an mmap/bytes of the whole file to hash (avoids reading it again).
         channels : channel selection (see :meth:`select`).
         """
-        from .. import __version__
-
         if isinstance(self.units, dict):
             extra = set(self.units) - self._used_units
             if extra:
@@ -527,7 +526,7 @@ class RecordingBuilder:
             if v is not None and k not in attrs:
                 attrs[k] = _attr_value(v)
         rec = RecordingArrays(t, self.channels, attrs)
-        if _ARRAYS_ONLY.get():
+        if ARRAYS_ONLY.get():
             return rec
         try:
             return rec.to_dataset()
@@ -537,7 +536,7 @@ class RecordingBuilder:
 
 #: Set by :func:`bearing_lab.io.read_arrays`: :meth:`RecordingBuilder.build` then returns the
 #: :class:`RecordingArrays` instead of the Dataset (no xarray import, for ``bearing-lab info``).
-_ARRAYS_ONLY = contextvars.ContextVar("bearing_lab_io_arrays_only", default=False)
+ARRAYS_ONLY = contextvars.ContextVar("bearing_lab_io_arrays_only", default=False)
 
 
 class _Channel:

@@ -42,6 +42,8 @@ import warnings
 
 import numpy as np
 
+from ..units import G
+
 VERDICTS = ("ok", "renamed", "refused", "uncaught", "silent", "invalid", "crash", "hang", "memory")
 BAD = ("uncaught", "silent", "invalid", "crash", "hang", "memory")
 
@@ -114,7 +116,7 @@ def _build_wav(mirror: Path, tmp: Path) -> Path:
     import scipy.io.wavfile
     from . import open_recording
     ds = open_recording(mirror / "cwru" / "130_OR007@6_0.mat")
-    x = np.stack([ds["DE"].values, ds["FE"].values], axis=1)[:40000] / 9.80665 / 10.0
+    x = np.stack([ds["DE"].values, ds["FE"].values], axis=1)[:40000] / G / 10.0
     p = tmp / "cwru130_de_fe.wav"
     scipy.io.wavfile.write(p, 12000, np.round(np.clip(x, -1, 1) * 32767).astype(np.int16))
     return p
@@ -144,7 +146,7 @@ def _build_testlab_text(mirror: Path, tmp: Path) -> Path:
     head = ("Name\tRun 1\nProject\tIMS set 2\nSection\tSection1\nIncrement\t"
             f"{1.0 / ds.attrs['sampling_rate_hz']:.10g}\n" + "b1\tb2\ng\tg\nReal\tReal\n")
     rows = "\n".join(f"{a:.6f}\t{b:.6f}".replace(".", ",") for a, b in
-                     zip(ds["b1"].values[:3000] / 9.80665, ds["b2"].values[:3000] / 9.80665))
+                     zip(ds["b1"].values[:3000] / G, ds["b2"].values[:3000] / G))
     p = tmp / "ims_export.txt"
     p.write_bytes((head + rows + "\n").encode("latin-1"))
     return p
@@ -300,7 +302,7 @@ def _open_quietly(path, options):
             return open_recording(path, **options)
 
 
-def _exception_verdict(exc, path: Path) -> tuple[str, str]:
+def exception_verdict(exc, path: Path) -> tuple[str, str]:
     from ..errors import RecordingError
     if isinstance(exc, RecordingError):
         if path.name not in str(exc):
@@ -317,7 +319,7 @@ def verdict(path: Path, source: Source, ref, truncation: bool) -> tuple[str, str
     except KeyboardInterrupt:
         raise
     except BaseException as exc:  # noqa: BLE001 - the point is to count them
-        return _exception_verdict(exc, path)
+        return exception_verdict(exc, path)
     got, want = _summary(ds), _summary(ref)
     if len(got["channels"]) != len(want["channels"]):
         return "silent", f"channels {got['channels']} instead of {want['channels']}"
@@ -350,7 +352,7 @@ def _peak_rss_mb() -> float:
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
 
 
-def _limit_address_space(extra_mb: int) -> None:
+def limit_address_space(extra_mb: int) -> None:
     import resource
     try:
         with open("/proc/self/status") as fh:
@@ -361,7 +363,7 @@ def _limit_address_space(extra_mb: int) -> None:
         pass
 
 
-def _scratch() -> Path:
+def scratch() -> Path:
     base = "/dev/shm" if os.path.isdir("/dev/shm") and os.access("/dev/shm", os.W_OK) else None
     return Path(tempfile.mkdtemp(prefix="bearing_lab_fuzz_", dir=base))
 
@@ -373,14 +375,14 @@ def worker(name: str, seed: int, mem_mb: int) -> None:
     os.dup2(2, 1)  # anything a library prints goes to stderr, never into the protocol
     source = SOURCES[name]
     mirror = Path(os.environ.get("BEARING_LAB_MIRROR", "../shared/data"))
-    tmp = _scratch()
+    tmp = scratch()
     try:
         original = source.build(mirror, tmp)
         data = original.read_bytes()
         hot = hot_spots(data, source.fmt)
         ref = _open_quietly(original, source.options)
         ref.load()
-        _limit_address_space(max(3 * mem_mb, 2048))
+        limit_address_space(max(3 * mem_mb, 2048))
         base = _peak_rss_mb()
         proto.write(json.dumps({"ready": _summary(ref), "bytes": len(data)}) + "\n")
         faults = _injected_faults()
@@ -424,12 +426,12 @@ def _inject(kind: str, path: Path) -> tuple[str, str]:
     if kind == "hang":
         time.sleep(3600)
     if kind == "uncaught":
-        return _exception_verdict(TypeError("injected"), path)
+        return exception_verdict(TypeError("injected"), path)
     return "silent", "injected"
 
 
 # ------------------------------------------------------------------ the parent
-class _Worker:
+class Worker:
     def __init__(self, name, seed, mem_mb, startup_s=120.0):
         cmd = [sys.executable, "-m", "bearing_lab.io._fuzz", "worker", name, str(seed), str(mem_mb)]
         self._boot(cmd, name, startup_s)
@@ -464,7 +466,7 @@ def fuzz_source(name: str, n: int, *, seed: int = 0, start: int = 0, timeout: fl
     """Run mutants ``start .. start+n-1`` of one source; return counts and examples."""
     counts = {v: 0 for v in VERDICTS}
     examples: dict[str, list] = {}
-    w = _Worker(name, seed, mem_mb)
+    w = Worker(name, seed, mem_mb)
     t0 = time.perf_counter()
     try:
         for i in range(start, start + n):
@@ -479,10 +481,10 @@ def fuzz_source(name: str, n: int, *, seed: int = 0, start: int = 0, timeout: fl
                     v, detail = "crash", f"worker died with status {w.proc.returncode}"
                 w.stop()
                 ans = {"i": i, "v": v, "detail": detail, "op": _describe(name, seed, i)}
-                w = _Worker(name, seed, mem_mb)
+                w = Worker(name, seed, mem_mb)
             elif ans["v"] == "memory":
                 w.stop()
-                w = _Worker(name, seed, mem_mb)
+                w = Worker(name, seed, mem_mb)
             counts[ans["v"]] += 1
             if ans["v"] in BAD:
                 examples.setdefault(ans["v"], [])
@@ -499,7 +501,7 @@ def fuzz_source(name: str, n: int, *, seed: int = 0, start: int = 0, timeout: fl
 def _source_bytes(name):
     source = SOURCES[name]
     mirror = Path(os.environ.get("BEARING_LAB_MIRROR", "../shared/data"))
-    tmp = _scratch()
+    tmp = scratch()
     try:
         p = source.build(mirror, tmp)
         return source, p.name, p.read_bytes()

@@ -28,13 +28,13 @@ import warnings
 
 import numpy as np
 
+from ..units import G
 from . import _fuzz
-from ._fuzz import _Worker, _exception_verdict, _limit_address_space, _scratch
+from ._fuzz import Worker, exception_verdict, limit_address_space, scratch
 
 STRUCT_KINDS = ("mat5", "v73", "netcdf", "wav", "uff", "special")
 STRUCT_VERDICTS = ("ok", "refused", "unverified", "uncaught", "silent", "invalid", "crash", "hang",
                    "refcrash")
-G = 9.80665
 
 
 def _field(rng, fields: dict):
@@ -407,7 +407,7 @@ def structured_verdict(path: Path, options: dict, kind: str) -> tuple[str, str]:
     except KeyboardInterrupt:
         raise
     except BaseException as exc:  # noqa: BLE001
-        return _exception_verdict(exc, path)
+        return exception_verdict(exc, path)
     try:
         schema.check_dataset(ds, kind="recording" if "reader" in ds.attrs else None)
     except Exception as exc:  # noqa: BLE001
@@ -452,11 +452,11 @@ def structured_worker(kind: str, seed: int) -> None:
     os.environ.setdefault("BEARING_LAB_READ_TIMEOUT", "5")
     proto = os.fdopen(os.dup(1), "w", buffering=1)
     os.dup2(2, 1)
-    _limit_address_space(2048)
+    limit_address_space(2048)
     proto.write(json.dumps({"ready": kind}) + "\n")
     for line in sys.stdin:
         index = int(line)
-        tmp = _scratch()
+        tmp = scratch()
         try:
             _phase("read")
             t0 = time.perf_counter()
@@ -479,7 +479,7 @@ def fuzz_structured(kind: str, n: int, *, seed: int = 0, timeout: float = 30.0) 
     os.environ["BEARING_LAB_FUZZ_PHASE"] = phase_file
 
     def start():
-        return _Worker.__new__(_Worker)._boot(cmd, kind)
+        return Worker.__new__(Worker)._boot(cmd, kind)
 
     w = start()
     t0, slowest = time.perf_counter(), 0.0

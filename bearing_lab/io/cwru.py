@@ -174,7 +174,7 @@ class CwruReader(RecordingReader):
 def _registered_by_content(path):
     """The registry entry whose sha256 is this file's (None if none, or the file is large)."""
     from .. import datasets
-    from .._files import sha256_file
+    from ..utils._files import sha256_file
     if path.stat().st_size > 256 * 2 ** 20:
         return None
     known = [r for r in datasets.load_registry().values() if r.sha256 and r.dataset.startswith("cwru")]

@@ -1,4 +1,10 @@
-"""Writers: compressed netCDF4 (lossless) and UFF 58b (back into Testlab and friends).
+"""Writers: netCDF4 (lossless, atomic, checksummed) and UFF 58b (back into Testlab and friends).
+
+Why one netCDF writer (:func:`to_netcdf`, for recordings, simulations, reports and the sweep
+cache): every ``.nc`` bearing_lab writes must survive a failure, a kill or a second process
+writing the same name (the file is written beside the target and renamed over it in one step,
+:func:`bearing_lab.utils._files.atomic_path`), must carry checksums (HDF5's Fletcher-32 on every
+numeric chunk, so a damaged chunk cannot be read as data), and must read back bit for bit.
 
 Why a hand-written 58b writer: ``pyuff.UFF.write_sets(binary=1)`` packs one value
 per ``struct.pack`` call and its ``mode='overwrite'`` leaves a 7-byte file; ours
@@ -10,13 +16,15 @@ a dataset 164 that declares SI units.
 """
 from __future__ import annotations
 
+import os
 from datetime import datetime
 from pathlib import Path
 
 import numpy as np
 
-from ..errors import RecordingError, check_choice
 from .. import units as _units
+from ..errors import RecordingError, check_choice
+from ..utils._files import atomic_path
 
 # quantity -> (UFF specific data type, length exponent, force exponent)
 _SPEC = {"acceleration": (12, 1, 0), "velocity": (11, 1, 0), "displacement": (8, 1, 0),
@@ -24,17 +32,50 @@ _SPEC = {"acceleration": (12, 1, 0), "velocity": (11, 1, 0), "displacement": (8,
 _DIR_CODES = {"+X": 1, "+Y": 2, "+Z": 3, "-X": -1, "-Y": -2, "-Z": -3}
 
 
-def to_netcdf(ds, path, *, complevel: int = 4):
-    """Write a Dataset to netCDF4 with zlib compression; reading it back is bit-for-bit equal.
+def _text(v: str) -> str:
+    """A string netCDF can store: undecodable bytes of a file name become U+FFFD."""
+    try:
+        v.encode("utf-8")
+        return v
+    except UnicodeEncodeError:
+        return v.encode("utf-8", "surrogateescape").decode("utf-8", "replace")
+
+
+def _attr(v):
+    if isinstance(v, (bool, np.bool_)):
+        return int(v)
+    if isinstance(v, (list, tuple)):
+        return _text("; ".join(map(str, v)))
+    if v is None:
+        return ""
+    if isinstance(v, str):
+        return _text(v)
+    return v
+
+
+def to_netcdf(ds, path, *, complevel: int = 4, checksum_file: bool = False, error=RecordingError) -> Path:
+    """Write a Dataset to netCDF4 (zlib + shuffle + Fletcher-32), atomically; reading it back is
+    bit-for-bit equal.
+
+    Floats keep their dtype and get no fill value (a NaN-free Dataset stays NaN-free);
+    attributes netCDF cannot store (bools, lists, None, undecodable file names) are
+    written as ints / "; "-joined strings / "" / repaired text.  The target is replaced
+    only once the new file is complete and on disk; a failure leaves an existing file
+    untouched and raises ``error`` naming the path.
 
     Parameters
     ----------
     ds : xarray.Dataset
-        A recording or simulation Dataset.
+        A recording, simulation or result Dataset.
     path : str or Path
         Output file (``.nc``).
     complevel : int
-        zlib level 1..9.
+        zlib level 1..9; 0 writes the values uncompressed (still with Fletcher-32).
+    checksum_file : bool
+        Also write ``<path>.sha256`` (``sha256sum -c`` format, the digest of the bytes written)
+        once the file is in place.
+    error : exception class
+        Raised when the file cannot be written (a :class:`~bearing_lab.errors.BearingLabError`).
 
     Returns
     -------
@@ -46,8 +87,60 @@ def to_netcdf(ds, path, *, complevel: int = 4):
     >>> xr.load_dataset("out.nc").identical(ds)   # doctest: +SKIP
     True
     """
-    from ..io_netcdf import write_netcdf
-    return write_netcdf(ds, path, complevel=complevel, error=RecordingError)
+    from .. import _xarray  # noqa: F401  (xarray writes without importing dask)
+    from ..utils._files import atomic_open, sha256_file
+    path = Path(path)
+    enc = {}
+    for name, var in ds.variables.items():
+        if var.dtype.kind in "iufc":
+            enc[name] = {"fletcher32": True}
+            if complevel:
+                enc[name].update(zlib=True, complevel=int(complevel), shuffle=True)
+            if var.dtype.kind in "fc":
+                enc[name]["_FillValue"] = None
+    out = ds.copy()
+    out.attrs = {k: _attr(v) for k, v in ds.attrs.items()}
+    for name in out.variables:
+        out[name].attrs = {k: _attr(v) for k, v in out[name].attrs.items()}
+    if path.is_dir():
+        raise error(f"{path}: is a directory; give a file name ending in .nc")
+    try:
+        with atomic_path(path) as tmp:
+            out.to_netcdf(tmp, engine="netcdf4", format="NETCDF4", encoding=enc)
+            digest = sha256_file(tmp) if checksum_file else None
+        if checksum_file:
+            with atomic_open(checksum_path(path), "w") as fh:
+                fh.write(f"{digest}  {path.name}\n")
+    except (OSError, ValueError, TypeError, RuntimeError, UnicodeError) as exc:
+        raise error(f"{path}: cannot write netCDF4 ({_write_failure(path, exc, out)}); an existing "
+                    "file of that name is left as it was") from exc
+    return path
+
+
+def checksum_path(path) -> Path:
+    """The checksum file :func:`to_netcdf` writes beside ``path`` with ``checksum_file=True``."""
+    path = Path(path)
+    return path.with_name(path.name + ".sha256")
+
+
+def _write_failure(path: Path, exc, ds) -> str:
+    """The true cause of a failed write.  netCDF-C/HDF5 report a full disk as "HDF error" or
+    as "Permission denied"; the free space and the directory's permissions tell them apart."""
+    import errno
+    import shutil
+    directory = path.parent if str(path.parent) else Path(".")
+    needed = sum(int(v.nbytes) for v in ds.variables.values())
+    try:
+        free = shutil.disk_usage(directory).free
+    except OSError:
+        free = None
+    full = getattr(exc, "errno", None) in (errno.ENOSPC, errno.EDQUOT)
+    if full or (free is not None and free < needed):
+        return (f"no space left on the device: {free / 1e6:.3g} MB free in {directory}, the data "
+                f"take up to {needed / 1e6:.3g} MB" if free is not None else "no space left on the device")
+    if isinstance(exc, PermissionError) and not os.access(directory, os.W_OK):
+        return f"no permission to write in {directory}"
+    return f"{type(exc).__name__}: {exc}"
 
 
 def _label_for(si: str, quantity: str) -> str:
@@ -164,7 +257,7 @@ def to_uff58b(ds, path, *, channels=None, units: str = "si", id1=None, id2=None,
         out.append("".join(text).encode("utf-8"))
         out.append(y.astype(bo_char + "f8").tobytes())
         out.append(b"%6i\n" % -1)
-    from .._files import atomic_open
+    from ..utils._files import atomic_open
     try:
         with atomic_open(path, "wb") as fh:  # an existing file survives any failure
             for chunk in out:

@@ -21,7 +21,8 @@ Report.save(path) / Report.load(path)                  -- ".html" (self-containe
 write_index(path, entries, *, title, notes)            -- the page listing all cases
 rows_table(rows), table_html(rows), figure_png(fig), fmt(v), esc(text) -- the HTML pieces
 """
-from .html import esc, figure_png, fmt, rows_table, table_html  # noqa: F401
+from ..utils.figures import figure_png  # noqa: F401
+from .html import esc, fmt, rows_table, table_html  # noqa: F401
 from .page import Report, write_index  # noqa: F401
 
 __all__ = ["Report", "write_index", "rows_table", "table_html", "figure_png", "fmt", "esc"]

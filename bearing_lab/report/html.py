@@ -7,16 +7,16 @@ and bench pages share them.
 """
 from __future__ import annotations
 
-import base64
 import html
-import io
 import itertools
 import math
 import re
 from pathlib import Path
 from string import Template
 
-__all__ = ["template", "css", "esc", "fmt", "figure_png", "figure_html", "table_html", "rows_table",
+from ..utils.figures import figure_png
+
+__all__ = ["template", "css", "esc", "fmt", "figure_html", "table_html", "rows_table",
            "index_rows", "kv_html", "notice_html"]
 
 _TEMPLATES = Path(__file__).with_name("templates")
@@ -51,16 +51,6 @@ def fmt(v, digits=5) -> str:
     if abs(x) >= 1e5 or abs(x) < 1e-3:
         return f"{x:.{digits - 1}e}"
     return f"{x:.{digits}g}"
-
-
-def figure_png(fig, dpi=80) -> str:
-    """Base64 PNG of a matplotlib figure (a pyplot figure is closed afterwards)."""
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=dpi)
-    if getattr(fig.canvas, "manager", None) is not None:
-        import matplotlib.pyplot as plt
-        plt.close(fig)
-    return base64.b64encode(buf.getvalue()).decode("ascii")
 
 
 def figure_html(fig, alt, caption="", dpi=80) -> str:

@@ -6,6 +6,7 @@ import json
 import re
 from pathlib import Path
 
+from .._version import __version__
 from ..errors import check_choice
 from .html import (css, esc, figure_html, kv_html, notice_html, rows_table, table_html, template,
                    index_rows)
@@ -15,11 +16,6 @@ __all__ = ["Report", "write_index"]
 
 def _now() -> str:
     return _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M:%S UTC")
-
-
-def _version() -> str:
-    from .. import __version__
-    return __version__
 
 
 def _anchor(title: str, used: set) -> str:
@@ -73,7 +69,7 @@ class Report:
         """A :class:`~bearing_lab.compare.ComparisonResult`: its table, and its figures."""
         self.add_rows(result.rows, title, intro=intro, tags=tags)
         if figures:
-            from ..figures import new_figure
+            from ..utils.figures import new_figure
             fig = new_figure(figsize=(10, 9), layout="constrained")
             axes = fig.subplots(3, 1)
             result.plot_waveforms(ax=axes[0], window_s=(0, 0.1))
@@ -137,11 +133,11 @@ class Report:
             title=esc(self.title), subtitle=esc(self.subtitle), css=css(), toc=" ".join(toc),
             sections="\n".join(secs), n_pass=n_pass, n_rows=len(self.rows), status_class=cls, status_text=text,
             known=f" ({n_known} failing as limitations the case declares)" if n_known else "", date=_now(),
-            version=_version())
+            version=__version__)
 
     def save(self, path, *, overwrite=True):
         """Write ``.html`` (self-contained page) or ``.json`` (sections, rows, info: reloadable), atomically."""
-        from .._files import atomic_open
+        from ..utils._files import atomic_open
         path = Path(path)
         if path.exists() and not overwrite:
             raise FileExistsError(f"{path} exists (pass overwrite=True)")
@@ -173,9 +169,9 @@ def write_index(path, entries: list, *, title="bearing_lab validation", notes=()
     (relative, or None), ``reason`` (for skipped or errored cases); optionally ``verdict``,
     ``verdict_text`` and ``declared_by``.  ``opening``: HTML shown above the table.
     """
-    from .._files import atomic_open
+    from ..utils._files import atomic_open
     notes_html = "".join(f'<p class="note">{esc(n)}</p>' for n in notes)
-    page = template("index.html").substitute(title=esc(title), css=css(), date=_now(), version=_version(),
+    page = template("index.html").substitute(title=esc(title), css=css(), date=_now(), version=__version__,
                                               rows=index_rows(entries), notes=notes_html,
                                               verdicts=opening)
     path = Path(path)

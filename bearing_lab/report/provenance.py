@@ -15,6 +15,8 @@ import platform
 import subprocess
 from pathlib import Path
 
+from .._version import __version__
+
 __all__ = ["software_versions", "source_revision", "environment", "citation", "PAPER_CITATION"]
 
 #: the paper whose model and experiment the project reproduces
@@ -55,7 +57,6 @@ def environment() -> dict:
 
 
 def citation() -> dict:
-    from .. import __version__
     rev = source_revision()
     software = (f"bearing_lab {__version__}" + (f" (source revision {rev})" if rev else "")
                 + ": rolling-bearing simulation, analysis and validation toolkit.")

@@ -26,7 +26,7 @@ import time as _time
 import numpy as np
 import xarray as xr
 
-from .. import __version__
+from .._version import __version__
 from ..errors import BearingLabError, SolverError
 from . import _kernels as K
 from . import _stepper as S

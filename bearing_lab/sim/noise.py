@@ -9,10 +9,10 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import SceneError, check_choice
+from ..units import G
 
-__all__ = ["add_measurement_noise", "NOISE_COLORS", "G0"]
+__all__ = ["add_measurement_noise", "NOISE_COLORS"]
 
-G0 = 9.80665
 #: power spectral density slope of each colour: PSD ∝ f**-slope
 NOISE_COLORS = {"white": 0.0, "pink": 1.0, "brown": 2.0}
 
@@ -52,7 +52,7 @@ def add_measurement_noise(ds, noise_g: float, *, seed: int = 0, channel: str | N
     if da.attrs.get("units") != "m s-2":
         raise SceneError(f"noise: channel {channel!r} is in {da.attrs.get('units')!r}, not an acceleration (m s-2)")
     rng = np.random.default_rng(seed)
-    noise = noise_g * G0 * _colored(rng, da.size, NOISE_COLORS[color]).reshape(da.shape)
+    noise = noise_g * G * _colored(rng, da.size, NOISE_COLORS[color]).reshape(da.shape)
     out = ds.copy()
     attrs = {"measurement_noise_g": float(noise_g), "measurement_noise_color": color,
              "measurement_noise_seed": int(seed), "measurement_noise_channel": str(channel)}

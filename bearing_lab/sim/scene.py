@@ -48,7 +48,8 @@ import numpy as np
 
 from ..bearings import BearingGeometry, CATALOG, get_bearing
 from ..errors import SceneError, check_choice
-from .scene_keys import _NUM, DEFECT_KEYS, G0, SCHEMA, STEEL_DENSITY  # noqa: F401  (the table of scene keys)
+from ..units import G
+from .scene_keys import _NUM, DEFECT_KEYS, SCHEMA, STEEL_DENSITY  # noqa: F401  (the table of scene keys)
 
 
 #: the shortest settling time of a scene with an axial load (the 3-D bearing), s
@@ -76,7 +77,7 @@ _UNITS = {
     "mass": {"kg": 1.0, "g": 1e-3},
     "pressure": {"gpa": 1.0, "pa": 1e-9, "mpa": 1e-3},
     "density": {"kg/m3": 1.0, "kg/m^3": 1.0},
-    "acceleration": {"m/s2": 1.0, "m/s^2": 1.0, "g": G0},
+    "acceleration": {"m/s2": 1.0, "m/s^2": 1.0, "g": G},
 }
 # unit kind and the scale of the key's own unit in that kind's base unit
 _SUFFIX = {
@@ -95,7 +96,7 @@ def _suffix(key: str):
     return None
 
 
-def _convert(value, key: str, where: str):
+def convert_value(value, key: str, where: str):
     """Convert a "1 mm"-style string to the unit the key names."""
     if not isinstance(value, str):
         return value
@@ -125,7 +126,7 @@ bearing, yet small enough that the physics (squares, products of keys) stays fin
 
 def _check(value, key, spec, where):
     default, typ, check, _ = spec
-    value = _convert(value, key, where)
+    value = convert_value(value, key, where)
     if typ is bool:
         if not isinstance(value, bool):
             raise SceneError(f"{where}: {value!r} must be true or false")
@@ -225,7 +226,7 @@ class Scene:
         defects = []
         for i, m in enumerate(d["defect"]):
             where = "defect" if len(d["defect"]) == 1 else f"defect[{i}]"
-            m = {k: _convert(v, k, f"{where}.{k}") for k, v in m.items()}
+            m = {k: convert_value(v, k, f"{where}.{k}") for k, v in m.items()}
             from .defects.contact import CONTACT_MODELS  # the registry names the allowed models
             check_choice(m.pop("contact_model", "auto"), ("auto", *CONTACT_MODELS),
                          f"{where}.contact_model", SceneError)
@@ -385,7 +386,7 @@ def _bearing_from(d: dict) -> BearingGeometry:
 
 
 # ---------------------------------------------------------------- overrides
-_ALIASES = {"speed_rpm": "speed.rpm", "rpm": "speed.rpm", "duration": "output.duration_s",
+SET_ALIASES = {"speed_rpm": "speed.rpm", "rpm": "speed.rpm", "duration": "output.duration_s",
             "fs": "output.sample_rate_hz"}
 
 
@@ -397,7 +398,7 @@ def _key_type(parts):
     return spec[1] if spec else None
 
 
-def _parse_value(text, typ=None, key=""):
+def parse_value(text, typ=None, key=""):
     """A ``--set`` value: the text itself for a text key (``bearing=6205``), a TOML array for a
     list key (``speed.profile=[[0, 1000], [0.05, 1800]]``), else a bool, int, float or text."""
     if not isinstance(text, str):
@@ -427,9 +428,9 @@ def _parse_value(text, typ=None, key=""):
 
 
 def _apply_override(raw: dict, key: str, value):
-    key = _ALIASES.get(key, key)
+    key = SET_ALIASES.get(key, key)
     parts = key.split(".")
-    value = _parse_value(value, _key_type(parts), key)
+    value = parse_value(value, _key_type(parts), key)
     if parts[0] in ("defect", "defects"):
         if len(parts) != 2:
             raise SceneError(f"--set {key}: use defect.<key>, e.g. defect.length_mm=1")
@@ -468,7 +469,7 @@ def parse_set(items) -> dict:
         k = k.strip()
         if not k:
             raise SceneError(f"--set {item!r}: no key before '='")
-        key = _ALIASES.get(k, k)
+        key = SET_ALIASES.get(k, k)
         if key in out:
             raise SceneError(f"--set {k}: the key {key} is already given (--set {given[key]}); give "
                              "it once")
@@ -483,14 +484,14 @@ def merge_overrides(overrides: dict, **named) -> dict:
     """
     out = {}
     for k, v in overrides.items():
-        key = _ALIASES.get(k, k)
+        key = SET_ALIASES.get(k, k)
         if key in out and out[key] != v:
             raise SceneError(f"{k}={v!r}: the key {key} is already set to {out[key]!r}")
         out[key] = v
     for key, v in named.items():
         if v is None:
             continue
-        if key in out and _parse_value(out[key]) != _parse_value(v):
+        if key in out and parse_value(out[key]) != parse_value(v):
             raise SceneError(f"{key} is given twice, as {out[key]!r} and {v!r}; give it once")
         out[key] = v
     return out

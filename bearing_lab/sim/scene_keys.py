@@ -6,8 +6,9 @@ the defaults where the paper is silent are explained in the :mod:`.scene` docstr
 """
 from __future__ import annotations
 
+from ..units import G
+
 STEEL_DENSITY = 7850.0    # kg/m^3, AISI 52100
-G0 = 9.80665             # m/s^2, standard gravity
 # section -> key -> (default, type, check, doc).  check: "pos", "nonneg", "any", "frac",
 # a tuple of allowed strings, or None.
 _NUM = (int, float)
@@ -86,7 +87,7 @@ SCHEMA: dict[str, dict[str, tuple]] = {
     },
     "gravity": {
         "enabled": (True, bool, None, "ring and ball weights along -Y"),
-        "g_m_s2": (G0, _NUM, "nonneg", "standard gravity"),
+        "g_m_s2": (G, _NUM, "nonneg", "standard gravity"),
     },
     "contact": {
         "damping_n_s_m": (350.0, _NUM, "nonneg", "IMPACT c_max (paper: 350 N s/m)"),

@@ -50,8 +50,8 @@ LEVEL_K = 2.0
 def comparison_overrides(case) -> dict:
     """Scene keys every simulated candidate of ``case`` gets: sensor off (a path is applied), the
     comparison's solver tolerance unless the case sets its own."""
-    from .recording_case import _scene_overrides
-    ov = _scene_overrides(case)
+    from .recording_case import scene_overrides
+    ov = scene_overrides(case)
     if "solver.rtol" not in (case.section("scene").get("set", {}) or {}):
         ov["solver.rtol"] = COMPARISON_RTOL
     return ov

@@ -98,7 +98,7 @@ _TOP_PAPER = {"name", "title", "description", "kind", "default", "bearing", "ref
               "studies", "numerical_error"}
 
 
-def _err(case, msg):
+def case_error(case, msg):
     return ValidationCaseError(f"validation case {case!r}: {msg}")
 
 
@@ -162,7 +162,7 @@ class ValidationCase:
         out = [s for s in (self.recording, self.reference) if s is not None]
         ratio = self.section("ratio")
         if ratio.get("recording"):
-            out.append(_ratio_spec(self, ratio))
+            out.append(ratio_spec(self, ratio))
         return out
 
 
@@ -185,21 +185,21 @@ def list_cases() -> dict:
 
 
 # ------------------------------------------------------------------ checks
-def _keys(name, where, mapping, allowed):
+def check_keys(name, where, mapping, allowed):
     if not isinstance(mapping, dict):
-        raise _err(name, f"[{where}] must be a table")
+        raise case_error(name, f"[{where}] must be a table")
     bad = sorted(set(mapping) - set(allowed))
     if bad:
-        raise _err(name, f"unknown key {bad[0]!r} in [{where}]; allowed keys are {', '.join(sorted(allowed))}")
+        raise case_error(name, f"unknown key {bad[0]!r} in [{where}]; allowed keys are {', '.join(sorted(allowed))}")
 
 
-def _number(name, where, v, *, lo=None, hi=None, positive=False):
+def check_number(name, where, v, *, lo=None, hi=None, positive=False):
     if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
-        raise _err(name, f"{where} = {v!r} must be a finite number")
+        raise case_error(name, f"{where} = {v!r} must be a finite number")
     if positive and not v > 0:
-        raise _err(name, f"{where} = {v!r} must be positive")
+        raise case_error(name, f"{where} = {v!r} must be positive")
     if (lo is not None and v < lo) or (hi is not None and v > hi):
-        raise _err(name, f"{where} = {v!r} must lie between {lo:g} and {hi:g}")
+        raise case_error(name, f"{where} = {v!r} must lie between {lo:g} and {hi:g}")
     return float(v)
 
 
@@ -208,15 +208,15 @@ def check_speed(name, where, v):
     if v in ("file", "estimate"):
         return v
     if isinstance(v, bool) or not isinstance(v, (int, float)) or not (math.isfinite(v) and v > 0):
-        raise _err(name, f"{where} = {v!r}: give the shaft speed in r/min, \"file\" (stored in the recording) "
+        raise case_error(name, f"{where} = {v!r}: give the shaft speed in r/min, \"file\" (stored in the recording) "
                          "or \"estimate\" (from the signal)")
     return float(v)
 
 
-def _recording(name, where, raw, base_dir, *, allowed=None) -> RecordingSpec:
-    _keys(name, where, raw, allowed or CASE_KEYS["recording"])
+def recording_spec(name, where, raw, base_dir, *, allowed=None) -> RecordingSpec:
+    check_keys(name, where, raw, allowed or CASE_KEYS["recording"])
     if bool(raw.get("file")) == bool(raw.get("name")):
-        raise _err(name, f"[{where}] needs exactly one of file (a path) or name (a registry recording)")
+        raise case_error(name, f"[{where}] needs exactly one of file (a path) or name (a registry recording)")
     spec = RecordingSpec(name=raw.get("name"), channel=raw.get("channel"), format=raw.get("format"),
                          sensitivity=raw.get("sensitivity"), units=raw.get("units"))
     if raw.get("file"):
@@ -227,30 +227,30 @@ def _recording(name, where, raw, base_dir, *, allowed=None) -> RecordingSpec:
         try:
             datasets.get(spec.name)
         except BearingLabError as exc:
-            raise _err(name, f"{where}.name: {exc}") from None
+            raise case_error(name, f"{where}.name: {exc}") from None
     if "fs" in raw:
-        spec.fs = _number(name, f"{where}.fs", raw["fs"], positive=True)
+        spec.fs = check_number(name, f"{where}.fs", raw["fs"], positive=True)
     if "scale" in raw:
         s = raw["scale"]
-        spec.scale = _number(name, f"{where}.scale", s, lo=SCALE_RANGE[0], hi=SCALE_RANGE[1]) if (
+        spec.scale = check_number(name, f"{where}.scale", s, lo=SCALE_RANGE[0], hi=SCALE_RANGE[1]) if (
             isinstance(s, (int, float)) and not isinstance(s, bool) and math.isfinite(s) and s > 0) else None
         if spec.scale is None:
-            raise _err(name, f"{where}.scale = {s!r}: a calibration factor must be a finite positive number "
+            raise case_error(name, f"{where}.scale = {s!r}: a calibration factor must be a finite positive number "
                              f"between {SCALE_RANGE[0]:g} and {SCALE_RANGE[1]:g} (1 = the file's values are right)")
     if spec.sensitivity is not None:
         from ..units import parse_sensitivity
         try:
             parse_sensitivity(spec.sensitivity)
         except BearingLabError as exc:
-            raise _err(name, f"{where}.sensitivity: {exc}") from None
-    spec.start_s = _number(name, f"{where}.start_s", raw.get("start_s", 0.0), lo=0.0, hi=1e6)
-    spec.duration_s = _number(name, f"{where}.duration_s", raw.get("duration_s", 1.0), positive=True)
+            raise case_error(name, f"{where}.sensitivity: {exc}") from None
+    spec.start_s = check_number(name, f"{where}.start_s", raw.get("start_s", 0.0), lo=0.0, hi=1e6)
+    spec.duration_s = check_number(name, f"{where}.duration_s", raw.get("duration_s", 1.0), positive=True)
     if "speed" in raw:
         spec.speed = check_speed(name, f"{where}.speed", raw["speed"])
     return spec
 
 
-def _ratio_spec(case, raw) -> RecordingSpec:
+def ratio_spec(case, raw) -> RecordingSpec:
     """The ``[ratio]`` companion: a registry name when the registry knows it, else a file."""
     rec = str(raw["recording"])
     spec = RecordingSpec(channel=raw.get("channel"), speed=raw.get("speed", "file"))
@@ -271,33 +271,33 @@ def _is_registry(name) -> bool:
         return False
 
 
-def _tolerances(name, raw, *, where="tolerances", allowed=None) -> dict:
+def parse_tolerances(name, raw, *, where="tolerances", allowed=None) -> dict:
     allowed = allowed or QUANTITIES
     if not isinstance(raw, dict) or not raw:
-        raise _err(name, f"needs a [{where}] table: one entry per compared quantity")
+        raise case_error(name, f"needs a [{where}] table: one entry per compared quantity")
     out = {}
     for q, spec in raw.items():
         if q not in allowed:
-            raise _err(name, f"unknown quantity {where}.{q}; allowed are {', '.join(allowed)}")
+            raise case_error(name, f"unknown quantity {where}.{q}; allowed are {', '.join(allowed)}")
         if not isinstance(spec, dict):
-            raise _err(name, f"{where}.{q} must be a table such as {{ pct = 1.0, reason = \"...\" }} "
+            raise case_error(name, f"{where}.{q} must be a table such as {{ pct = 1.0, reason = \"...\" }} "
                              "(or {} for the quantity's default)")
-        _keys(name, f"{where}.{q}", spec, {"pct", "factor", "reason", "known_limitation"})
+        check_keys(name, f"{where}.{q}", spec, {"pct", "factor", "reason", "known_limitation"})
         kinds = [k for k in ("pct", "factor") if k in spec]
         if len(kinds) > 1:
-            raise _err(name, f"{where}.{q} needs one of pct or factor, not both")
+            raise case_error(name, f"{where}.{q} needs one of pct or factor, not both")
         default = QUANTITIES[q].tolerance if q in QUANTITIES else None
         if kinds and not str(spec.get("reason", "")).strip():
-            raise _err(name, f"{where}.{q} sets {kinds[0]} but gives no reason: every tolerance needs one")
+            raise case_error(name, f"{where}.{q} sets {kinds[0]} but gives no reason: every tolerance needs one")
         if default is None and not kinds:
-            raise _err(name, f"{where}.{q} has no default: give pct or factor, and a reason")
+            raise case_error(name, f"{where}.{q} has no default: give pct or factor, and a reason")
         kind = kinds[0] if kinds else default.kind
         value = spec[kind] if kinds else default.value
         reason = str(spec.get("reason") or default.reason).strip()
         try:
             out[q] = Tolerance(kind, value, reason, str(spec.get("known_limitation", "")).strip())
         except ValidationCaseError as exc:
-            raise _err(name, f"{where}.{q}: {exc}") from None
+            raise case_error(name, f"{where}.{q}: {exc}") from None
     return out
 
 
@@ -334,13 +334,13 @@ def load_case(spec) -> ValidationCase:
         raise ValidationCaseError(f"validation case {source!r} is not valid TOML: {exc}") from None
     name = str(raw.get("name") or stem)
     kind = raw.get("kind", "recording")
-    check_choice(kind, ("recording", "paper"), "kind", partial(_err, name))
+    check_choice(kind, ("recording", "paper"), "kind", partial(case_error, name))
     top = _TOP_PAPER if kind == "paper" else _TOP_RECORDING
     bad = sorted(set(raw) - top)
     if bad:
         hint = (" ([[run]] tables belong to paper cases; a healthy recording of the same rig goes in "
                 "[reference])" if bad[0] == "run" else "")
-        raise _err(name, f"unknown key {bad[0]!r}{hint}; allowed top-level keys are {', '.join(sorted(top))}")
+        raise case_error(name, f"unknown key {bad[0]!r}{hint}; allowed top-level keys are {', '.join(sorted(top))}")
     case = ValidationCase(name=name, title=str(raw.get("title", name)), kind=kind, source=source, text=text,
                           data=raw, base_dir=base_dir, default=bool(raw.get("default", False)))
     from .case_checks import check_paper, check_recording

@@ -7,14 +7,13 @@ from __future__ import annotations
 import numpy as np
 
 from ..compare import SIGNAL_COLORS
-
-G0 = 9.80665
+from ..units import G
 
 __all__ = ["waveforms", "spectra", "envelope_spectra", "structural_path", "psd_overlay", "paper_run"]
 
 
 def _fig(h=3.2, n=1, w=10):
-    from ..figures import new_figure
+    from ..utils.figures import new_figure
     fig = new_figure(figsize=(w, h * n), layout="constrained")
     return fig, fig.subplots(n, 1, squeeze=False)[:, 0]
 
@@ -26,14 +25,14 @@ def waveforms(signals: dict, fs, *, recording_label, window_s=0.1, shift=0):
     xe = signals["experiment"]
     t = np.arange(xe.size) / fs
     win = t <= min(window_s, t[-1])
-    axes[0].plot(t[win], xe[win] / G0, lw=0.6, color="k")
+    axes[0].plot(t[win], xe[win] / G, lw=0.6, color="k")
     axes[0].set_title(f"recording {recording_label}", fontsize=10)
     titles = {"model": "simulation: the bearing model alone (outer ring, no path, no background)",
               "path+background": "simulation after the fixed structural path (and background), over the recording"}
     for ax, k in zip(axes[1:], names):
         if k != "model":
-            ax.plot(t[win], xe[win] / G0, lw=0.5, color="0.65", label="recording")
-        ax.plot(t[win], signals[k][win] / G0, lw=0.6, color=SIGNAL_COLORS.get(k, "tab:red"),
+            ax.plot(t[win], xe[win] / G, lw=0.5, color="0.65", label="recording")
+        ax.plot(t[win], signals[k][win] / G, lw=0.6, color=SIGNAL_COLORS.get(k, "tab:red"),
                 label="simulation")
         ax.set_title(titles[k], fontsize=10)
         ax.legend(loc="upper right", fontsize=8)
@@ -52,7 +51,7 @@ def spectra(signals: dict, fs):
     for k, y in signals.items():
         y = np.nan_to_num(np.asarray(y, float))
         f, a = amplitude_spectrum(y - y.mean(), fs, window="hann")
-        ax.semilogy(f, np.maximum(a / G0, 1e-12), lw=0.5, color=colors.get(k, "0.5"),
+        ax.semilogy(f, np.maximum(a / G, 1e-12), lw=0.5, color=colors.get(k, "0.5"),
                     label="recording" if k == "experiment" else f"simulation: {k}")
     ax.set_xlabel("frequency (Hz)")
     ax.set_ylabel("amplitude (g)")
@@ -73,9 +72,9 @@ def structural_path(path, fs):
     c = path.curves
     if c:
         tt = c["time_s"] * 1e3
-        a1.semilogy(tt, c["recording"] / G0, "k", lw=1.0, label="recording")
-        a1.semilogy(tt, c["before"] / G0, color="tab:blue", lw=0.9, label="simulation, no path")
-        a1.semilogy(tt, c["after"] / G0, color="tab:red", lw=0.9, label="simulation through the fitted path")
+        a1.semilogy(tt, c["recording"] / G, "k", lw=1.0, label="recording")
+        a1.semilogy(tt, c["before"] / G, color="tab:blue", lw=0.9, label="simulation, no path")
+        a1.semilogy(tt, c["after"] / G, color="tab:red", lw=0.9, label="simulation through the fitted path")
         a1.set_xlabel("time from the impact (ms)")
         a1.set_ylabel("mean envelope (g)")
         a1.legend(fontsize=8)
@@ -96,7 +95,7 @@ def psd_overlay(curves: dict, fs, title):
     for label, y in curves.items():
         y = np.nan_to_num(np.asarray(y, float))
         f, p = welch(y - y.mean(), fs, window="hann", nperseg=min(y.size, 1024))
-        ax.semilogy(f, np.maximum(p / G0 ** 2, 1e-20), lw=0.8, label=label)
+        ax.semilogy(f, np.maximum(p / G ** 2, 1e-20), lw=0.8, label=label)
     ax.set_xlabel("frequency (Hz)")
     ax.set_ylabel("PSD (g²/Hz)")
     ax.legend(fontsize=8)
@@ -110,7 +109,7 @@ def paper_run(label, x, fs, *, kinematic: dict, measured: dict, paper_simulation
     fig, (a1, a2) = _fig(n=2)
     t = np.arange(x.size) / fs
     sel = t <= 0.1
-    a1.plot(t[sel], x[sel] / G0, lw=0.6, color="tab:blue", label="bearing_lab simulation")
+    a1.plot(t[sel], x[sel] / G, lw=0.6, color="tab:blue", label="bearing_lab simulation")
     if amplitude_g:
         a1.axhspan(-amplitude_g, amplitude_g, color="tab:orange", alpha=0.12,
                    label=f"paper: about ±{amplitude_g:g} g")
@@ -118,10 +117,10 @@ def paper_run(label, x, fs, *, kinematic: dict, measured: dict, paper_simulation
     a1.set_ylabel("acceleration (g)")
     a1.legend(loc="upper right", fontsize=8)
     a1.set_title(f"{label}: outer-ring acceleration, first 0.1 s; simulated max |a| = "
-                 f"{np.max(np.abs(x)) / G0:.3g} g", fontsize=10)
+                 f"{np.max(np.abs(x)) / G:.3g} g", fontsize=10)
     f, a = amplitude_spectrum(x - x.mean(), fs, window="hann")
     s2 = f <= 1000
-    a2.semilogy(f[s2], np.maximum(a[s2] / G0, 1e-12), lw=0.6, color="tab:blue", label="bearing_lab simulation")
+    a2.semilogy(f[s2], np.maximum(a[s2] / G, 1e-12), lw=0.6, color="tab:blue", label="bearing_lab simulation")
     for q, c in (("shaft_hz", "0.4"), ("bpfo", "tab:red"), ("bpfi", "tab:green")):
         if q in kinematic:
             a2.axvline(kinematic[q], color=c, ls="--", lw=0.8)

@@ -14,9 +14,10 @@ from pathlib import Path
 
 import numpy as np
 
+from ..units import G as G0
+
 __all__ = ["landscape", "figures", "write_identification", "add_to_case_report"]
 
-G0 = 9.80665
 _VARS = {"score_db": "misfit score (shape + weight x |level|)",
          "shape_db": "shape misfit (RMS log-envelope difference)",
          "level_db": "level: 20 log10(simulated / measured signature peak)"}
@@ -24,7 +25,7 @@ _VARS = {"score_db": "misfit score (shape + weight x |level|)",
 
 def landscape(result):
     import xarray as xr
-    from .. import __version__
+    from .._version import __version__
     from ..sweeps import dim_name, key_units
     keys = list(result.grid)
     vals = [sorted(result.grid[k]) for k in keys]
@@ -125,15 +126,15 @@ def add_to_case_report(result, case_dir):
 
 
 def write_identification(result, out, *, report=False) -> dict:
-    from .._files import atomic_open
-    from .._json import clean
+    from ..utils._files import atomic_open
+    from ..utils._json import clean
     from ..report import Report
     d = Path(out) / result.case
     d.mkdir(parents=True, exist_ok=True)
     paths = {"json": d / "identification.json", "nc": d / "identification.nc", "html": d / "identification.html"}
     with atomic_open(paths["json"], "w", encoding="utf-8") as fh:
         json.dump(clean(result.to_dict()), fh, indent=1, allow_nan=False)
-    from .._files import atomic_path
+    from ..utils._files import atomic_path
     with atomic_path(paths["nc"]) as tmp:
         landscape(result).to_netcdf(tmp)
     rep = Report(f"{result.case}: defect identification")

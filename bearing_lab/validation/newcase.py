@@ -17,6 +17,7 @@ import math
 import os
 from pathlib import Path
 
+from .._version import __version__
 from .quantities import QUANTITIES
 
 __all__ = ["new_case_text", "resolution_limits", "compared_duration", "DEFAULT_ROWS"]
@@ -135,7 +136,6 @@ def new_case_text(recording, *, name=None, bearing=None, speed=None, channel=Non
 
     ``case_dir``: where the case will be written; the recording is then named relative to it.
     """
-    from .. import __version__
     from ..io import open_recording
     path = Path(recording)
     ds = open_recording(path, **({"format": fmt} if fmt else {}))

@@ -34,7 +34,7 @@ MODEL_ASSUMPTIONS = [
 ]
 
 
-from .._json import clean  # noqa: E402  (NaN/inf -> null: one rule for every JSON output)
+from ..utils._json import clean  # noqa: E402  (NaN/inf -> null: one rule for every JSON output)
 
 
 def summary(case, result, wall) -> dict:
@@ -182,7 +182,7 @@ def build_report(case, result, wall) -> Report:
 
 def write_case(case, result, out, *, wall) -> str:
     """Write the case's files into ``out`` (atomically); returns "pass" or "fail"."""
-    from .._files import atomic_open
+    from ..utils._files import atomic_open
     out.mkdir(parents=True, exist_ok=True)
     report = build_report(case, result, wall)
     info = {k: v for k, v in report.info.items() if k != "case TOML"}

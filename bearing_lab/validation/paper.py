@@ -18,9 +18,10 @@ import time
 import numpy as np
 
 from ..analysis.measurement import measure
-from ..compare import G0, compare
+from ..compare import compare
 from . import figures, simulation
 from .quantities import QUANTITIES, value_of
+from ..units import G
 from .rows import make_row
 
 __all__ = ["run_paper_case", "study_rows"]
@@ -55,11 +56,11 @@ def _run_rows(case, label, m, ref, rpm, kin) -> list:
                              paper_simulation=ps.get("excitation_period_s")))
     tol = _tolerance(case, label, "peak_model")
     if tol is not None and "amplitude_g" in pe:
-        rows.append(make_row(f"{label}: peak_model", value_of(QUANTITIES["peak_model"], m), pe["amplitude_g"] * G0,
+        rows.append(make_row(f"{label}: peak_model", value_of(QUANTITIES["peak_model"], m), pe["amplitude_g"] * G,
                              tol, label=f"{label}: waveform amplitude (max |a| of the simulation)", units="m s-2",
                              signal="model", span="paper, measured (read from its waveform figure)",
                              note=f"the paper gives 'about ±{pe['amplitude_g']:g} g' for its experiment",
-                             paper_simulation=(ps.get("amplitude_g") or float("nan")) * G0))
+                             paper_simulation=(ps.get("amplitude_g") or float("nan")) * G))
     return rows
 
 
@@ -91,7 +92,7 @@ def study_rows(case, table, reference):
     """Rows (the offset study's amplitude ratios) and the trend table, from the studies' Dataset."""
     study = [str(s) for s in table["study"].values]
     label = [str(s) for s in table["label"].values]
-    acc = np.asarray(table["peak_acceleration"].values, float) / G0
+    acc = np.asarray(table["peak_acceleration"].values, float) / G
     dur = np.asarray(table["excitation_duration"].values, float)
     rows = []
     tol = case.tolerances.get("offset_ratio")
@@ -157,7 +158,7 @@ def run_paper_case(case, out_dir, *, steps):
     result = compare(signals, fs, rows, n=n, ses_fmax=1000.0,
                      attrs={"case": case.name, "kind": "paper", "bpfo_hz": kin["bpfo"], "bpfi_hz": kin["bpfi"],
                             "shaft_hz": rpm / 60.0})
-    from .._files import sha256_bytes
+    from ..utils._files import sha256_bytes
     prov["reference file sha256"] = sha256_bytes(case.data["_reference_text"].encode("utf-8"))
     sections = [("rows", "Comparison table", {"rows": rows, "show_reference": True, "show_paper": True, "intro": (
         "Experiment: what the paper measured. Reference: the kinematic value at the paper's stated speed (not "

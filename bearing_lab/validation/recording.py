@@ -37,7 +37,7 @@ class Recording:
     def sha256(self) -> str:
         if self.dataset.attrs.get("source_sha256"):
             return str(self.dataset.attrs["source_sha256"])
-        from .._files import sha256_file
+        from ..utils._files import sha256_file
         return sha256_file(self.path)
 
     @property

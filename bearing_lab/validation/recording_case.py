@@ -64,7 +64,7 @@ class Prepared:
         return self.measured["record"]["extras"]["fault"]
 
 
-def _scene_overrides(case) -> dict:
+def scene_overrides(case) -> dict:
     return {} if case.section("structural_path").get("method") == "none" else dict(simulation.SENSOR_OFF)
 
 
@@ -97,7 +97,7 @@ def prepare(case, *, mirror=None) -> Prepared:
             f"the blind diagnosis is {m_rec['extras']['analysis']['diagnosis']}; the impacts are timed on the "
             f"declared defect's {declared.upper()} family, which the {fam['route']} route detects")
     m_seg = measure(rec.segment(n), fs, fault=m_rec["extras"]["fault"], **kw)
-    scene = simulation.build_scene(case, rpm=speed.rpm, fs=fs, duration=n / fs, overrides=_scene_overrides(case))
+    scene = simulation.build_scene(case, rpm=speed.rpm, fs=fs, duration=n / fs, overrides=scene_overrides(case))
     ds = simulation.run(scene)
     return Prepared(case, rec, speed, probe.bearing, scene, n, {"record": m_rec, "segment": m_seg},
                     {"model": simulation.signal(ds)[:n]}, ds)
@@ -216,7 +216,7 @@ def compare_candidates(prep, path, background, candidates: dict, *, tolerances=N
     out = {}
     for label, ov in candidates.items():
         scene = simulation.build_scene(case, rpm=prep.speed.rpm, fs=prep.fs, duration=prep.n / prep.fs,
-                                       overrides={**_scene_overrides(case), **ov})
+                                       overrides={**scene_overrides(case), **ov})
         sig = simulate_signals(prep, path, background, scene=scene)
         out[label] = evaluate_rows({k: v for k, v in tolerances.items() if not QUANTITIES[k].ratio},
                                    prep.measured, measure_signals(prep, sig), context=ctx)

@@ -9,7 +9,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..analysis.measurement import measure
-from ..compare import G0, align_by_impulse_phase, compare, shift
+from ..compare import align_by_impulse_phase, compare, shift
+from ..units import G
 from . import figures, simulation
 from .recording import open_spec
 from .speed import resolve_speed
@@ -38,9 +39,9 @@ def context(case, prep, path, background=None) -> dict:
 
 def ratio_companion(case, prep, path, *, mirror=None) -> dict:
     """Impulse strength of the ``[ratio]`` companion: its recording, and its scene through the same path."""
-    from .case import _ratio_spec
+    from .case import ratio_spec
     cfg = case.section("ratio")
-    spec = _ratio_spec(case, cfg)
+    spec = ratio_spec(case, cfg)
     spec.duration_s, spec.start_s = case.recording.duration_s, case.recording.start_s
     rec = open_spec(spec, case.name, mirror)
     speed = resolve_speed(spec.speed, rec.dataset, rec.x, bearing=prep.bearing, case_name=case.name,
@@ -65,7 +66,7 @@ def _decomposition(parts: dict) -> list:
     total = parts.get("recording")
     out = []
     for label, rms in parts.items():
-        out.append({"signal": label, "RMS (m s-2)": rms, "RMS (g)": rms / G0,
+        out.append({"signal": label, "RMS (m s-2)": rms, "RMS (g)": rms / G,
                     "share of the recording's RMS (%)": 100.0 * rms / total if total else float("nan")})
     return out
 
@@ -150,10 +151,10 @@ def _sections(case, prep, path, background, aligned, shift_k, result, healthy):
         secs.append(("figures", "Structural path", [figures.structural_path(path, prep.fs)]))
     if background is not None:
         bg = background.to_dict()
-        tones = ", ".join(f"{t['frequency_hz']:.2f} Hz ({t['amplitude_m_s2'] / G0:.3g} g)" for t in bg["tones"][:8])
+        tones = ", ".join(f"{t['frequency_hz']:.2f} Hz ({t['amplitude_m_s2'] / G:.3g} g)" for t in bg["tones"][:8])
         secs.append(("table", "Background model", {"rows": [
-            {"measured on": bg["source"], "RMS (g)": bg["rms_m_s2"] / G0, "tones RMS (g)": bg["rms_tones_m_s2"] / G0,
-             "broadband RMS (g)": bg["rms_broadband_m_s2"] / G0, "strongest tones": tones or "none"}],
+            {"measured on": bg["source"], "RMS (g)": bg["rms_m_s2"] / G, "tones RMS (g)": bg["rms_tones_m_s2"] / G,
+             "broadband RMS (g)": bg["rms_broadband_m_s2"] / G, "strongest tones": tones or "none"}],
             "intro": "Added to the simulation after the structural path (signal 'path+background'), so RMS, crest "
                      "factor and kurtosis compare like with like (docs/validation.md, 'Background model')."}))
         secs.append(("figures", "Background model", [figures.psd_overlay(

@@ -25,11 +25,12 @@ from pathlib import Path
 
 import numpy as np
 
+from .._version import __version__
 from ..errors import BearingLabError, RecordingError
+from ..units import G
 
 __all__ = ["StandIn", "make_standin_recording", "default_tones", "FORMATS"]
 
-G0 = 9.80665
 #: file suffix -> written format
 FORMATS = {".uff": "UFF 58b", ".unv": "UFF 58b", ".mat": "Testlab MATLAB export"}
 
@@ -63,7 +64,7 @@ def _write_testlab_mat(path, x, fs, channel):
     sig = {"x_values": {"start_value": 0.0, "increment": 1.0 / fs, "number_of_values": x.size,
                         "quantity": {"label": "s"}},
            "y_values": {"values": x.astype(np.float64),
-                        "quantity": {"label": "g", "unit_transformation": {"factor": 1.0 / G0, "offset": 0.0}}},
+                        "quantity": {"label": "g", "unit_transformation": {"factor": 1.0 / G, "offset": 0.0}}},
            "function_record": {"name": f"1:{channel}", "creation_time": "2026/01/01 00:00:00",
                                "primary_channel": {"label": channel}}}
     scipy.io.savemat(path, {"Signal": sig})
@@ -71,7 +72,6 @@ def _write_testlab_mat(path, x, fs, channel):
 
 def _dataset(x, fs, channel, hidden):
     import xarray as xr
-    from .. import __version__
     t = np.arange(x.size) / fs
     return xr.Dataset({channel: ("time", x, {"units": "m s-2", "quantity": "acceleration", "original_units": "m/s2",
                                              "long_name": "housing acceleration (stand-in)"})},
@@ -140,8 +140,8 @@ def make_standin_recording(path, *, scene="paper-O2", overrides=None, rpm=1793.0
     t = np.arange(x.size) / fs
     tones = default_tones(rpm) if tones is None else [tuple(map(float, tn)) for tn in tones]
     for f, a_g in tones:
-        x = x + a_g * G0 * np.cos(2 * np.pi * f * t + rng.uniform(0, 2 * np.pi))
-    x = x + rng.normal(0.0, noise_g * G0, x.size)
+        x = x + a_g * G * np.cos(2 * np.pi * f * t + rng.uniform(0, 2 * np.pi))
+    x = x + rng.normal(0.0, noise_g * G, x.size)
     hidden = {"scene": scene, "overrides": dict(overrides or {}), "rpm": rpm, "jitter": jitter,
               "resonance_hz": resonance_hz, "resonance_damping": resonance_damping, "sensor_gain": sensor_gain,
               "tones": tones, "noise_g": noise_g, "seed": seed, "duration_s": duration, "fs": fs,
@@ -152,7 +152,7 @@ def make_standin_recording(path, *, scene="paper-O2", overrides=None, rpm=1793.0
 
 
 def _write(path, ds, x, fs, channel):
-    from .._files import atomic_path
+    from ..utils._files import atomic_path
     from ..io import to_uff58b
     try:
         with atomic_path(path) as tmp:
@@ -179,14 +179,14 @@ def make_sample_recording(path) -> Path:
     import tempfile
 
     import xarray as xr
-    from .._files import atomic_path
+    from ..utils._files import atomic_path
     from ..io import to_uff58b
     s = SAMPLE
     with tempfile.TemporaryDirectory() as tmp:
         st = make_standin_recording(Path(tmp) / "a.uff", scene=s["scene"], overrides=s["overrides"], rpm=s["rpm"],
                                     duration=s["duration"], fs=s["fs"], seed=s["seed"], channel=s["channel"])
     x = np.asarray(st.dataset[s["channel"]].values, float)
-    volts = x / G0 * s["sensitivity_v_per_g"]
+    volts = x / G * s["sensitivity_v_per_g"]
     ds = xr.Dataset({s["channel"]: ("time", volts, {"units": "V", "quantity": "voltage", "original_units": "V",
                                                   "long_name": "accelerometer output, 9.91 mV/g (sample)"})},
                     coords={"time": st.dataset["time"]},

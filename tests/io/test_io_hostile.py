@@ -386,7 +386,7 @@ def test_long_output_name_up_to_the_limit(tmp_path, datafile, capsys):
 def test_stale_temporaries_of_long_names_are_found(tmp_path):
     """The cut-and-hashed temporary prefix is the same in every process, so a killed writer's
     temporary of a long name is removed by the next write."""
-    from bearing_lab import _files
+    from bearing_lab.utils import _files
     name = "b" * 250 + ".nc"
     stale = tmp_path / (_files._tmp_prefix(name, ".nc").replace(f"-{os.getpid()}.", "-4194303.")
                         + "zzzzzzzz.nc")
@@ -410,7 +410,7 @@ def test_full_disk_is_named_as_such(tmp_path, monkeypatch):
     import shutil
     import xarray as xr
     from bearing_lab.errors import BearingLabError
-    from bearing_lab.io_netcdf import write_netcdf
+    from bearing_lab.io import to_netcdf
 
     def denied(self, path, **kw):
         raise PermissionError(13, "Permission denied", str(path))
@@ -421,10 +421,10 @@ def test_full_disk_is_named_as_such(tmp_path, monkeypatch):
     monkeypatch.setattr(shutil, "disk_usage", lambda p: real(p)._replace(free=4096))
     with pytest.raises(BearingLabError, match=r"o.nc: cannot write netCDF4 \(no space left on the "
                                               r"device: 0.0041 MB free in .*, the data take up to 1.6 MB\)"):
-        write_netcdf(ds, tmp_path / "o.nc")
+        to_netcdf(ds, tmp_path / "o.nc")
     monkeypatch.setattr(shutil, "disk_usage", real)  # space enough: the library's own words
     with pytest.raises(BearingLabError, match=r"PermissionError: \[Errno 13\] Permission denied"):
-        write_netcdf(ds, tmp_path / "o.nc")
+        to_netcdf(ds, tmp_path / "o.nc")
 
 
 def test_column_name_that_netcdf_refuses_is_cleaned_at_read(write, tmp_path, capsys):

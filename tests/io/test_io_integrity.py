@@ -217,8 +217,7 @@ def test_info_describes_simulation_output(tmp_path):
     """`bearing-lab info` printed a traceback on every simulation output."""
     from bearing_lab.cli import main
     from bearing_lab.sim import simulate
-    from bearing_lab.io_netcdf import write_netcdf
-    p = write_netcdf(simulate("paper-healthy", duration=0.01, progress=False), tmp_path / "s.nc")
+    p = to_netcdf(simulate("paper-healthy", duration=0.01, progress=False), tmp_path / "s.nc")
     r = subprocess.run([sys.executable, "-m", "bearing_lab", "info", str(p)], capture_output=True,
                        text=True, timeout=120)
     assert r.returncode == 0, r.stderr

@@ -66,7 +66,7 @@ def test_pooch_registry():
 def test_every_mirrored_registry_file_has_its_true_sha256(mirror):
     """A registry row without a checksum lets a mirror serve anything: every row whose file is in
     the mirror must carry the sha256 of that file."""
-    from bearing_lab._files import sha256_file
+    from bearing_lab.utils._files import sha256_file
     if mirror is None:
         pytest.skip("no mirror")
     checked = 0
@@ -90,7 +90,7 @@ def _fake_mirror(tmp_path, content=None):
 def patched_hash(monkeypatch):
     """The lms/binary8byte_g.uff row with the sha256 of this test file (no mirror needed)."""
     from dataclasses import replace
-    from bearing_lab._files import sha256_file
+    from bearing_lab.utils._files import sha256_file
     reg = dict(datasets.load_registry())
     name = "lms/binary8byte_g.uff"
     reg[name] = replace(reg[name], sha256=sha256_file(Path(__file__)))

@@ -11,8 +11,7 @@ from bearing_lab import simulate
 from bearing_lab.sim import _kernels as K
 from bearing_lab.sim import load_scene
 from bearing_lab.sim.assembly import assemble
-
-G0 = 9.80665
+from bearing_lab.units import G as G0
 
 
 @pytest.mark.parametrize("overrides", [{}, {"defect.length_mm": 3.0, "defect.skew_deg": 60.0}],

@@ -9,8 +9,7 @@ import pytest
 
 from bearing_lab import simulate
 from bearing_lab.errors import SceneError
-
-G0 = 9.80665
+from bearing_lab.units import G as G0
 
 CASES = {
     # name: (scene, overrides, duration, what is checked)

@@ -11,7 +11,7 @@ import pytest
 import xarray as xr
 
 from bearing_lab import get_bearing, simulate
-from bearing_lab.io_netcdf import write_netcdf
+from bearing_lab.io import to_netcdf
 from bearing_lab.schema import check_dataset
 from bearing_lab.sim.hertz import race_contact, series_stiffness
 from tests.naive import impulse_times, interpolated_peak_frequency, static_ball_loads
@@ -106,7 +106,7 @@ def test_deterministic_and_lossless_netcdf(tmp_path):
     b = simulate("paper-slot", duration=0.05, progress=False)
     for name in a.data_vars:
         assert np.array_equal(a[name].values, b[name].values), name
-    p = write_netcdf(a, tmp_path / "s.nc")
+    p = to_netcdf(a, tmp_path / "s.nc")
     with xr.open_dataset(p) as back:
         for name in a.data_vars:
             assert np.array_equal(back[name].values, a[name].values), name

@@ -25,7 +25,7 @@ import warnings
 
 import numpy as np
 
-from bearing_lab._files import atomic_path, cache_dir, sha256_bytes
+from bearing_lab.utils._files import atomic_path, cache_dir, sha256_bytes
 
 FORMAT = 1
 _ARRAYS = ("psi", "delta", "G", "drop", "intact_fraction")

@@ -190,7 +190,7 @@ class ContactTable:
         """Plot G / delta^1.5 (carried share of the intact load) and the intact fraction of
         the Hertz ellipse against the ball's track position, at the approaches ``deltas``
         (m).  Returns the figure."""
-        from ...figures import new_figure
+        from ...utils.figures import new_figure
         scale = {"mm": 1e3, "m": 1.0, "um": 1e6}[s_units]
         if ax is None:
             fig = new_figure(figsize=(6, 3.5))

@@ -11,7 +11,7 @@
 """
 from __future__ import annotations
 
-__all__ = ["new_figure"]
+__all__ = ["new_figure", "figure_png"]
 
 
 def new_figure(figsize=None, *, layout=None, **kwargs):
@@ -29,3 +29,16 @@ def new_figure(figsize=None, *, layout=None, **kwargs):
     fig = plt.figure(figsize=figsize, layout=layout, **kwargs)
     plt.close(fig)
     return fig
+
+
+def figure_png(fig, dpi=80) -> str:
+    """Base64 PNG of a matplotlib figure (a pyplot figure is closed afterwards), for an ``<img>``
+    in a self-contained page."""
+    import base64
+    import io
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=dpi)
+    if getattr(fig.canvas, "manager", None) is not None:
+        import matplotlib.pyplot as plt
+        plt.close(fig)
+    return base64.b64encode(buf.getvalue()).decode("ascii")
