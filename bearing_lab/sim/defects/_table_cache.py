@@ -12,7 +12,7 @@ the key, and a sha256 of the arrays.  Reading checks the key, the shapes, that e
 value is finite and the checksum; an entry that fails is reported (a
 :class:`TableCacheWarning` naming the file and the reason), rebuilt and replaced, never
 used.  Writes go to a temporary file that is renamed into place
-(:func:`bearing_lab._files.atomic_path`), so concurrent processes see either no entry or
+(:func:`bearing_lab.utils._files.atomic_path`), so concurrent processes see either no entry or
 a complete one; two processes building the same table write identical content.
 """
 from __future__ import annotations

@@ -287,7 +287,7 @@ def contact_table(defect: Defect, bearing, *, model: str, clearance: float = 0.0
 
     Tables are kept in memory (a defect's ``angle`` does not enter the table, so the same
     outline at several positions or speeds is built once) and, with ``cache=True``, on
-    disk under :func:`bearing_lab._files.cache_dir` ``("tables")``, keyed by everything
+    disk under :func:`bearing_lab.utils._files.cache_dir` ``("tables")``, keyed by everything
     the table depends on; a damaged disk entry is reported and rebuilt.  The returned
     arrays are read-only; ``info["source"]`` says where the table came from ("built",
     "memory", "disk").
