@@ -232,7 +232,7 @@ def choose_contact_model(defect, requested: str, bearing) -> str:
     return "halfspace"
 
 
-def _track_offset(defect, st, race, psi0, bearing):
+def track_offset(defect, st, race, psi0, bearing):
     """The defect as the contact meets it in the 3-D bearing: the groove's cross-section turned
     about its curvature centre by the contact angle at the defect's position, so that the table,
     built for a ball at the groove bottom, sees the outline where the contact track really runs.
@@ -311,7 +311,7 @@ def _defect_tables(scene: Scene, lz: float, delta_max: float, material, delta_to
     t_tables = time.perf_counter()
     for kk, (code, dfc, psi0, ball, model) in enumerate(entries):
         if st3d is not None and code < 2:
-            dfc, _ = _track_offset(dfc, st3d, dfc.race, psi0, b)
+            dfc, _ = track_offset(dfc, st3d, dfc.race, psi0, b)
         # the loaded range above the deepest drop: a ball that falls into the defect is
         # loaded there, and reads computed values, not an extrapolation
         top = None if delta_top is None else delta_top[kk]

@@ -53,9 +53,9 @@ MISS_DELTA = 20e-6  # an approach no bench scene reaches: beyond it a defect can
 def _track_3d(scene, fid):
     """(each defect as the 3-D contact track meets it, what the track is): a race defect turned across
     the groove by the static contact angle at its position, as its contact table is built
-    (:func:`.assembly._track_offset`); a ball defect as it is."""
+    (:func:`.assembly.track_offset`); a ball defect as it is."""
     from ..errors import BearingLabError, SolverError
-    from .assembly import _track_offset, load_zone_angle, static_3d
+    from .assembly import track_offset, load_zone_angle, static_3d
     from .bearing3d import groove_offsets
     from .defects.geometry import RaceGeometry
     try:
@@ -73,7 +73,7 @@ def _track_3d(scene, fid):
             out.append(d)
             parts.append(f"defect {k} (ball): as on the planar track")
             continue
-        met, alpha = _track_offset(d, st, d.race, lz + d.angle, b)
+        met, alpha = track_offset(d, st, d.race, lz + d.angle, b)
         r_g = groove_offsets(b)[0 if d.race == "inner" else 1] + b.ball_diameter / 2
         gap = max(float(RaceGeometry.from_bearing(b, d.race, clearance=scene.clearance)
                         .approach(0.0, met.min_abs_axial())), 0.0)

@@ -152,7 +152,7 @@ def test_break_it_a_table_blind_to_the_contact_track_keeps_striking_the_centred_
     """With the defect table built at the groove bottom whatever the contact angle, the centred defect is
     struck under 300 N axial as without it: the previous test would fail."""
     from bearing_lab.sim import assembly
-    monkeypatch.setattr(assembly, "_track_offset", lambda defect, st, race, psi0, bearing: (defect, 0.0))
+    monkeypatch.setattr(assembly, "track_offset", lambda defect, st, race, psi0, bearing: (defect, 0.0))
     p0 = float(np.abs(simulate("paper-O1", duration=0.1, progress=False, **{"load.on": "outer"})
                       ["outer_ring_acc_y"]).max())
     p1 = float(np.abs(simulate("paper-O1", duration=0.1, progress=False, **{"load.on": "outer", "load.axial_n": 300.0})
@@ -195,14 +195,14 @@ def test_the_turned_table_sees_the_drop_a_ball_meets_at_its_contact_angle(h_mm):
     """A 1 x 1 mm defect at offset H met at 8.22 deg (300 N axial on the 6308): the drop the 3-D model's
     table holds (the defect turned about the groove's curvature centre) against brute force on the
     torus with the ball centre moved along the contact normal."""
-    from bearing_lab.sim.assembly import _track_offset
+    from bearing_lab.sim.assembly import track_offset
     from bearing_lab.sim.defects import Defect
     from bearing_lab.sim.defects.geometry import RaceGeometry, drop_profile_2d
     b = get_bearing("6308")
     alpha = math.radians(8.220)
     d = Defect(race="outer", shape="rectangle", length=1e-3, width=1e-3, depth=0.5e-3, offset=h_mm * 1e-3)
     st = {"phis": np.array([0.0, math.pi]), "alpha_o": np.array([alpha, alpha])}
-    turned, _ = _track_offset(d, st, "outer", 0.0, b)
+    turned, _ = track_offset(d, st, "outer", 0.0, b)
     g = RaceGeometry.from_bearing(b, "outer")
     psi = np.linspace(-1.2e-3, 1.2e-3, 481) / g.track_radius
     table_drop = float(np.max(drop_profile_2d(turned, g, psi)))
