@@ -66,23 +66,24 @@ def anti_alias_taps(fs_out: float, oversample: int) -> np.ndarray:
     return h / np.sum(h)  # unit gain at 0 Hz
 
 
-def _warm_up(asm=None):
-    """Compile (or load from numba's cache) the loop of ``asm``'s kind, or of every kind without
-    ``asm``, once per process, by a 20 µs run; return the seconds it took (reported apart from
-    run time)."""
-    kinds = [V.kind_of(asm.p)] if asm is not None else list(V.KINDS)
-    todo = [k for k in kinds if k not in _COMPILED["kinds"]]
+def _warm_up(asm=None, method=None):
+    """Compile (or load from numba's cache) the loop of ``asm``'s kind for ``method``, or the
+    loops of every kind for every method without ``asm`` (the benchmarks), once per process, by
+    a 20 µs run; return the seconds it took (reported apart from run time)."""
+    keys = [(V.kind_of(asm.p), method)] if asm is not None else [(k, None) for k in V.KINDS]
+    todo = [k for k in keys if k not in _COMPILED["kinds"]]
     if not todo:
         return 0.0
     t0 = _time.perf_counter()
-    for kind in todo:
+    for kind, m in todo:
         if asm is None:
             scene = load_scene({"output": {"duration_s": 1e-3, "settle_s": 0.0}, **_KIND_SCENES[kind]})
             run_on = assemble(scene, fidelity=scene.data["fidelity"].replace("auto", "multibody"))
         else:  # its own copy of the arrays the loop writes to (the table reach, the buffers)
             run_on = dataclasses.replace(asm, dflt=asm.dflt.copy(), hbuf=asm.hbuf.copy(), gbuf=asm.gbuf.copy())
-        _run(run_on, METHODS["dp54"], 1e-3, progress=False, t_end_override=2e-5)
-        _COMPILED["kinds"].add(kind)
+        _run(run_on, METHODS["dp54"] if m is None else m, 1e-3, progress=False, t_end_override=2e-5,
+             step=1e-6, fixed_method=m is not None)
+        _COMPILED["kinds"].add((kind, m))
     S.fir_decimate(np.zeros((4, 2)), np.ones(2), 0, 1, np.zeros((2, 2)))
     seconds = _time.perf_counter() - t0
     _COMPILED["seconds"] += seconds
@@ -99,7 +100,7 @@ def _loads(kern, out_t, out_state, args, work):
 
 
 def _run(asm, method, rtol, *, progress, t_end_override=None, step=None, max_step=None,
-         defect_steps=40, chunk_s=0.05, loads=True):
+         defect_steps=40, chunk_s=0.05, loads=True, fixed_method=False):
     """Integrate in chunks and stream the output: nothing finer than the output rate is kept
     beyond one chunk plus the anti-alias filter's length.
 
@@ -170,7 +171,8 @@ def _run(asm, method, rtol, *, progress, t_end_override=None, step=None, max_ste
     v_buf = np.zeros((0, vel_idx.shape[0]))  # fine velocities [v_start, m_next)
     v_start = 0
     args = (asm.p, asm.sp_t, asm.sp_w, asm.sp_th, asm.dint, asm.dflt, asm.hbuf, asm.gbuf)
-    kern = V.kernels(V.kind_of(asm.p))  # the loop compiled for this kind of scene
+    # the loop compiled for this kind of scene (and with fixed_method, for this method only)
+    kern = V.kernels(V.kind_of(asm.p), int(method) if fixed_method else None)
     work = S.work_arrays(n, z)      # the loop's stage derivatives, state vectors and ball loads
     loads_work = (work[1], work[4], work[5])    # a state-size scratch vector and the two ball-load vectors
     bar = None
@@ -320,7 +322,6 @@ def simulate(scene, *, fidelity: str | None = None, duration: float | None = Non
     check_budget(sc)  # before any work: a scene that would run for days is refused here
     t_start = _time.perf_counter()
     asm = _assemble(sc)
-    compile_s = _warm_up(asm)  # the loop of this scene's kind only
     d = sc.data
     from .auto import resolve
     choice = resolve(sc)
@@ -336,8 +337,9 @@ def simulate(scene, *, fidelity: str | None = None, duration: float | None = Non
             step_ = choice["step_s"]
     rtol_ = rtol_ if rtol_ is not None else 1e-5
     max_step = max_step if max_step is not None else 2.5e-5
+    compile_s = _warm_up(asm, METHODS[method_name])  # this scene's kind and method only
     res = _run(asm, METHODS[method_name], rtol_, progress=progress, max_step=max_step, step=step_,
-               defect_steps=d["solver"]["defect_steps"], loads=d["output"]["ball_loads"])
+               defect_steps=d["solver"]["defect_steps"], loads=d["output"]["ball_loads"], fixed_method=True)
     for _ in range(TABLE_EXTENSIONS):
         over = _tables_exceeded(asm)
         if not over:
@@ -349,7 +351,7 @@ def simulate(scene, *, fidelity: str | None = None, duration: float | None = Non
         asm = _assemble(sc, delta_top=top)
         asm.table_time_s += table_s
         res = _run(asm, METHODS[method_name], rtol_, progress=progress, max_step=max_step, step=step_,
-                   defect_steps=d["solver"]["defect_steps"], loads=d["output"]["ball_loads"])
+                   defect_steps=d["solver"]["defect_steps"], loads=d["output"]["ball_loads"], fixed_method=True)
     over = _tables_exceeded(asm)
     if over:
         raise SolverError(f"scene {sc.name!r}: the balls' approach on defect table(s) {sorted(over)} "

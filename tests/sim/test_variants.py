@@ -10,7 +10,7 @@ import pytest
 
 from bearing_lab.sim import _kernels as K, _variants as V
 from bearing_lab.sim.assembly import assemble
-from bearing_lab.sim.integrate import _KIND_SCENES
+from bearing_lab.sim.integrate import _KIND_SCENES, METHODS, _run
 from bearing_lab.sim.scene import load_scene
 
 
@@ -46,12 +46,25 @@ def test_a_copy_handed_another_kind_gives_nan_not_numbers():
 def test_the_ball_loads_compile_once_for_every_chunk():
     from bearing_lab.sim import simulate
     simulate("paper-O1", duration=0.12, progress=False)  # three 50 ms chunks and the warm-up's one sample
-    assert len(V.kernels("kinematic").loads_at.signatures) == 1
-    assert len(V.kernels("kinematic").integrate.signatures) == 1
+    kern = V.kernels("kinematic", METHODS["bs32"])  # what auto picks for paper-O1
+    assert len(kern.loads_at.signatures) == 1
+    assert len(kern.integrate.signatures) == 1
 
 
-def test_a_simulation_compiles_its_own_kind_only():
+@pytest.mark.parametrize("method", ["dp54", "rk4"])
+def test_a_loop_fixed_to_one_method_is_the_loop_of_every_method(method):
+    sc = load_scene("paper-O1", **{"output.duration_s": 0.01})
+    asm = assemble(sc)
+    kw = dict(progress=False, step=1e-6 if method == "rk4" else None)
+    fixed = _run(asm, METHODS[method], 1e-4, fixed_method=True, **kw)
+    every = _run(asm, METHODS[method], 1e-4, fixed_method=False, **kw)
+    for key in ("acc", "disp", "fi", "fo"):
+        np.testing.assert_array_equal(fixed[key], every[key])
+    assert V.kernels("kinematic", METHODS[method]).integrate.signatures
+
+
+def test_a_simulation_compiles_its_own_kind_and_method_only():
     code = ("import json\nfrom bearing_lab.sim import simulate, _variants as V\n"
             "simulate('paper-O1', duration=0.01, progress=False)\nprint(json.dumps(sorted(V._LOADED)))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
-    assert json.loads(out.stdout.strip().splitlines()[-1]) == ["kinematic"]
+    assert json.loads(out.stdout.strip().splitlines()[-1]) == [["kinematic", METHODS["bs32"]]]
