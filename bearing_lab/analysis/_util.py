@@ -6,6 +6,8 @@ with a message naming the input and the problem, instead of returning NaN.
 """
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 from scipy import signal as _sig
 
@@ -54,12 +56,24 @@ def get_window(window, n: int, *, func: str) -> np.ndarray:
                             "windows are always passed explicitly")
     if isinstance(window, (str, tuple)):
         try:
-            return _sig.get_window(window, n, fftbins=True).astype(np.float64)
+            try:
+                return _named_window(window, int(n))
+            except TypeError:  # unhashable parameters: made each time
+                return _sig.get_window(window, n, fftbins=True).astype(np.float64)
         except ValueError as exc:
             raise AnalysisError(f"{func}: invalid window {window!r}: {exc}") from None
     w = np.asarray(window, dtype=np.float64)
     if w.shape != (n,):
         raise AnalysisError(f"{func}: window array has shape {w.shape}, expected ({n},)")
+    return w
+
+
+@functools.lru_cache(maxsize=2)
+def _named_window(window, n):
+    """A named window, made once per (name, length): the spectra of one record use the same
+    window several times (16 ms each for a minute at 20 kHz).  Read-only, as it is shared."""
+    w = _sig.get_window(window, n, fftbins=True).astype(np.float64)
+    w.flags.writeable = False
     return w
 
 

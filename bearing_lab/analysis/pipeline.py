@@ -94,20 +94,21 @@ def _tacho_speed(x, fs, tacho, pulses_per_rev):
 
 def _speed(x, fs, geom, *, rpm, rpm_source, shaft_hz, tacho, pulses_per_rev, tolerance, n_harmonics,
            fallback=True, units="m s-2"):
-    """(signal to analyse, speed dict, pre-whitened signal or None)."""
+    """(signal to analyse, speed dict, pre-whitened signal or None, the envelope spectra computed:
+    ``{key: (f, spectrum, fmax)}``, key "cpw" or ("x", band), for :func:`run_routes` to reuse)."""
     if shaft_hz is not None:
         fr = float(shaft_hz)
         if not (math.isfinite(fr) and fr > 0):
             raise AnalysisError(f"analyze: shaft_hz={shaft_hz!r} must be a positive frequency in Hz")
-        return x, _fixed_speed(fr, "given", "exact", "shaft frequency given"), None
+        return x, _fixed_speed(fr, "given", "exact", "shaft frequency given"), None, {}
     if tacho is not None:
         xa, sp = _tacho_speed(x, fs, tacho, pulses_per_rev)
-        return xa, sp, None
+        return xa, sp, None, {}
     if rpm is not None and not (math.isfinite(rpm) and rpm > 0):
         raise AnalysisError(f"analyze: rpm={rpm!r} must be a positive speed in r/min")
     check_choice(rpm_source, ("given", "file"), "analyze: rpm_source", AnalysisError)
     xw = cepstral_prewhitening(x)
-    cache = {}
+    cache, ses = {}, {}
 
     def spectra(f0):
         """Pre-whitened SES (once, reaching the fastest blind candidate's decoys) and the SES of
@@ -116,7 +117,8 @@ def _speed(x, fs, geom, *, rpm, rpm_source, shaft_hz, tacho, pulses_per_rev, tol
         if "cpw" not in cache:
             fmax = min(0.49 * fs, spectrum_top(geom.fault_frequencies(BLIND_RANGE_HZ[1]), BLIND_RANGE_HZ[1],
                                                tolerance=tolerance, n_harmonics=n_harmonics))
-            cache["cpw"] = CyclicSpectrum(*squared_envelope_spectrum(xw, fs, window="hann", fmax=fmax))
+            ses["cpw"] = (*squared_envelope_spectrum(xw, fs, window="hann", fmax=fmax), fmax)
+            cache["cpw"] = CyclicSpectrum(*ses["cpw"][:2])
         line_top = n_harmonics * max(ff["bpfi"], 2 * ff["bsf"], ff["bpfo"]) * (1 + tolerance) + f0
         nb = int(2 ** np.floor(np.log2(max(1.0, fs / 2 / line_top))))
         if nb not in cache:
@@ -124,7 +126,8 @@ def _speed(x, fs, geom, *, rpm, rpm_source, shaft_hz, tacho, pulses_per_rev, tol
                 kg = fast_kurtogram(x, fs, min_bandwidth=fs / 2 / nb)
                 top = min(0.49 * fs, spectrum_top(geom.fault_frequencies(BLIND_RANGE_HZ[1]), BLIND_RANGE_HZ[1],
                                                   tolerance=tolerance, n_harmonics=n_harmonics))
-                cache[nb] = CyclicSpectrum(*squared_envelope_spectrum(x, fs, window="hann", band=kg.band, fmax=top))
+                ses[("x", kg.band)] = (*squared_envelope_spectrum(x, fs, window="hann", band=kg.band, fmax=top), top)
+                cache[nb] = CyclicSpectrum(*ses[("x", kg.band)][:2])
                 cache[nb].band, cache[nb].kurtosis = kg.band, float(kg.kurtosis_max)
             except AnalysisError:
                 cache[nb] = None
@@ -136,7 +139,7 @@ def _speed(x, fs, geom, *, rpm, rpm_source, shaft_hz, tacho, pulses_per_rev, tol
         # nothing to go by: the strongest harmonic family, for the fault-frequency table only
         sp["shaft_hz"] = float(shaft_frequency(x, fs, window="boxcar")[0])
         sp["note"] += f"; fault frequencies shown at the strongest line family, {sp['shaft_hz']:.3f} Hz"
-    return x, sp, xw
+    return x, sp, xw, ses
 
 
 def _period(routes, decided, key, x, xw, fs, band):
@@ -177,7 +180,7 @@ def _run(x, fs, *, bearing, rpm=None, shaft_hz=None, tolerance=0.02, n_harmonics
         raise AnalysisError(f"analyze: x must be one channel (1-D), got shape {x.shape}")
     geom = _bearing(bearing)
     m = metrics(x)
-    xa, speed, xw = _speed(x, fs, geom, rpm=rpm, rpm_source=rpm_source, shaft_hz=shaft_hz, tacho=tacho,
+    xa, speed, xw, ses = _speed(x, fs, geom, rpm=rpm, rpm_source=rpm_source, shaft_hz=shaft_hz, tacho=tacho,
                            pulses_per_rev=pulses_per_rev, tolerance=tolerance, n_harmonics=n_harmonics,
                            units=units)
     fr = float(speed["shaft_hz"])
@@ -185,7 +188,7 @@ def _run(x, fs, *, bearing, rpm=None, shaft_hz=None, tolerance=0.02, n_harmonics
         out = _unresolved(speed, geom, fs, xa.size, m, tolerance, n_harmonics)
         return _below_floor_unresolved(out, band_rms(xa, fs, None), floor_in_units(units, fs / 2), units)
     res = run_routes(xa, fs, geom, fr, tolerance=tolerance, n_harmonics=n_harmonics, prewhiten=prewhiten,
-                     xw=xw if xa is x else None)
+                     xw=xw if xa is x else None, ses=ses if xa is x else None)
     routes = res["routes"]
     verdict, humps = apply_humps(combine(routes, speed), routes, res["fault_hz"], shaft_hz=fr,
                                  factors=geom.frequency_factors(), speed_status=speed["status"], tolerance=tolerance)
@@ -337,7 +340,7 @@ def shaft_speed(x, fs, *, bearing, rpm=None, rpm_source="given", tolerance=0.02,
     x = check_signal(x, func="shaft_speed", min_samples=1024)
     if x.ndim != 1:
         raise AnalysisError(f"shaft_speed: x must be one channel (1-D), got shape {x.shape}")
-    _, sp, _ = _speed(x, fs, _bearing(bearing), rpm=rpm, rpm_source=rpm_source, shaft_hz=None, tacho=None,
+    _, sp, _, _ = _speed(x, fs, _bearing(bearing), rpm=rpm, rpm_source=rpm_source, shaft_hz=None, tacho=None,
                       pulses_per_rev=1, tolerance=tolerance, n_harmonics=n_harmonics, fallback=False, units=units)
     return sp
 

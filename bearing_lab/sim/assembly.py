@@ -530,7 +530,8 @@ def assemble(scene: Scene, *, fidelity: str | None = None, delta_top=None) -> As
     if len(sp_t) > 1:
         sp_th[1:] = np.cumsum(0.5 * (sp_w[1:] + sp_w[:-1]) * np.diff(sp_t))
     # shaft angle is measured from t = 0: shift so that theta(0) = 0
-    th0, _ = K.shaft_state(0.0, sp_t, sp_w, sp_th)
+    # (the kernel's Python source: one call does not pay for compiling or loading it)
+    th0, _ = K.shaft_state.py_func(0.0, sp_t, sp_w, sp_th)
     sp_th = sp_th - th0
 
     # loads and their optional step
