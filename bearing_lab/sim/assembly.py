@@ -109,10 +109,37 @@ def _solve_relative(target, force_of, scale, where):
         if hi > 1e-2:
             raise SceneError(f"{where}: no static equilibrium (load {w:.3g} N too large for the bearing)")
     a = brentq(along, lo, hi, xtol=1e-16, rtol=1e-14)
-    norm = max(w, 1.0)
-    sol = root(lambda e: (force_of(e) - target) / norm, a * direction, method="hybr",
-               options={"xtol": 1e-14})
-    return sol.x if sol.success else a * direction
+    return _newton_2d(lambda e: force_of(e) - target, a * direction, max(w, 1.0), abs(scale), where)
+
+
+def _newton_2d(residual, e, norm, scale, where, *, tol=1e-10, iterations=60):
+    """Newton's method with a backtracking line search on a 2-D force balance ``residual(e) = 0`` (N),
+    from ``e`` (m; the solution along the load direction).  The Jacobian by central differences.
+    Converged when the unbalanced force is below ``tol`` x ``norm``; otherwise a SceneError names
+    the unbalance: the start is never taken from an unbalanced solution."""
+    r = residual(e)
+    h = 1e-7 * max(scale, 1e-9)
+    for _ in range(iterations):
+        if np.max(np.abs(r)) <= tol * norm:
+            return e
+        jac = np.column_stack([(residual(e + h * u) - residual(e - h * u)) / (2 * h) for u in np.eye(2)])
+        try:
+            step = np.linalg.solve(jac, -r)
+        except np.linalg.LinAlgError:
+            break
+        t, size = 1.0, float(np.max(np.abs(r)))
+        while t > 1e-6:
+            trial = residual(e + t * step)
+            if np.all(np.isfinite(trial)) and np.max(np.abs(trial)) < size:
+                e, r = e + t * step, trial
+                break
+            t *= 0.5
+        else:
+            break
+    if np.max(np.abs(r)) <= 1e-6 * norm:       # a float's worth from the balance: as good as it gets
+        return e
+    raise SceneError(f"{where}: static equilibrium not found (unbalanced force {np.max(np.abs(r)):.3g} N of "
+                     f"{norm:.3g} N after Newton's method)")
 
 
 def _loaded_ring_positions(on, phases, z, phi_c0, forces_at, f_in, f_out, ks, km, scale):
