@@ -427,8 +427,7 @@ def identify(case, *, grid=None, refine=True, scheduler="serial", n_workers=None
         if jr is not None and jr.entries:
             notify(f"resuming: {len(jr.entries)} scored scenes in {jr.path} are read back, not simulated")
         notify(estimate_text(est))
-    r_lo, r_hi = est["refine_scenes"]
-    bar = Progress(f"identify {case.name}", int(np.prod([len(v) for v in grid.values()])) + (r_lo + r_hi) // 2,
+    bar = Progress(f"identify {case.name}", int(np.prod([len(v) for v in grid.values()])) + est["refine_likely"],
                    bar=progress is True, callback=progress if callable(progress) else None)
     bar.tables(est["tables_new"]["aligned"] + est["tables_new"]["skewed"])
     client, close = _client(scheduler, n_workers)

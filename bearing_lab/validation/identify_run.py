@@ -31,6 +31,11 @@ TABLE_CPU_S = {"aligned": (0.15, 1.0), "skewed": (0.8, 5.0)}
 SCENE_CPU_S_PER_S = (0.08, 0.8)
 #: fewest scenes the refinement adds in the runs measured (210-244 on the stand-ins); its most is its budget
 REFINE_FEWEST = 100
+#: the likely figures inside those brackets: the middle of the measured tables (0.3 s aligned, 1.3-3.2 s
+#: skewed), a scene with its scoring, and the refinement's scenes in the runs measured
+TABLE_CPU_LIKELY_S = {"aligned": 0.3, "skewed": 2.0}
+SCENE_CPU_LIKELY_S_PER_S = 0.15
+REFINE_LIKELY = 230
 
 
 def refine_budget(grid) -> int:
@@ -89,7 +94,8 @@ def estimate(base, grid, *, refine: bool, done=()) -> dict:
 
     The coarse grid's scenes not in ``done`` (points already scored) are planned exactly (their tables,
     cached or not); the refinement's scenes are counted from :data:`REFINE_FEWEST` to :func:`refine_budget`,
-    each with a table of its own to build (skewed unless every searched skew is 0)."""
+    each with a table of its own to build (skewed unless every searched skew is 0; at the low end only in
+    the share of the coarse grid's tables that were not cached)."""
     import itertools
     keys = list(grid)
     done = {tuple(p[k] for k in keys) for p in done}
@@ -103,9 +109,16 @@ def estimate(base, grid, *, refine: bool, done=()) -> dict:
     for j, (tl, th) in enumerate((TABLE_CPU_S["aligned"], TABLE_CPU_S["skewed"])):
         n = plan["new"]["aligned" if j == 0 else "skewed"]
         lo, hi = lo + n * tl, hi + n * th
-    lo += len(todo) * SCENE_CPU_S_PER_S[0] * sec + r_lo * (TABLE_CPU_S[kind][0] + SCENE_CPU_S_PER_S[0] * sec)
+    # the refinement's scenes lie off the grid, each with a table of its own: new, unless this grid's tables
+    # were cached too (a rerun), which the low end allows for in the same share
+    n_new = plan["new"]["aligned"] + plan["new"]["skewed"]
+    share = n_new / plan["tables"] if plan["tables"] else 1.0
+    lo += len(todo) * SCENE_CPU_S_PER_S[0] * sec + r_lo * (share * TABLE_CPU_S[kind][0] + SCENE_CPU_S_PER_S[0] * sec)
     hi += len(todo) * SCENE_CPU_S_PER_S[1] * sec + r_hi * (TABLE_CPU_S[kind][1] + SCENE_CPU_S_PER_S[1] * sec)
-    return {"cpu_s": (lo, hi), "coarse_scenes": len(todo), "coarse_done": len(done), "refine_scenes": (r_lo, r_hi),
+    r_mid = min(REFINE_LIKELY, r_hi) if refine else 0
+    likely = (sum(plan["new"][k] * TABLE_CPU_LIKELY_S[k] for k in plan["new"])
+              + (len(todo) + r_mid) * SCENE_CPU_LIKELY_S_PER_S * sec + r_mid * share * TABLE_CPU_LIKELY_S[kind])
+    return {"cpu_s": (lo, hi), "likely_cpu_s": likely, "refine_likely": r_mid, "coarse_scenes": len(todo), "coarse_done": len(done), "refine_scenes": (r_lo, r_hi),
             "tables": plan["tables"], "tables_cached": plan["cached"], "tables_new": plan["new"],
             "record_s": sec}
 
@@ -119,7 +132,8 @@ def estimate_text(est) -> str:
             + (f" + {r_lo}-{r_hi} in the refinement" if r_hi else "")
             + f", {est['record_s']:g} s each; contact tables of the coarse grid: {n_new} to build "
               f"({est['tables_new']['skewed']} skewed), {est['tables_cached']} cached: about "
-              f"{_duration(lo)}-{_duration(hi)} of CPU")
+              f"{_duration(lo)}-{_duration(hi)} of CPU, likely about {_duration(est['likely_cpu_s'])}"
+            + (f" (with the refinement's usual {est['refine_likely']} scenes)" if r_hi else ""))
 
 
 def _duration(s) -> str:
