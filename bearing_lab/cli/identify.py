@@ -78,6 +78,8 @@ def run(args) -> int:
     except IdentificationInterrupted as stop:
         return _stopped(stop.result, args, journal)
     paths = write_identification(res, args.output, report=args.report)
+    for ext in ("json", "nc", "html"):      # a partial result of an earlier, stopped run is superseded
+        (Path(args.output) / case.name / f"identification-partial.{ext}").unlink(missing_ok=True)
     if args.json:
         from .._json import clean
         print(json.dumps(clean(res.to_dict()), allow_nan=False))

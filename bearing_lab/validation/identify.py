@@ -303,12 +303,8 @@ def _sweep_scored(setting, base, params, combos, scored, digests, *, scheduler, 
         if m["score_db"] < keep.get("score_db", np.inf):
             keep.update(score_db=m["score_db"], signature=sig)
         if bar is not None:
-            bar.scene(built_table=not cached and float(ds.attrs.get("table_time_s", 0.0)) > TABLE_BUILT_S)
+            bar.scene(built_table=c in bar.builds)
     sweep(base, params, scheduler=scheduler, cache_dir=cache_dir, progress=False, metrics=False, on_scene=on_scene)
-
-
-#: a scene whose tables took longer than this built one (reading one back from the disk cache takes milliseconds)
-TABLE_BUILT_S = 0.05
 
 
 def ds_dim(key):
@@ -429,14 +425,14 @@ def identify(case, *, grid=None, refine=True, scheduler="serial", n_workers=None
         notify(estimate_text(est))
     bar = Progress(f"identify {case.name}", int(np.prod([len(v) for v in grid.values()])) + est["refine_likely"],
                    bar=progress is True, callback=progress if callable(progress) else None)
-    bar.tables(est["tables_new"]["aligned"] + est["tables_new"]["skewed"])
+    bar.tables(est["tables_new"]["aligned"] + est["tables_new"]["skewed"], est["builds"])
     client, close = _client(scheduler, n_workers)
     points: list = []
     keep: dict = {}
     walked = roughness = None
     try:
         _run_grid(st, base, grid, scheduler=client, cache_dir=cache_dir, bar=bar, out=points, keep=keep, journal=jr)
-        bar.tables(0)
+        bar.tables(0, ())
         if refine:
             run = dict(scheduler="serial", cache_dir=cache_dir, bar=bar, out=points, keep=keep, journal=jr)
             roughness, thr, walked = _refinement(st, base, grid, points, run, thr, threshold_db is None)
@@ -451,7 +447,7 @@ def identify(case, *, grid=None, refine=True, scheduler="serial", n_workers=None
             res = _result(case, st, points, grid, thr, declared, t_cpu, t_wall, keep.get("signature"), None, None,
                           partial=True)
             res.resumed = len(jr.entries) if jr else 0
-            res.estimate, res.setup_cpu_s = est, setup_cpu
+            res.estimate, res.setup_cpu_s = {k: v for k, v in est.items() if k != "builds"}, setup_cpu
         raise IdentificationInterrupted(res) from None
     finally:
         bar.close()
@@ -459,15 +455,14 @@ def identify(case, *, grid=None, refine=True, scheduler="serial", n_workers=None
             client.close()
     res = _result(case, st, points, grid, thr, declared, t_cpu, t_wall, keep["signature"], roughness, walked)
     res.resumed = len(old)
-    res.estimate, res.setup_cpu_s = est, setup_cpu
+    res.estimate, res.setup_cpu_s = {k: v for k, v in est.items() if k != "builds"}, setup_cpu
     return res
 
 
 def _setting(case, mirror, level_weight):
     """The comparison setting (recording's signature, fixed path, background, score) and the base scene
     of a loaded case."""
-    from . import simulation
-    from .candidates import comparison_overrides, setting_for
+    from .candidates import setting_for
     from .recording import open_spec
     from .recording_case import prepare
     from .rig import background_for, path_for
@@ -477,9 +472,16 @@ def _setting(case, mirror, level_weight):
     reference = open_spec(case.reference, case.name, mirror) if case.reference is not None else None
     bg = background_for(case, prep.recording, m, reference)
     st = setting_for(prep, path, bg, level_weight=level_weight)
-    base = simulation.build_scene(case, rpm=prep.speed.rpm, fs=prep.fs, duration=prep.n / prep.fs,
+    return st, base_scene(case, prep)
+
+
+def base_scene(case, prep):
+    """The scene every candidate is a change of: the case's, at the recording's measured speed, sampling
+    rate and length, with the comparison's solver settings (``prep``: the prepared recording)."""
+    from . import simulation
+    from .candidates import comparison_overrides
+    return simulation.build_scene(case, rpm=prep.speed.rpm, fs=prep.fs, duration=prep.n / prep.fs,
                                   overrides=comparison_overrides(case))
-    return st, base
 
 
 def _scorer(st, base, grid, points, run):
@@ -538,14 +540,19 @@ def _result(case, st, points, grid, thr, declared, t_cpu, t_wall, best_signature
                         "best so far and each profile is the best scene simulated at each value (an upper bound): "
                         "more scenes can lower any of them, so an interval can widen or move and none is final; "
                         "rerun the same command to resume")
-        for p in params.values():
-            p["statement"] = "partial, " + p["statement"]
+        for k, p in params.items():
+            name, unit = PARAMS[k]
+            if len(grid[k]) > 1 and len(p["profile"]) < 2:
+                p["statement"] = (f"{name}: only {p['best']:g} {unit} simulated so far (of {len(grid[k])} grid "
+                                  "values): nothing to conclude yet")
+                p["identifiable"] = False
+            p["statement"] = "partial, " + p["statement"].replace("from this recording", "from the scenes done so far")
     if roughness is not None:
         notes.append(f"score roughness {roughness:.2f} dB: moving one parameter of the best scene by "
                      f"{100 * ROUGHNESS_STEP:g} % of its grid step changes the score by up to this much"
                      + ("; the interval threshold is raised to twice it (the best scene and any other each move "
                         "by up to it)" if 2 * roughness >= thr - 1e-12 and roughness > 0 else ""))
-    if not any(p["identifiable"] for p in params.values()):
+    if not partial and not any(p["identifiable"] for p in params.values()):
         notes.append("no parameter is identifiable: the recording's impact signature does not change with the "
                      "searched geometry more than with its own noise")
     return Identification(case.name, points, best, params, thr, st.noise_db, st.level_weight, st.level_reason,

@@ -66,7 +66,8 @@ def _table_cached(defect, bearing, kw) -> bool:
 
 def table_plan(base, points) -> dict:
     """Contact tables the scenes ``points`` ([{key: value}] over ``base``) need: distinct ones, split into
-    cached / to build (aligned or skewed outline), and the table of each point (index into ``keys``)."""
+    cached / to build (aligned or skewed outline), and ``builds``: the indices of the points that build one
+    (the first to need each table not cached)."""
     from ..sim.assembly import _statics, table_requests
     statics = _statics(base)
     seen, new, of_point = {}, {"aligned": 0, "skewed": 0}, []
@@ -85,8 +86,12 @@ def table_plan(base, points) -> dict:
                     new["skewed" if d.skew != 0.0 else "aligned"] += 1
             ids.append(ident)
         of_point.append(tuple(ids))
-    return {"tables": len(seen), "cached": cached, "new": new, "of_point": of_point,
-            "built": {i: v for i, v in seen.items()}}
+    first_use = {}
+    for k, ids in enumerate(of_point):
+        for ident in ids:
+            first_use.setdefault(ident, k)
+    builds = sorted({k for ident, k in first_use.items() if not seen[ident]})
+    return {"tables": len(seen), "cached": cached, "new": new, "builds": builds}
 
 
 def estimate(base, grid, *, refine: bool, done=()) -> dict:
@@ -118,7 +123,9 @@ def estimate(base, grid, *, refine: bool, done=()) -> dict:
     r_mid = min(REFINE_LIKELY, r_hi) if refine else 0
     likely = (sum(plan["new"][k] * TABLE_CPU_LIKELY_S[k] for k in plan["new"])
               + (len(todo) + r_mid) * SCENE_CPU_LIKELY_S_PER_S * sec + r_mid * share * TABLE_CPU_LIKELY_S[kind])
-    return {"cpu_s": (lo, hi), "likely_cpu_s": likely, "refine_likely": r_mid, "coarse_scenes": len(todo), "coarse_done": len(done), "refine_scenes": (r_lo, r_hi),
+    return {"cpu_s": (lo, hi), "likely_cpu_s": likely, "refine_likely": r_mid,
+            "builds": [tuple(todo[k][q] for q in keys) for k in plan["builds"]], "coarse_scenes": len(todo),
+            "coarse_done": len(done), "refine_scenes": (r_lo, r_hi),
             "tables": plan["tables"], "tables_cached": plan["cached"], "tables_new": plan["new"],
             "record_s": sec}
 
@@ -152,14 +159,16 @@ class Progress:
 
     def __init__(self, desc, total, *, bar=True, callback=None):
         self.done, self.total, self.tables_left, self.callback = 0, int(total), 0, callback
+        self.builds = set()
         self.bar = None
         if bar:
             from tqdm.auto import tqdm
             # smoothing 0: the mean rate over the run (the first scenes build tables and are slower)
             self.bar = tqdm(total=self.total, unit="scene", desc=desc, leave=False, smoothing=0.0)
 
-    def tables(self, n_new):
-        self.tables_left = int(n_new)
+    def tables(self, n_new, builds):
+        """``n_new`` tables to build, by the scenes ``builds`` (tuples of their grid values)."""
+        self.tables_left, self.builds = int(n_new), set(builds)
         self._show()
 
     def scene(self, built_table=False):
@@ -170,9 +179,9 @@ class Progress:
             self.total = self.done
             if self.bar is not None:
                 self.bar.total = self.total
+        self._show()
         if self.bar is not None:
             self.bar.update(1)
-        self._show()
         if self.callback is not None:
             self.callback({"scenes": self.done, "total": self.total, "tables_left": self.tables_left})
 

@@ -146,3 +146,4 @@ def test_cli_interrupted_writes_a_partial_result_exits_130_and_resumes(rig, tmp_
     assert len(ran) == 1 and "resuming: 3 scored scenes" in err, err
     done = json.loads((tmp_path / "rig" / "identification.json").read_text())
     assert done["partial"] is False and done["n_scenes"] == 4 and done["resumed"] == 3
+    assert not (tmp_path / "rig" / "identification-partial.json").exists()      # superseded
