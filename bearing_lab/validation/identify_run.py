@@ -104,12 +104,14 @@ def estimate(base, grid, *, refine: bool, done=()) -> dict:
     import itertools
     keys = list(grid)
     done = {tuple(p[k] for k in keys) for p in done}
+    coarse = set(itertools.product(*(grid[k] for k in keys)))
     todo = [dict(zip(keys, c)) for c in itertools.product(*(grid[k] for k in keys)) if c not in done]
     plan = table_plan(base, todo)
     sec = float(base.duration)
     skews = grid.get("defect.skew_deg") or [d.skew for d in base.defects]
     kind = "skewed" if any(s != 0.0 for s in skews) else "aligned"
     r_lo, r_hi = (min(REFINE_FEWEST, refine_budget(grid)), refine_budget(grid)) if refine else (0, 0)
+    r_lo = max(0, r_lo - len(done - coarse))    # a resumed refinement may find its scenes read back
     lo = hi = 0.0
     for j, (tl, th) in enumerate((TABLE_CPU_S["aligned"], TABLE_CPU_S["skewed"])):
         n = plan["new"]["aligned" if j == 0 else "skewed"]
@@ -125,7 +127,7 @@ def estimate(base, grid, *, refine: bool, done=()) -> dict:
               + (len(todo) + r_mid) * SCENE_CPU_LIKELY_S_PER_S * sec + r_mid * share * TABLE_CPU_LIKELY_S[kind])
     return {"cpu_s": (lo, hi), "likely_cpu_s": likely, "refine_likely": r_mid,
             "builds": [tuple(todo[k][q] for q in keys) for k in plan["builds"]], "coarse_scenes": len(todo),
-            "coarse_done": len(done), "refine_scenes": (r_lo, r_hi),
+            "coarse_done": len(done & coarse), "refine_scenes": (r_lo, r_hi),
             "tables": plan["tables"], "tables_cached": plan["cached"], "tables_new": plan["new"],
             "record_s": sec}
 
@@ -135,7 +137,7 @@ def estimate_text(est) -> str:
     r_lo, r_hi = est["refine_scenes"]
     lo, hi = est["cpu_s"]
     return (f"{est['coarse_scenes']} coarse scenes to simulate"
-            + (f" ({est['coarse_done']} read back from the journal)" if est["coarse_done"] else "")
+            + (f" ({est['coarse_done']} of the grid read back from the journal)" if est["coarse_done"] else "")
             + (f" + {r_lo}-{r_hi} in the refinement" if r_hi else "")
             + f", {est['record_s']:g} s each; contact tables of the coarse grid: {n_new} to build "
               f"({est['tables_new']['skewed']} skewed), {est['tables_cached']} cached: about "
@@ -229,9 +231,12 @@ def _source_fingerprint() -> str:
 def comparison_fingerprint(setting, base) -> str:
     """sha256 of what a scene's score depends on besides the scene: the recording's signature, the
     structural path, the background, the band, period, amplitude weight and tolerance, the path's shape
-    residual, the background seed, the scoring code, and the base scene."""
+    residual, the background seed, the scoring code, and the base scene (an amplitude weight given
+    explicitly and the same weight by default give the same fingerprint)."""
     h = hashlib.sha256()
-    fields = {f.name: getattr(setting, f.name) for f in dataclasses.fields(setting) if f.name not in ("prep", "notes")}
+    # the score's inputs only: not the notes, the amplitude weight's reason or the split-half misfit (the threshold's)
+    fields = {f.name: getattr(setting, f.name) for f in dataclasses.fields(setting)
+              if f.name not in ("prep", "notes", "level_reason", "noise_db")}
     _digest(h, fields)
     h.update(b"\0" + _source_fingerprint().encode() + b"\0" + base.to_toml().encode())
     return h.hexdigest()
