@@ -220,12 +220,19 @@ def _digest(h, obj, depth=0):
         h.update(repr(obj).encode())
 
 
+_SOURCE: list = []
+
+
 def _source_fingerprint() -> str:
-    root = Path(__file__).resolve().parents[1]
-    h = hashlib.sha256()
-    for f in sorted([*(root / "validation").glob("*.py"), *(root / "analysis").rglob("*.py")]):
-        h.update(f.name.encode() + b"\0" + f.read_bytes())
-    return h.hexdigest()
+    """sha256 of the scoring code's source (validation and analysis), read once per process: the code this
+    process runs, even if the files change while it runs."""
+    if not _SOURCE:
+        root = Path(__file__).resolve().parents[1]
+        h = hashlib.sha256()
+        for f in sorted([*(root / "validation").glob("*.py"), *(root / "analysis").rglob("*.py")]):
+            h.update(f.name.encode() + b"\0" + f.read_bytes())
+        _SOURCE.append(h.hexdigest())
+    return _SOURCE[0]
 
 
 def comparison_fingerprint(setting, base) -> str:
