@@ -28,8 +28,9 @@ lock:
 validate: install
 	$(VENV)/bin/bearing-lab validate -o reports
 
+# one file per worker, handed out in the order tests/conftest.py sets (the longest first)
 test: install
-	$(PY) -m pytest -n 2 --dist loadfile -q $(PYTEST_ARGS)
+	$(PY) -m pytest -n 2 --dist loadfile --no-loadscope-reorder -q $(PYTEST_ARGS)
 
 bench: install
 	$(VENV)/bin/bearing-lab bench

@@ -144,6 +144,7 @@ class Stack:
         self.cached = np.zeros(n, dtype=bool)
         self.common_attrs = None
         self.scene_attrs = {}  # scalar per-scene attributes, name -> values by scene index
+        self.on_put = None     # on_put(i, ds, cached): called as each scene is placed
 
     def put(self, i, ds, *, cached):
         if self.arrays is None:
@@ -177,6 +178,8 @@ class Stack:
         self.wall[i] = float(ds.attrs.get("wall_time_s", np.nan))
         self.steps[i] = int(ds.attrs.get("solver_steps", 0))
         self.cached[i] = cached
+        if self.on_put is not None:
+            self.on_put(i, ds, cached)
 
     def dataset(self, sdims, coords):
         import xarray as xr

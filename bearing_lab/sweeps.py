@@ -413,7 +413,7 @@ def _assemble(acc, keys, values, shape, digests, metrics):
 
 
 def sweep(scene, params: dict, *, scheduler=None, n_workers: int | None = None, cache_dir=None,
-          progress: bool = True, metrics: bool = True, **simulate_kwargs):
+          progress: bool = True, metrics: bool = True, on_scene=None, **simulate_kwargs):
     """Simulate every combination of swept scene keys; return one labelled Dataset.
 
     Parameters
@@ -428,6 +428,9 @@ def sweep(scene, params: dict, *, scheduler=None, n_workers: int | None = None, 
         ``~/.cache/bearing_lab/sweeps``); False: no cache.
     progress : tqdm bar over the scenes as they finish.
     metrics : add rms, peak, crest_factor, kurtosis of outer_ring_acc_y.
+    on_scene : ``on_scene(index, ds, cached)``, called in this process as each scene is read from
+        the cache or finishes (``index`` in C order over the grid); an exception it raises (a
+        KeyboardInterrupt) stops the sweep, the scenes cached so far kept.
     **simulate_kwargs : fixed for every scene: ``duration``, ``fs``, ``rtol``,
         ``method``, ``step``, ``fidelity`` or ``--set`` keys.
 
@@ -452,6 +455,7 @@ def sweep(scene, params: dict, *, scheduler=None, n_workers: int | None = None, 
     n = len(scenes)
 
     acc = _Stack(shape, n)
+    acc.on_put = on_scene
     hits, todo, rejected = _from_cache(cdir, scenes, digests, acc)
 
     bar = None

@@ -25,6 +25,31 @@ if not os.environ.get("BEARING_LAB_TEST_CACHE"):
     os.environ["BEARING_LAB_TEST_CACHE"] = _RUN_CACHE.name
 os.environ["BEARING_LAB_CACHE"] = os.environ["BEARING_LAB_TEST_CACHE"]
 
+#: test files whose work is longest, started first so that under `make test` (one file per worker, files
+#: handed out in this order: --no-loadscope-reorder) no worker is left with a long file at the end: the
+#: identification (its module fixture is most of the suite's CPU); the other files follow by their number of
+#: tests, as xdist's default ordering had them
+FIRST = ("validation/test_identify.py",)
+
+
+def pytest_collection_modifyitems(config, items):
+    """Files in FIRST first, then the others by their number of tests, most first (what xdist's
+    default --loadscope-reorder did), keeping the order of tests inside a file."""
+    if not hasattr(config, "workerinput"):
+        return                      # a plain (serial) run keeps the collection order
+    root = Path(__file__).resolve().parent
+
+    def rel(item):
+        try:
+            return Path(str(item.path)).resolve().relative_to(root).as_posix()
+        except ValueError:
+            return str(item.path)
+    count = {}
+    for it in items:
+        count[rel(it)] = count.get(rel(it), 0) + 1
+    rank = {f: i for i, f in enumerate(FIRST)}
+    items.sort(key=lambda it: (rank.get(rel(it), len(FIRST)), -count[rel(it)] if rel(it) not in rank else 0))
+
 IN_CI = os.environ.get("CI", "").lower() in ("1", "true", "yes")
 
 

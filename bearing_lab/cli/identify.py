@@ -11,13 +11,6 @@ import json
 import sys
 
 
-#: scenes the refinement typically adds (210 and 244 on the stand-ins), and CPU s per scene of a 1 s record (table
-#: cached, skewed table built: the README walkthrough, 37 s and 742 s for 384 scenes);
-#: measured in docs/identification.md ("The search")
-REFINE_TYPICAL = (100, 250)
-SCENE_CPU_S = (0.1, 1.9)
-
-
 def register(subparsers):
     p = subparsers.add_parser(
         "identify", help="identify the defect's length, offset and skew from a case's recording",
@@ -26,9 +19,11 @@ def register(subparsers):
                      "path and background matches the recording; report an interval per parameter, or that it "
                      "is not identifiable.  The default grid is 140 scenes; the refinement (a simplex search from the best, "
                      "a roughness probe, profiles minimised over the other parameters, a polish) adds about "
-                     f"{REFINE_TYPICAL[0]}-{REFINE_TYPICAL[1]} more.  A scene of a 1 s record at 20 kHz costs about "
-                     f"{SCENE_CPU_S[0]:g} s of CPU with its contact table cached, {SCENE_CPU_S[1]:g} s when a skewed "
-                     "outline's table has to be built."))
+                     "100-250 more.  Before the scenes run, the CPU time they need is estimated from the contact "
+                     "tables to build and the scenes to simulate.  Every scored scene is kept in "
+                     "DIR/<case>/identification-journal.jsonl: a run stopped by Ctrl-C or a kill resumes there "
+                     "when rerun; a stopped run writes the partial result of the scenes done to "
+                     "DIR/<case>/identification-partial.{json,nc,html} and exits with status 130."))
     p.add_argument("case", metavar="CASE", help="case TOML file (docs/case-format.md) with one [[defect]]")
     p.add_argument("-o", "--output", default="reports", metavar="DIR", help="output directory (default: reports)")
     p.add_argument("--length-mm", type=float, nargs="+", default=None, help="along-track lengths to search, mm")
@@ -49,6 +44,8 @@ def register(subparsers):
     p.add_argument("--report", action="store_true", help="add the result to DIR/<case>/index.html (run validate first)")
     p.add_argument("--json", action="store_true", help="print the result as JSON")
     p.add_argument("--mirror", default=None, metavar="DIR", help="directory holding public recordings")
+    p.add_argument("--restart", action="store_true",
+                   help="discard the journal of an earlier run of this case in DIR (default: resume from it)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors (the files are written)")
     p.set_defaults(func=run)
@@ -56,7 +53,7 @@ def register(subparsers):
 
 def run(args) -> int:
     from ..validation import load_case
-    from ..validation.identify import default_grid, identify
+    from ..validation.identify import IdentificationInterrupted, default_grid, identify
     from ..validation.identify_report import write_identification
     from ..errors import ValidationCaseError
     if args.workers < 1:
@@ -67,20 +64,22 @@ def run(args) -> int:
                        ("defect.skew_deg", args.skew_deg), ("defect.depth_mm", args.depth_mm)):
         if given:
             grid[key] = list(given)
-    n = 1
-    for v in grid.values():
-        n *= len(v)
-    if not (args.json or args.quiet):
-        lo, hi = (n, n) if args.no_refine else (n + REFINE_TYPICAL[0], n + REFINE_TYPICAL[1])
-        sec = float(case.recording.duration_s)
-        print(f"identify {case.name}: {n} scenes on the coarse grid"
-              + ("" if args.no_refine else f" + about {REFINE_TYPICAL[0]}-{REFINE_TYPICAL[1]} in the refinement")
-              + f" of {sec:g} s each: about {SCENE_CPU_S[0] * lo * sec:.0f}-{SCENE_CPU_S[1] * hi * sec:.0f} s of CPU "
-                "(cached / new contact tables; measured at 20 kHz)", file=sys.stderr)
-    res = identify(case, grid=grid, refine=not args.no_refine, scheduler="serial" if args.workers <= 1 else "local",
-                   n_workers=args.workers, progress=not (args.no_progress or args.quiet), level_weight=args.amplitude_weight,
-                   mirror=args.mirror, cache_dir=args.cache or False)
+    from pathlib import Path
+    journal = Path(args.output) / case.name / "identification-journal.jsonl"
+    if args.restart and journal.is_file():
+        journal.unlink()
+    say = None if (args.json or args.quiet) else (lambda text: print(f"identify {case.name}: {text}", file=sys.stderr))
+    try:
+        with _term_stops():
+            res = identify(case, grid=grid, refine=not args.no_refine,
+                           scheduler="serial" if args.workers <= 1 else "local", n_workers=args.workers,
+                           progress=not (args.no_progress or args.quiet), level_weight=args.amplitude_weight,
+                           mirror=args.mirror, cache_dir=args.cache or False, journal=journal, notify=say)
+    except IdentificationInterrupted as stop:
+        return _stopped(stop.result, args, journal)
     paths = write_identification(res, args.output, report=args.report)
+    for ext in ("json", "nc", "html"):      # a partial result of an earlier, stopped run is superseded
+        (Path(args.output) / case.name / f"identification-partial.{ext}").unlink(missing_ok=True)
     if args.json:
         from ..utils._json import clean
         print(json.dumps(clean(res.to_dict()), allow_nan=False))
@@ -94,3 +93,48 @@ def run(args) -> int:
     print(f"{res.n_scenes} scenes, {res.cpu_time_s:.1f} s CPU here, {res.wall_time_s:.1f} s wall; "
           f"wrote {', '.join(str(p) for p in paths.values())}")
     return 0
+
+
+class _term_stops:
+    """SIGTERM (a kill) stops the run as Ctrl-C does, so the partial result is written (restored after)."""
+
+    def __enter__(self):
+        import signal
+        self.old = None
+        try:
+            self.old = signal.signal(signal.SIGTERM, self._raise)
+        except ValueError:          # not the main thread: leave the signal alone
+            pass
+        return self
+
+    @staticmethod
+    def _raise(signum, frame):
+        raise KeyboardInterrupt
+
+    def __exit__(self, *exc):
+        import signal
+        if self.old is not None:
+            signal.signal(signal.SIGTERM, self.old)
+        return False
+
+
+def _stopped(res, args, journal) -> int:
+    """A stopped run: the partial result of the scenes done (if any) written and printed; exit status 130."""
+    from ..validation.identify_report import write_identification
+    where = f"the scored scenes are kept in {journal}; rerun the same command to resume"
+    if res is None:
+        print(f"bearing-lab identify: interrupted before any scene finished; {where}", file=sys.stderr)
+        return 130
+    paths = write_identification(res, args.output, stem="identification-partial")
+    if args.json:
+        from ..utils._json import clean
+        print(json.dumps(clean(res.to_dict()), allow_nan=False))
+    elif not args.quiet:
+        print(f"PARTIAL result (interrupted after {res.n_scenes} scenes):")
+        for p in res.parameters.values():
+            print(p["statement"])
+        for note in res.notes:
+            print(f"note: {note}")
+        print(f"wrote {', '.join(str(p) for p in paths.values())}")
+    print(f"bearing-lab identify: interrupted; {where}", file=sys.stderr)
+    return 130

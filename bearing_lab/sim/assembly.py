@@ -311,14 +311,12 @@ def static_3d(scene: Scene, fid: str) -> dict:
     return cache[fid]
 
 
-def _defect_tables(scene: Scene, lz: float, delta_max: float, material, delta_top=None, st3d=None):
-    """Each defect's contact table, packed for the kernels: a ball defect gets one table per
-    race it meets.  Returns (models, tables, entries, dint, dflt, hbuf, gbuf, table_time_s)."""
+def _table_entries(scene: Scene, lz: float):
+    """(models, entries): each defect's contact model and its table entries (race code, defect used for
+    the table, psi0, ball, model); a ball defect gets one entry per race it meets."""
     import dataclasses
     d, b = scene.data, scene.bearing
-    from .defects import contact_table
-    from .defects.contact import CONTACT_MODELS
-    models, tables = [], []
+    models = []
     entries = []  # (race code, defect used for the table, psi0, ball, model)
     for kk, defect in enumerate(scene.defects):
         req = (d["defect"][kk] or {}).get("contact_model", "auto")
@@ -330,6 +328,29 @@ def _defect_tables(scene: Scene, lz: float, delta_max: float, material, delta_to
                                 defect.angle, 0, model))
         else:
             entries.append((0 if defect.race == "outer" else 1, defect, lz + defect.angle, -1, model))
+    return models, entries
+
+
+def _table_request(scene, entry, delta_max, material, top, st3d):
+    """(defect, keywords) of :func:`contact_table` for one table entry (the defect turned to the 3-D
+    contact track when ``st3d`` is given)."""
+    code, dfc, psi0, _, model = entry
+    if st3d is not None and code < 2:
+        dfc, _ = track_offset(dfc, st3d, dfc.race, psi0, scene.bearing)
+    # the loaded range above the deepest drop: a ball that falls into the defect is
+    # loaded there, and reads computed values, not an extrapolation
+    return dfc, dict(model=model, clearance=scene.clearance, delta_max=delta_max, material=material,
+                     above_drop=delta_max, delta_top=top)
+
+
+def _defect_tables(scene: Scene, lz: float, delta_max: float, material, delta_top=None, st3d=None):
+    """Each defect's contact table, packed for the kernels: a ball defect gets one table per
+    race it meets.  Returns (models, tables, entries, dint, dflt, hbuf, gbuf, table_time_s)."""
+    b = scene.bearing
+    from .defects import contact_table
+    from .defects.contact import CONTACT_MODELS
+    models, entries = _table_entries(scene, lz)
+    tables = []
     n_e = max(len(entries), 1)
     dint = np.zeros((n_e, 7), dtype=np.int64)
     dflt = np.zeros((n_e, K.N_DFLT))
@@ -337,13 +358,9 @@ def _defect_tables(scene: Scene, lz: float, delta_max: float, material, delta_to
     hoff = goff = 0
     t_tables = time.perf_counter()
     for kk, (code, dfc, psi0, ball, model) in enumerate(entries):
-        if st3d is not None and code < 2:
-            dfc, _ = track_offset(dfc, st3d, dfc.race, psi0, b)
-        # the loaded range above the deepest drop: a ball that falls into the defect is
-        # loaded there, and reads computed values, not an extrapolation
         top = None if delta_top is None else delta_top[kk]
-        tab = contact_table(dfc, b, model=model, clearance=scene.clearance, delta_max=delta_max,
-                            material=material, above_drop=delta_max, delta_top=top)
+        dfc, kw = _table_request(scene, entries[kk], delta_max, material, top, st3d)
+        tab = contact_table(dfc, b, **kw)
         tables.append(tab)
         psi = np.asarray(tab.psi, dtype=float)
         kind = 1 if CONTACT_MODELS[model].tabulated else 0
@@ -511,29 +528,19 @@ def _axial_states(scene, st, p, fid, y0, atol):
     return y, a
 
 
-def assemble(scene: Scene, *, fidelity: str | None = None, delta_top=None) -> Assembly:
-    """The scene's parameters, tables and initial state for the time loop.
-
-    ``delta_top``: per defect-table entry, a lower bound of the table's top approach (m), for a
-    re-run after the loop reached above a table."""
-    d = scene.data
-    b = scene.bearing
+def _statics(scene: Scene, fidelity=None):
+    """(fidelity, inner and outer Hertz contacts, static equilibrium, 3-D or not) of a scene."""
+    d, b = scene.data, scene.bearing
     fid = fidelity or scene.fidelity
     if fid == "auto":
         from .auto import resolve
         fid = resolve(scene)["fidelity"]
-    z = b.n_balls
-    mat = d["material"]
-    E, nu = mat["youngs_modulus_gpa"] * 1e9, mat["poisson_ratio"]
     hi, ho = race_contacts(scene)
-    k_eff = series_stiffness(hi.stiffness, ho.stiffness)
-    m_i, m_o, m_b = scene.masses()
-    ftf = b.frequency_factors()["ftf"]
-    lz = load_zone_angle(scene)
+    m_b = scene.masses()[2]
     # cage angle at t = 0: a ball centred in the load zone (the symmetric start)
-    phi_c0 = lz
+    phi_c0 = load_zone_angle(scene)
     _, rpm0 = scene.speed_profile()
-    omega_c0 = ftf * rpm0[0] * 2 * math.pi / 60
+    omega_c0 = b.frequency_factors()["ftf"] * rpm0[0] * 2 * math.pi / 60
     three_d = needs_3d(scene)
     if three_d:
         if d["cage"]["model"] == "dynamic":
@@ -549,6 +556,44 @@ def assemble(scene: Scene, *, fidelity: str | None = None, delta_top=None) -> As
         st = static_equilibrium(scene, phi_c0, hi.stiffness, ho.stiffness,
                                 ball_mass=0.0 if fid == "quasi-static" else m_b, omega_cage=omega_c0,
                                 exponent=d["contact"]["exponent"])
+    return fid, hi, ho, st, three_d
+
+
+def _table_delta_max(st, ho) -> float:
+    """The defect tables' loaded approach range: 3 x the most loaded ball's static deflection."""
+    static_max = float(np.max(st["ball_loads"])) if len(st["ball_loads"]) else 0.0
+    return max(3.0 * (max(static_max, 50.0) / ho.stiffness) ** (2 / 3), 5e-6)
+
+
+def table_requests(scene: Scene, *, statics=None) -> list:
+    """The contact tables the scene's defects need, without building any: ``[(defect, keywords)]`` as
+    :func:`bearing_lab.sim.defects.contact_table` takes them (a cost estimate counts those not cached).
+    ``statics``: :func:`_statics` of a scene with the same bearing, load and speed, to reuse."""
+    _, hi, ho, st, three_d = statics or _statics(scene)
+    mat = scene.data["material"]
+    material = (mat["youngs_modulus_gpa"] * 1e9, mat["poisson_ratio"])
+    _, entries = _table_entries(scene, load_zone_angle(scene))
+    return [_table_request(scene, e, _table_delta_max(st, ho), material, None, st if three_d else None)
+            for e in entries]
+
+
+def assemble(scene: Scene, *, fidelity: str | None = None, delta_top=None) -> Assembly:
+    """The scene's parameters, tables and initial state for the time loop.
+
+    ``delta_top``: per defect-table entry, a lower bound of the table's top approach (m), for a
+    re-run after the loop reached above a table."""
+    d = scene.data
+    b = scene.bearing
+    fid, hi, ho, st, three_d = _statics(scene, fidelity)
+    z = b.n_balls
+    mat = d["material"]
+    E, nu = mat["youngs_modulus_gpa"] * 1e9, mat["poisson_ratio"]
+    k_eff = series_stiffness(hi.stiffness, ho.stiffness)
+    m_i, m_o, m_b = scene.masses()
+    ftf = b.frequency_factors()["ftf"]
+    lz = load_zone_angle(scene)
+    # cage angle at t = 0: a ball centred in the load zone (the symmetric start)
+    phi_c0 = lz
 
     # speed profile (rad/s), shaft angle at the nodes
     sp_t, rpm = scene.speed_profile()
@@ -579,8 +624,7 @@ def assemble(scene: Scene, *, fidelity: str | None = None, delta_top=None) -> As
     # defects -> tables (a ball defect gets one table per race it meets)
     static_max = float(np.max(st["ball_loads"])) if len(st["ball_loads"]) else 0.0
     models, tables, entries, dint, dflt, hbuf, gbuf, table_time = _defect_tables(
-        scene, lz, max(3.0 * (max(static_max, 50.0) / ho.stiffness) ** (2 / 3), 5e-6), (E, nu), delta_top,
-        st if three_d else None)
+        scene, lz, _table_delta_max(st, ho), (E, nu), delta_top, st if three_d else None)
 
     p, dyn = _parameters(scene, fid, st, hi, ho, k_eff, (m_i, m_o, m_b), (tstep, f_in2, f_out2, g),
                          ftf, phi_c0, len(entries))

@@ -28,7 +28,7 @@ import numpy as np
 
 from ..errors import ValidationCaseError
 
-__all__ = ["Identification", "default_grid", "identify", "PARAMS"]
+__all__ = ["Identification", "IdentificationInterrupted", "default_grid", "identify", "PARAMS"]
 
 #: searched scene keys -> (short name, unit)
 PARAMS = {"defect.length_mm": ("length", "mm"), "defect.offset_mm": ("offset H", "mm"),
@@ -56,13 +56,28 @@ class Identification:
     signatures: dict = field(default_factory=dict)   # "recording", "best" -> Signature
     declared: dict = field(default_factory=dict)
     roughness_db: float | None = None    # score change for 1 % of a grid step at the best scene
+    partial: bool = False                # stopped before the end: the scenes done only, nothing final
+    resumed: int = 0                     # scenes read back from the journal of an earlier run
+    estimate: dict = field(default_factory=dict)   # identify_run.estimate() made before the scenes ran
+    setup_cpu_s: float = 0.0             # CPU s of preparing the comparison (recording, path, background)
 
     def to_dict(self) -> dict:
         return {"case": self.case, "best": self.best, "parameters": self.parameters,
                 "threshold_db": self.threshold_db, "noise_db": self.noise_db, "level_weight": self.level_weight,
                 "level_reason": self.level_reason, "grid": self.grid, "n_scenes": self.n_scenes,
                 "cpu_time_s": self.cpu_time_s, "wall_time_s": self.wall_time_s, "notes": self.notes,
-                "declared": self.declared, "roughness_db": self.roughness_db}
+                "declared": self.declared, "roughness_db": self.roughness_db, "partial": self.partial,
+                "resumed": self.resumed, "estimate": self.estimate, "setup_cpu_s": self.setup_cpu_s}
+
+
+class IdentificationInterrupted(KeyboardInterrupt):
+    """An identification stopped (Ctrl-C, or SIGTERM through the CLI): ``result`` is the partial
+    :class:`Identification` of the scenes done (``partial`` True), or None when no scene had finished.
+    Every scene scored before the stop is in the journal, if one was given: a rerun resumes there."""
+
+    def __init__(self, result):
+        super().__init__("identification interrupted")
+        self.result = result
 
 
 def _declared(case) -> dict:
@@ -230,34 +245,66 @@ def _probes(grid, best) -> list:
     return out
 
 
-def _run_grid(setting, base, grid, *, scheduler, cache_dir, bar, out, keep):
-    """Simulate ``grid`` (chunked by its first key) and append scored points to ``out``; ``keep``
-    holds the best scene's signature."""
+def _run_grid(setting, base, grid, *, scheduler, cache_dir, bar, out, keep, journal=None):
+    """Simulate ``grid`` (chunked by its first key) and append scored points to ``out`` in the grid's order;
+    ``keep`` holds the best simulated scene's signature; ``bar``: a :class:`.identify_run.Progress` (or
+    None), moved by each scene as it finishes.  A scene in ``journal`` is read back, one simulated is added
+    to it; when the run is stopped the scenes scored so far are still appended."""
     import itertools
-    from ..sweeps import sweep
-    from .candidates import candidate_signature
     keys = list(grid)
     first, rest = keys[0], keys[1:]
     done = {tuple(p[k] for k in keys) for p in out}
     for v in grid[first]:
-        combos = [c for c in itertools.product(*(grid[k] for k in rest)) if (v, *c) not in done]
-        if not combos:
+        chunk = [(v, *c) for c in itertools.product(*(grid[k] for k in rest))]
+        todo = [c for c in chunk if c not in done]
+        if not todo:
             continue
-        ds = sweep(base, {first: [v], **{k: grid[k] for k in rest}}, scheduler=scheduler, cache_dir=cache_dir,
-                   progress=False, metrics=False)
-        ch = ds.attrs["default_channel"]
-        for c in itertools.product(*(grid[k] for k in rest)):
-            if c not in combos:
-                continue
-            sel = {ds_dim(first): v, **{ds_dim(k): x for k, x in zip(rest, c)}}
-            x = np.asarray(ds[ch].sel(sel, method="nearest").values, float)
-            sig = candidate_signature(setting, x)
-            m = setting.score(sig)
-            out.append({first: v, **dict(zip(rest, c)), **m})
-            if m["score_db"] < keep.get("score_db", np.inf):
-                keep.update(score_db=m["score_db"], signature=sig)
-            if bar is not None:
-                bar.update(1)
+        scored = {}
+        digests = {c: _digest(base, dict(zip(keys, c))) for c in todo} if journal is not None else {}
+        for c in todo:
+            hit = journal.get(digests[c]) if journal is not None else None
+            if hit is not None:
+                scored[c] = hit
+                if bar is not None:
+                    bar.scene()
+        try:
+            missing = [c for c in todo if c not in scored]
+            if len(missing) == len(chunk):
+                _sweep_scored(setting, base, {first: [v], **{k: grid[k] for k in rest}}, chunk, scored, digests,
+                              scheduler=scheduler, cache_dir=cache_dir, bar=bar, keep=keep, journal=journal)
+            else:
+                for c in missing:
+                    _sweep_scored(setting, base, {k: [x] for k, x in zip(keys, c)}, [c], scored, digests,
+                                  scheduler=scheduler, cache_dir=cache_dir, bar=bar, keep=keep, journal=journal)
+        finally:
+            out.extend({**dict(zip(keys, c)), **scored[c]} for c in todo if c in scored)
+
+
+def _digest(base, point) -> str:
+    """The sweep's cache key of the scene ``point`` over ``base`` (what the journal is keyed on)."""
+    from ..sweeps import scene_hash
+    return scene_hash(base.replace(**point).to_toml(), {})
+
+
+def _sweep_scored(setting, base, params, combos, scored, digests, *, scheduler, cache_dir, bar, keep, journal):
+    """One sweep over ``params`` (whose C-order scenes are ``combos``); each scene is scored into ``scored``
+    (and the journal) as it finishes."""
+    from ..sweeps import sweep
+    from .candidates import candidate_signature
+    keys = list(params)
+
+    def on_scene(i, ds, cached):
+        c = combos[i]
+        sig = candidate_signature(setting, np.asarray(ds[ds.attrs["default_channel"]].values, float))
+        m = setting.score(sig)
+        scored[c] = m
+        if journal is not None:
+            journal.add(digests.get(c) or _digest(base, dict(zip(keys, c))), dict(zip(keys, c)), m)
+        if m["score_db"] < keep.get("score_db", np.inf):
+            keep.update(score_db=m["score_db"], signature=sig)
+        if bar is not None:
+            bar.scene(built_table=c in bar.builds)
+    sweep(base, params, scheduler=scheduler, cache_dir=cache_dir, progress=False, metrics=False, on_scene=on_scene)
 
 
 def ds_dim(key):
@@ -313,7 +360,8 @@ def _profile(points, key, threshold, walked=None, span=None):
 
 
 def identify(case, *, grid=None, refine=True, scheduler="serial", n_workers=None, cache_dir=False,
-             progress=True, level_weight=None, mirror=None, threshold_db=None) -> Identification:
+             progress=True, level_weight=None, mirror=None, threshold_db=None, journal=None,
+             notify=None) -> Identification:
     """Identify the case's defect geometry from its recording (see the module docstring).
 
     Parameters
@@ -337,8 +385,22 @@ def identify(case, *, grid=None, refine=True, scheduler="serial", n_workers=None
     threshold_db : float, optional
         Interval threshold (default: max(3 × the recording's split-half misfit, 0.3 dB, twice the
         score's roughness at the best scene)).
+    progress : bool or callable
+        True: a progress bar over the scenes; a callable: called after every scene with
+        ``{"scenes", "total", "tables_left"}`` (it may stop the run by raising KeyboardInterrupt).
+    journal : path, optional
+        JSON-lines file of the scored scenes (:class:`.identify_run.Journal`): scenes found there are read
+        back, not simulated; every scene scored is added as it finishes, so a stopped run resumes.
+    notify : callable, optional
+        ``notify(text)`` receives the cost estimate and the resume count before the scenes run.
+
+    Raises
+    ------
+    IdentificationInterrupted (a KeyboardInterrupt) when stopped: its ``result`` is the partial
+    identification of the scenes done (``partial`` True), or None if none had finished.
     """
     from . import load_case
+    from .identify_run import Journal, Progress, comparison_fingerprint, estimate, estimate_text
     t_cpu, t_wall = time.process_time(), time.perf_counter()
     case = case if hasattr(case, "section") else load_case(case)
     declared = _declared(case)
@@ -347,37 +409,60 @@ def identify(case, *, grid=None, refine=True, scheduler="serial", n_workers=None
     if bad or not grid or any(not v for v in grid.values()):
         raise ValidationCaseError(f"identify: grid keys must be among {', '.join(PARAMS)} with at least one value "
                                   f"each; got {', '.join(bad) or 'an empty grid'}")
+    if notify is not None:
+        notify("preparing the comparison (the recording, the structural path, the background)")
     st, base = _setting(case, mirror, level_weight)
+    setup_cpu = time.process_time() - t_cpu
     thr = float(threshold_db) if threshold_db is not None else max(3 * st.noise_db, MIN_THRESHOLD_DB)
-    n_coarse = int(np.prod([len(v) for v in grid.values()]))
-    n_total = n_coarse + ((REFINE_MAX_SCENES + 2 * len(grid)) * (1 + len(grid)) if refine else 0)   # an estimate
+    jr = Journal(journal, comparison_fingerprint(st, base)) if journal else None
+    old = [e["point"] for e in (jr.entries.values() if jr else []) if set(e["point"]) == set(grid)]
+    est = estimate(base, grid, refine=refine, done=old)
+    if notify is not None:
+        if jr is not None and jr.set_aside is not None:
+            notify(f"the journal {jr.path} was of another comparison: set aside as {jr.set_aside.name}")
+        if jr is not None and jr.entries:
+            notify(f"resuming: {len(jr.entries)} scored scenes in {jr.path} are read back, not simulated")
+        notify(estimate_text(est))
+    bar = Progress(f"identify {case.name}", int(np.prod([len(v) for v in grid.values()])) + est["refine_likely"],
+                   bar=progress is True, callback=progress if callable(progress) else None)
+    bar.tables(est["tables_new"]["aligned"] + est["tables_new"]["skewed"], est["builds"])
     client, close = _client(scheduler, n_workers)
-    bar = None
-    if progress:
-        from tqdm.auto import tqdm
-        bar = tqdm(total=n_total, unit="scene", desc=f"identify {case.name}", leave=False)
     points: list = []
     keep: dict = {}
-    walked = None
+    walked = roughness = None
     try:
-        _run_grid(st, base, grid, scheduler=client, cache_dir=cache_dir, bar=bar, out=points, keep=keep)
-        roughness = None
+        _run_grid(st, base, grid, scheduler=client, cache_dir=cache_dir, bar=bar, out=points, keep=keep, journal=jr)
+        bar.tables(0, ())
         if refine:
-            run = dict(scheduler="serial", cache_dir=cache_dir, bar=bar, out=points, keep=keep)
+            run = dict(scheduler="serial", cache_dir=cache_dir, bar=bar, out=points, keep=keep, journal=jr)
             roughness, thr, walked = _refinement(st, base, grid, points, run, thr, threshold_db is None)
+        best = min(points, key=lambda p: p["score_db"])
+        if keep.get("score_db") != best["score_db"]:     # the best scene was read back: its signature again
+            keep = {}
+            _run_grid(st, base, {k: [best[k]] for k in grid}, scheduler="serial", cache_dir=cache_dir, bar=None,
+                      out=[], keep=keep)
+    except KeyboardInterrupt:
+        res = None
+        if points:
+            res = _result(case, st, points, grid, thr, declared, t_cpu, t_wall, keep.get("signature"), None, None,
+                          partial=True)
+            res.resumed = len(jr.entries) if jr else 0
+            res.estimate, res.setup_cpu_s = {k: v for k, v in est.items() if k != "builds"}, setup_cpu
+        raise IdentificationInterrupted(res) from None
     finally:
-        if bar is not None:
-            bar.close()
+        bar.close()
         if close:
             client.close()
-    return _result(case, st, points, grid, thr, declared, t_cpu, t_wall, keep["signature"], roughness, walked)
+    res = _result(case, st, points, grid, thr, declared, t_cpu, t_wall, keep["signature"], roughness, walked)
+    res.resumed = len(old)
+    res.estimate, res.setup_cpu_s = {k: v for k, v in est.items() if k != "builds"}, setup_cpu
+    return res
 
 
 def _setting(case, mirror, level_weight):
     """The comparison setting (recording's signature, fixed path, background, score) and the base scene
     of a loaded case."""
-    from . import simulation
-    from .candidates import comparison_overrides, setting_for
+    from .candidates import setting_for
     from .recording import open_spec
     from .recording_case import prepare
     from .rig import background_for, path_for
@@ -387,9 +472,16 @@ def _setting(case, mirror, level_weight):
     reference = open_spec(case.reference, case.name, mirror) if case.reference is not None else None
     bg = background_for(case, prep.recording, m, reference)
     st = setting_for(prep, path, bg, level_weight=level_weight)
-    base = simulation.build_scene(case, rpm=prep.speed.rpm, fs=prep.fs, duration=prep.n / prep.fs,
+    return st, base_scene(case, prep)
+
+
+def base_scene(case, prep):
+    """The scene every candidate is a change of: the case's, at the recording's measured speed, sampling
+    rate and length, with the comparison's solver settings (``prep``: the prepared recording)."""
+    from . import simulation
+    from .candidates import comparison_overrides
+    return simulation.build_scene(case, rpm=prep.speed.rpm, fs=prep.fs, duration=prep.n / prep.fs,
                                   overrides=comparison_overrides(case))
-    return st, base
 
 
 def _scorer(st, base, grid, points, run):
@@ -434,19 +526,35 @@ def _client(scheduler, n_workers):
     return scheduler, False
 
 
-def _result(case, st, points, grid, thr, declared, t_cpu, t_wall, best_signature, roughness=None, walked=None):
+def _result(case, st, points, grid, thr, declared, t_cpu, t_wall, best_signature, roughness=None, walked=None,
+            partial=False):
     best = min(points, key=lambda p: p["score_db"])
     walked = walked or {}
     params = {k: _profile(points, k, thr, walked.get(k), (min(grid[k]), max(grid[k]))) for k in grid}
     notes = list(st.notes) + [f"amplitude weight {st.level_weight:g}: {st.level_reason}"]
+    if partial:
+        n_coarse = int(np.prod([len(v) for v in grid.values()]))
+        on_grid = sum(all(p[k] in grid[k] for k in grid) for p in points)
+        notes.insert(0, f"PARTIAL: stopped after {len(points)} scenes ({on_grid} of the coarse grid's {n_coarse}"
+                        + (", the refinement not finished" if on_grid >= n_coarse else "") + "); the best scene is the "
+                        "best so far and each profile is the best scene simulated at each value (an upper bound): "
+                        "more scenes can lower any of them, so an interval can widen or move and none is final; "
+                        "rerun the same command to resume")
+        for k, p in params.items():
+            name, unit = PARAMS[k]
+            if len(grid[k]) > 1 and len(p["profile"]) < 2:
+                p["statement"] = (f"{name}: only {p['best']:g} {unit} simulated so far (of {len(grid[k])} grid "
+                                  "values): nothing to conclude yet")
+                p["identifiable"] = False
+            p["statement"] = "partial, " + p["statement"].replace("from this recording", "from the scenes done so far")
     if roughness is not None:
         notes.append(f"score roughness {roughness:.2f} dB: moving one parameter of the best scene by "
                      f"{100 * ROUGHNESS_STEP:g} % of its grid step changes the score by up to this much"
                      + ("; the interval threshold is raised to twice it (the best scene and any other each move "
                         "by up to it)" if 2 * roughness >= thr - 1e-12 and roughness > 0 else ""))
-    if not any(p["identifiable"] for p in params.values()):
+    if not partial and not any(p["identifiable"] for p in params.values()):
         notes.append("no parameter is identifiable: the recording's impact signature does not change with the "
                      "searched geometry more than with its own noise")
     return Identification(case.name, points, best, params, thr, st.noise_db, st.level_weight, st.level_reason,
                           grid, len(points), time.process_time() - t_cpu, time.perf_counter() - t_wall, notes,
-                          {"recording": st.measured, "best": best_signature}, declared, roughness)
+                          {"recording": st.measured, "best": best_signature}, declared, roughness, partial)

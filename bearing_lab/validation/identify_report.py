@@ -61,6 +61,14 @@ def landscape(result):
 def figures(result) -> list:
     from matplotlib.figure import Figure
     rec, best = result.signatures["recording"], result.signatures["best"]
+    out = []
+    if best is not None:        # None: a partial result whose best scene was read back from the journal
+        out.append(_best_figure(result, rec, best))
+    return out + [_profile_figure(result)]
+
+
+def _best_figure(result, rec, best):
+    from matplotlib.figure import Figure
     fig = Figure(figsize=(10, 3.4), layout="constrained")
     ax = fig.subplots()
     ax.plot(rec.time * 1e3, rec.envelope / G0, color="k", lw=1.2, label=f"recording ({rec.n_impacts} impacts)")
@@ -72,8 +80,13 @@ def figures(result) -> list:
     ax.legend(fontsize=8)
     keys = list(result.grid)
     best_txt = ", ".join(f"{k.split('.')[1]} = {result.best[k]:g}" for k in keys)
-    out = [(fig, f"Mean impact envelope ({rec.band_hz[0]:g}-{rec.band_hz[1]:g} Hz) of the recording and of the best "
-                 f"scene ({best_txt}; score {result.best['score_db']:.2f} dB).")]
+    return (fig, f"Mean impact envelope ({rec.band_hz[0]:g}-{rec.band_hz[1]:g} Hz) of the recording and of the best "
+                 f"scene ({best_txt}; score {result.best['score_db']:.2f} dB).")
+
+
+def _profile_figure(result):
+    from matplotlib.figure import Figure
+    keys = list(result.grid)
     fig2 = Figure(figsize=(10, 2.8), layout="constrained")
     axes = np.atleast_1d(fig2.subplots(1, len(keys)))
     for ax, k in zip(axes, keys):
@@ -89,11 +102,10 @@ def figures(result) -> list:
         ax.set_xlabel(f"{PARAMS[k][0]} ({p['unit']})")
         ax.set_title(("" if p["identifiable"] else "not identifiable: ") + f"best {p['best']:g}", fontsize=9)
     axes[0].set_ylabel("profile misfit (dB)")
-    out.append((fig2, f"Misfit profiles: black, the least score found by minimising over the other parameters at "
+    return ((fig2, f"Misfit profiles: black, the least score found by minimising over the other parameters at "
                       f"each walked value (without the refinement: the best coarse scene at each grid value); grey, "
                       f"other simulated scenes within the threshold; dashed: best + {result.threshold_db:.2f} dB (the "
                       f"interval threshold); shaded: the interval."))
-    return out
 
 
 def _sections(result) -> list:
@@ -125,19 +137,19 @@ def add_to_case_report(result, case_dir):
     return rep
 
 
-def write_identification(result, out, *, report=False) -> dict:
+def write_identification(result, out, *, report=False, stem="identification") -> dict:
     from ..utils._files import atomic_open
     from ..utils._json import clean
     from ..report import Report
     d = Path(out) / result.case
     d.mkdir(parents=True, exist_ok=True)
-    paths = {"json": d / "identification.json", "nc": d / "identification.nc", "html": d / "identification.html"}
+    paths = {ext: d / f"{stem}.{ext}" for ext in ("json", "nc", "html")}
     with atomic_open(paths["json"], "w", encoding="utf-8") as fh:
         json.dump(clean(result.to_dict()), fh, indent=1, allow_nan=False)
     from ..utils._files import atomic_path
     with atomic_path(paths["nc"]) as tmp:
         landscape(result).to_netcdf(tmp)
-    rep = Report(f"{result.case}: defect identification")
+    rep = Report(f"{result.case}: defect identification" + (" (PARTIAL: interrupted)" if result.partial else ""))
     for title, html, figs in _sections(result):
         rep.add_html(html, title) if figs is None else rep.add_figures(figs, title)
     rep.add_provenance()

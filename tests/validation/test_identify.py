@@ -2,6 +2,8 @@
 θ = 30°, 320 N, speed jitter, tones, noise, a 4.3 kHz resonance the model does not contain); the rig's
 structural path comes from a calibration recording of the same rig."""
 import json
+import os
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -21,11 +23,20 @@ GRID = {"defect.length_mm": [2.5, 3.0, 3.6], "defect.offset_mm": [0.0, 0.25, 0.5
 
 @pytest.fixture(scope="module")
 def found(tmp_path_factory):
+    """The identification over GRID; its scored scenes are journalled in the run's cache folder, so a run
+    with a kept cache (BEARING_LAB_TEST_CACHE set beforehand) reads them back instead of simulating them."""
     d = tmp_path_factory.mktemp("ident")
     # the case's first guess is 2.5 mm, not the hidden 3 mm
     case = hidden(d, "paper-O2", 0.3, 30.0, seed=23, calib=calibration(d), name="rig", duration_s=0.5,
                   declared_length_mm=2.5)
-    return d, case, identify(case, grid=GRID, progress=False)
+    return d, case, identify(case, grid=GRID, progress=False, journal=shared_folder() / "journal.jsonl")
+
+
+def shared_folder():
+    """The identification's journal folder (inside the run's cache)."""
+    share = Path(os.environ["BEARING_LAB_CACHE"]) / "identify-fixture"
+    share.mkdir(parents=True, exist_ok=True)
+    return share
 
 
 def test_identify_brackets_offset_and_skew_or_says_not_identifiable(found):
@@ -43,6 +54,11 @@ def test_identify_brackets_offset_and_skew_or_says_not_identifiable(found):
     # the amplitude took part: the path came from another recording of the rig
     assert r.level_weight == 1.0 and "calib" in r.level_reason
     assert r.n_scenes >= 27 + 6
+    from bearing_lab.validation.identify_run import refine_budget
+    assert r.n_scenes - 27 <= refine_budget(GRID), (r.n_scenes, refine_budget(GRID))   # the estimate's bound holds
+    if int(os.environ.get("PYTEST_XDIST_WORKER_COUNT", "1")) < 2 and not r.resumed:   # all built in this process
+        lo, hi = r.estimate["cpu_s"]
+        assert lo <= r.cpu_time_s - r.setup_cpu_s <= hi, (lo, r.cpu_time_s - r.setup_cpu_s, hi)
 
 
 def test_the_score_roughness_is_measured_and_widens_the_threshold(found):
@@ -77,8 +93,10 @@ def test_only_optimised_profile_values_exclude(found):
     best = min(r.points, key=lambda p: p["score_db"])
     st, base = _setting(load_case(case), None, r.level_weight)
     points = list(r.points)
+    from bearing_lab.validation.identify_run import Journal, comparison_fingerprint
+    journal = Journal(shared_folder() / "journal.jsonl", comparison_fingerprint(st, base))
     score = _scorer(st, base, r.grid, points, dict(scheduler="serial", cache_dir=False, bar=None, out=points,
-                                                    keep={}))
+                                                    keep={}, journal=journal))
     shown = []
     for k in ("defect.offset_mm", "defect.skew_deg"):
         lo = _profile(r.points, k, r.threshold_db)["interval"][0]

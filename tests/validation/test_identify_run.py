@@ -1,0 +1,149 @@
+"""An identification a user can run: its cost estimate brackets what it costs, its progress moves with every
+scene, and a stopped run keeps its scenes (a rerun reads them back) and reports a partial result.  A small
+grid (4 scenes of 0.5 s) on the stand-in rig of test_identify.py, with contact tables built cold in a cache
+of this module's own."""
+import json
+import os
+
+import pytest
+
+from bearing_lab.cli import main
+from bearing_lab.validation.identify import IdentificationInterrupted, identify
+
+from ._standins import calibration, hidden
+
+pytestmark = pytest.mark.xdist_group("identification_run")
+
+# two aligned outlines (θ = 0) and two skewed ones; none is the stand-ins' own (H = 0.3 mm, θ = 30°)
+GRID = {"defect.length_mm": [2.5, 3.0], "defect.offset_mm": [0.25], "defect.skew_deg": [0.0, 30.0]}
+
+
+@pytest.fixture(scope="module")
+def rig(tmp_path_factory):
+    """The stand-in case, and the cold run over GRID (its estimate, progress events and result), in a table
+    cache no other test has filled."""
+    from bearing_lab.sim.defects import contact
+    d = tmp_path_factory.mktemp("ident_run")
+    saved_env, saved_mem = os.environ["BEARING_LAB_CACHE"], dict(contact._MEMORY)
+    os.environ["BEARING_LAB_CACHE"] = str(d / "cache")
+    contact._MEMORY.clear()
+    try:
+        case = hidden(d, "paper-O2", 0.3, 30.0, seed=23, calib=calibration(d), name="rig", duration_s=0.5,
+                      declared_length_mm=2.5)
+        events, said = [], []
+        res = identify(case, grid=GRID, refine=False, progress=events.append, notify=said.append)
+        yield d, case, res, events, said
+    finally:
+        os.environ["BEARING_LAB_CACHE"] = saved_env
+        contact._MEMORY.clear()
+        contact._MEMORY.update(saved_mem)
+
+
+def test_the_estimate_counts_the_tables_to_build_and_brackets_the_cost(rig):
+    d, case, res, _, said = rig
+    est = res.estimate
+    assert est["coarse_scenes"] == 4 and est["refine_scenes"] == (0, 0)
+    assert est["tables_new"] == {"aligned": 2, "skewed": 2} and est["tables_cached"] == 0, est
+    lo, hi = est["cpu_s"]
+    spent = res.cpu_time_s - res.setup_cpu_s          # the scenes: tables, time loops, scoring
+    print(f"estimate {lo:.1f}-{hi:.1f} s CPU, spent {spent:.1f} s (setup {res.setup_cpu_s:.1f} s)")
+    assert lo <= spent <= hi, (lo, spent, hi)
+    assert any("4 to build (2 skewed), 0 cached" in s for s in said), said
+    # the tables are counted as contact_table keys them: after the run every one is cached
+    from bearing_lab.validation.identify import _setting
+    from bearing_lab.validation.identify_run import estimate
+    from bearing_lab.validation import load_case
+    os.environ["BEARING_LAB_CACHE"], saved = str(d / "cache"), os.environ["BEARING_LAB_CACHE"]
+    try:
+        _, base = _setting(load_case(case), None, None)
+        again = estimate(base, GRID, refine=False)
+    finally:
+        os.environ["BEARING_LAB_CACHE"] = saved
+    assert again["tables_cached"] == 4 and again["tables_new"] == {"aligned": 0, "skewed": 0}, again
+    assert again["cpu_s"][1] < hi
+
+
+def test_progress_moves_with_every_scene_and_counts_the_tables_left(rig):
+    _, _, res, events, _ = rig
+    assert [e["scenes"] for e in events] == [1, 2, 3, 4]
+    assert events[0]["tables_left"] == 3 and events[-1]["tables_left"] == 0, events
+    assert all(e["total"] >= e["scenes"] for e in events)
+
+
+def _counting_runner(monkeypatch, stop_after=None):
+    """Count the scenes simulated (the sweep's scene runner); raise KeyboardInterrupt on scene ``stop_after``+1."""
+    import bearing_lab.sweeps as sw
+    real, ran = sw._simulate_scene, []
+
+    def run(*a, **k):
+        if stop_after is not None and len(ran) == stop_after:
+            raise KeyboardInterrupt
+        ran.append(a[1])
+        return real(*a, **k)
+    monkeypatch.setattr(sw, "_simulate_scene", run)
+    return ran
+
+
+def test_a_stopped_run_keeps_its_scenes_and_a_rerun_reads_them_back(rig, tmp_path, monkeypatch):
+    d, case, full, _, _ = rig
+    monkeypatch.setenv("BEARING_LAB_CACHE", str(d / "cache"))
+    journal = tmp_path / "j.jsonl"
+
+    def ctrl_c_at_two(ev):
+        if ev["scenes"] == 2:
+            raise KeyboardInterrupt
+    with pytest.raises(IdentificationInterrupted) as exc:
+        identify(case, grid=GRID, refine=False, progress=ctrl_c_at_two, journal=journal)
+    part = exc.value.result
+    assert part is not None and part.partial and part.n_scenes == 2
+    assert part.notes[0].startswith("PARTIAL: stopped after 2 scenes (2 of the coarse grid's 4")
+    assert all(p["statement"].startswith("partial, ") for p in part.parameters.values())
+    assert part.best["score_db"] == min(p["score_db"] for p in full.points[:2])
+    assert len(journal.read_text().splitlines()) == 1 + 2
+    ran = _counting_runner(monkeypatch)
+    said = []
+    res = identify(case, grid=GRID, refine=False, progress=False, journal=journal, notify=said.append)
+    assert len(ran) == 2 and res.resumed == 2 and not res.partial      # only the two scenes not done
+    assert any(s.startswith("resuming: 2 scored scenes") for s in said), said
+    assert res.estimate["coarse_done"] == 2 and res.estimate["coarse_scenes"] == 2
+    key = list(GRID)
+    got = {tuple(p[k] for k in key): p["score_db"] for p in res.points}
+    assert got == {tuple(p[k] for k in key): p["score_db"] for p in full.points}      # the same scores
+    assert res.signatures["best"] is not None
+
+
+def test_a_journal_of_another_comparison_is_set_aside(rig, tmp_path, monkeypatch):
+    d, case, full, _, _ = rig
+    monkeypatch.setenv("BEARING_LAB_CACHE", str(d / "cache"))
+    journal = tmp_path / "j.jsonl"
+    journal.write_text(json.dumps({"journal": "bearing_lab identification", "comparison": "0" * 64}) + "\n"
+                       + json.dumps({"scene": "x", "point": {}, "score": {"score_db": -99.0}}) + "\n")
+    said = []
+    res = identify(case, grid={k: v[:1] for k, v in GRID.items()}, refine=False, progress=False, journal=journal,
+                   notify=said.append)
+    assert res.resumed == 0 and res.best["score_db"] > -99.0
+    assert (tmp_path / "j.jsonl.old").is_file() and any("set aside" in s for s in said), said
+
+
+def test_cli_interrupted_writes_a_partial_result_exits_130_and_resumes(rig, tmp_path, monkeypatch, capsys):
+    d, case, full, _, _ = rig
+    monkeypatch.setenv("BEARING_LAB_CACHE", str(d / "cache"))
+    args = ["identify", str(case), "-o", str(tmp_path), "--no-progress", "--no-refine", "--length-mm", "2.5", "3.0",
+            "--offset-mm", "0.25", "--skew-deg", "0", "30"]
+    _counting_runner(monkeypatch, stop_after=3)
+    assert main(args) == 130
+    out, err = capsys.readouterr()
+    assert out.startswith("PARTIAL result (interrupted after 3 scenes)") and "partial, length" in out, out
+    assert "rerun the same command to resume" in err
+    written = json.loads((tmp_path / "rig" / "identification-partial.json").read_text())
+    assert written["partial"] is True and written["n_scenes"] == 3
+    assert not (tmp_path / "rig" / "identification.json").exists()
+    monkeypatch.undo()
+    monkeypatch.setenv("BEARING_LAB_CACHE", str(d / "cache"))
+    ran = _counting_runner(monkeypatch)
+    assert main(args) == 0
+    out, err = capsys.readouterr()
+    assert len(ran) == 1 and "resuming: 3 scored scenes" in err, err
+    done = json.loads((tmp_path / "rig" / "identification.json").read_text())
+    assert done["partial"] is False and done["n_scenes"] == 4 and done["resumed"] == 3
+    assert not (tmp_path / "rig" / "identification-partial.json").exists()      # superseded
