@@ -86,6 +86,8 @@ def run(args) -> int:
         return 0
     if args.quiet:
         return 0
+    if res.explains_recording is False:
+        print("NOT EXPLAINED: " + next(n for n in res.notes if "does not explain" in n))
     for p in res.parameters.values():
         print(p["statement"])
     for note in res.notes:

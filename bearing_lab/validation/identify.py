@@ -60,6 +60,7 @@ class Identification:
     resumed: int = 0                     # scenes read back from the journal of an earlier run
     estimate: dict = field(default_factory=dict)   # identify_run.estimate() made before the scenes ran
     setup_cpu_s: float = 0.0             # CPU s of preparing the comparison (recording, path, background)
+    explains_recording: bool | None = None   # the best scene within the threshold of the recording
 
     def to_dict(self) -> dict:
         return {"case": self.case, "best": self.best, "parameters": self.parameters,
@@ -67,7 +68,8 @@ class Identification:
                 "level_reason": self.level_reason, "grid": self.grid, "n_scenes": self.n_scenes,
                 "cpu_time_s": self.cpu_time_s, "wall_time_s": self.wall_time_s, "notes": self.notes,
                 "declared": self.declared, "roughness_db": self.roughness_db, "partial": self.partial,
-                "resumed": self.resumed, "estimate": self.estimate, "setup_cpu_s": self.setup_cpu_s}
+                "resumed": self.resumed, "estimate": self.estimate, "setup_cpu_s": self.setup_cpu_s,
+                "explains_recording": self.explains_recording}
 
 
 class IdentificationInterrupted(KeyboardInterrupt):
@@ -552,9 +554,29 @@ def _result(case, st, points, grid, thr, declared, t_cpu, t_wall, best_signature
                      f"{100 * ROUGHNESS_STEP:g} % of its grid step changes the score by up to this much"
                      + ("; the interval threshold is raised to twice it (the best scene and any other each move "
                         "by up to it)" if 2 * roughness >= thr - 1e-12 and roughness > 0 else ""))
-    if not partial and not any(p["identifiable"] for p in params.values()):
+    explains = _explains(best["score_db"], thr, st.noise_db, partial)
+    if not explains[0]:
+        notes.insert(1 if partial else 0, explains[1])
+    elif not partial and not any(p["identifiable"] for p in params.values()):
         notes.append("no parameter is identifiable: the recording's impact signature does not change with the "
                      "searched geometry more than with its own noise")
-    return Identification(case.name, points, best, params, thr, st.noise_db, st.level_weight, st.level_reason,
-                          grid, len(points), time.process_time() - t_cpu, time.perf_counter() - t_wall, notes,
-                          {"recording": st.measured, "best": best_signature}, declared, roughness, partial)
+    res = Identification(case.name, points, best, params, thr, st.noise_db, st.level_weight, st.level_reason,
+                         grid, len(points), time.process_time() - t_cpu, time.perf_counter() - t_wall, notes,
+                         {"recording": st.measured, "best": best_signature}, declared, roughness, partial)
+    res.explains_recording = explains[0]
+    return res
+
+
+def _explains(best_db, thr, noise_db, partial) -> tuple:
+    """(explains, statement): does the best scene explain the recording?  It does when its score lies within
+    the threshold (the recording's own noise, its roughness): no geometry can then be told from the truth.
+    Above it, the model does not explain the recording, and the intervals describe the nearest geometry of
+    a model that misfits, not the defect."""
+    if best_db <= thr:
+        return True, ""
+    ratio = f", {best_db / noise_db:.1f} times the recording's split-half misfit ({noise_db:.2f} dB)" if noise_db > 0 else ""
+    return False, ((("so far, " if partial else "") + "the model does not explain this recording: the best scene "
+                    f"misfits it by {best_db:.2f} dB, above the threshold of {thr:.2f} dB{ratio}; the intervals "
+                    "are those of the nearest geometry of a model that misfits, not the defect's, and a parameter "
+                    "called not identifiable may be hidden by the misfit (see the signature figure: the best "
+                    "scene's mean impact against the recording's)"))

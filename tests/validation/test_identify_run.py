@@ -147,3 +147,18 @@ def test_cli_interrupted_writes_a_partial_result_exits_130_and_resumes(rig, tmp_
     done = json.loads((tmp_path / "rig" / "identification.json").read_text())
     assert done["partial"] is False and done["n_scenes"] == 4 and done["resumed"] == 3
     assert not (tmp_path / "rig" / "identification-partial.json").exists()      # superseded
+
+
+def test_the_truth_explains_the_recording_and_a_far_geometry_does_not(rig):
+    """A recording the model made is explained by its own geometry; a geometry far from it is reported as not
+    explaining the recording, rather than as parameters that are merely not identifiable."""
+    _, case, _, _, _ = rig
+    truth = identify(case, grid={"defect.length_mm": [3.0], "defect.offset_mm": [0.3], "defect.skew_deg": [30.0]},
+                     refine=False, progress=False)
+    assert truth.explains_recording is True, (truth.best["score_db"], truth.threshold_db)
+    assert not any("does not explain" in n for n in truth.notes)
+    far = identify(case, grid={"defect.length_mm": [1.0], "defect.offset_mm": [0.0], "defect.skew_deg": [-60.0]},
+                   refine=False, progress=False)
+    assert far.explains_recording is False and far.best["score_db"] > far.threshold_db
+    assert "the model does not explain this recording" in far.notes[0]
+    assert far.to_dict()["explains_recording"] is False
