@@ -50,26 +50,17 @@ def refine_budget(grid) -> int:
 
 
 def _table_cached(defect, bearing, kw) -> bool:
-    """Whether the table :func:`contact_table` would return for (defect, kw) is in memory or on disk (its
-    key formed as ``contact_table`` forms it)."""
-    from dataclasses import replace
-    from ..sim.defects import _table_cache, contact
-    args = dict(model=kw["model"], clearance=float(kw["clearance"]), delta_max=float(kw["delta_max"]),
-                n_psi=None, n_delta=41, against=None,
-                material=(float(kw["material"][0]), float(kw["material"][1])))
-    for name in ("above_drop", "delta_top"):
-        if kw.get(name) is not None:
-            args[name] = float(kw[name])
-    key = _table_cache.table_key(replace(defect, angle=0.0), bearing, **args)
-    return key in contact._MEMORY or _table_cache.entry_path(key, kw["model"]).is_file()
+    """Whether the table :func:`contact_table` would return for (defect, kw) is in memory or on disk."""
+    from ..sim.defects.contact import table_is_cached
+    return table_is_cached(defect, bearing, **kw)
 
 
 def table_plan(base, points) -> dict:
     """Contact tables the scenes ``points`` ([{key: value}] over ``base``) need: distinct ones, split into
     cached / to build (aligned or skewed outline), and ``builds``: the indices of the points that build one
     (the first to need each table not cached)."""
-    from ..sim.assembly import _statics, table_requests
-    statics = _statics(base)
+    from ..sim.assembly import scene_statics, table_requests
+    statics = scene_statics(base)
     seen, new, of_point = {}, {"aligned": 0, "skewed": 0}, []
     cached = 0
     for p in points:

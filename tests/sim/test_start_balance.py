@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from bearing_lab.errors import SceneError
-from bearing_lab.sim.assembly import _solve_relative
+from bearing_lab.sim.statics import _solve_relative
 
 
 def _force(e):

@@ -278,6 +278,28 @@ def _correlate(f: np.ndarray, kern: np.ndarray, m: int, n_psi: int) -> np.ndarra
     return out
 
 
+def _arguments_and_key(defect, bearing, *, model, clearance=0.0, delta_max, n_psi=None, n_delta=41, against=None,
+                       material=None, above_drop=None, delta_top=None):
+    """The table's normalised arguments and its cache key, as :func:`contact_table` forms them."""
+    from . import _table_cache
+    material = DEFAULT_MATERIAL if material is None else (float(material[0]), float(material[1]))
+    args = dict(model=model, clearance=float(clearance), delta_max=float(delta_max), n_psi=n_psi,
+                n_delta=int(n_delta), against=against, material=material)
+    if above_drop is not None:
+        args["above_drop"] = float(above_drop)
+    if delta_top is not None:
+        args["delta_top"] = float(delta_top)
+    return args, _table_cache.table_key(replace(defect, angle=0.0), bearing, **args)
+
+
+def table_is_cached(defect: Defect, bearing, **kw) -> bool:
+    """Whether :func:`contact_table` with these arguments would read its table back (from memory or the
+    disk cache) instead of building it."""
+    from . import _table_cache
+    _, key = _arguments_and_key(defect, bearing, **kw)
+    return key in _MEMORY or _table_cache.entry_path(key, kw["model"]).is_file()
+
+
 def contact_table(defect: Defect, bearing, *, model: str, clearance: float = 0.0,
                   delta_max: float, n_psi: int | None = None, n_delta: int = 41,
                   against: str | None = None, material: tuple[float, float] | None = None,
@@ -326,15 +348,10 @@ def contact_table(defect: Defect, bearing, *, model: str, clearance: float = 0.0
     ContactTable
     """
     from . import _table_cache
-    material = DEFAULT_MATERIAL if material is None else (float(material[0]), float(material[1]))
-    args = dict(model=model, clearance=float(clearance), delta_max=float(delta_max), n_psi=n_psi,
-                n_delta=int(n_delta), against=against, material=material)
-    if above_drop is not None:
-        args["above_drop"] = float(above_drop)
-    if delta_top is not None:
-        args["delta_top"] = float(delta_top)
+    args, key = _arguments_and_key(defect, bearing, model=model, clearance=clearance, delta_max=delta_max,
+                                   n_psi=n_psi, n_delta=n_delta, against=against, material=material,
+                                   above_drop=above_drop, delta_top=delta_top)
     _check_arguments(defect, **args)
-    key = _table_cache.table_key(replace(defect, angle=0.0), bearing, **args)
     hit = _MEMORY.get(key)
     if hit is not None:
         return hit
