@@ -402,29 +402,13 @@ def identify(case, *, grid=None, refine=True, scheduler="serial", n_workers=None
     identification of the scenes done (``partial`` True), or None if none had finished.
     """
     from . import load_case
-    from .identify_run import Journal, Progress, comparison_fingerprint, estimate, estimate_text
+    from .identify_run import Progress
     t_cpu, t_wall = time.process_time(), time.perf_counter()
     case = case if hasattr(case, "section") else load_case(case)
     declared = _declared(case)
     grid = {k: [float(x) for x in v] for k, v in (grid or default_grid(case)).items()}
-    bad = [k for k in grid if k not in PARAMS]
-    if bad or not grid or any(not v for v in grid.values()):
-        raise ValidationCaseError(f"identify: grid keys must be among {', '.join(PARAMS)} with at least one value "
-                                  f"each; got {', '.join(bad) or 'an empty grid'}")
-    if notify is not None:
-        notify("preparing the comparison (the recording, the structural path, the background)")
-    st, base = _setting(case, mirror, level_weight)
-    setup_cpu = time.process_time() - t_cpu
-    thr = float(threshold_db) if threshold_db is not None else max(3 * st.noise_db, MIN_THRESHOLD_DB)
-    jr = Journal(journal, comparison_fingerprint(st, base)) if journal else None
-    old = [e["point"] for e in (jr.entries.values() if jr else []) if set(e["point"]) == set(grid)]
-    est = estimate(base, grid, refine=refine, done=old)
-    if notify is not None:
-        if jr is not None and jr.set_aside is not None:
-            notify(f"the journal {jr.path} was of another comparison: set aside as {jr.set_aside.name}")
-        if jr is not None and jr.entries:
-            notify(f"resuming: {len(jr.entries)} scored scenes in {jr.path} are read back, not simulated")
-        notify(estimate_text(est))
+    st, base, setup_cpu, thr, jr, old, est = _prepare(case, grid, refine, mirror, level_weight, threshold_db,
+                                                      journal, notify, t_cpu)
     bar = Progress(f"identify {case.name}", int(np.prod([len(v) for v in grid.values()])) + est["refine_likely"],
                    bar=progress is True, callback=progress if callable(progress) else None)
     bar.tables(est["tables_new"]["aligned"] + est["tables_new"]["skewed"], est["builds"])
@@ -446,19 +430,47 @@ def identify(case, *, grid=None, refine=True, scheduler="serial", n_workers=None
     except KeyboardInterrupt:
         res = None
         if points:
-            res = _result(case, st, points, grid, thr, declared, t_cpu, t_wall, keep.get("signature"), None, None,
-                          partial=True)
-            res.resumed = len(jr.entries) if jr else 0
-            res.estimate, res.setup_cpu_s = {k: v for k, v in est.items() if k != "builds"}, setup_cpu
+            res = _stamped(_result(case, st, points, grid, thr, declared, t_cpu, t_wall, keep.get("signature"),
+                                   None, None, partial=True), len(jr.entries) if jr else 0, est, setup_cpu)
         raise IdentificationInterrupted(res) from None
     finally:
         bar.close()
         if close:
             client.close()
-    res = _result(case, st, points, grid, thr, declared, t_cpu, t_wall, keep["signature"], roughness, walked)
-    res.resumed = len(old)
+    return _stamped(_result(case, st, points, grid, thr, declared, t_cpu, t_wall, keep["signature"], roughness,
+                            walked), len(old), est, setup_cpu)
+
+
+def _stamped(res, resumed, est, setup_cpu):
+    """``res`` with the scenes read back, the estimate made before the run and the setup's CPU time."""
+    res.resumed = resumed
     res.estimate, res.setup_cpu_s = {k: v for k, v in est.items() if k != "builds"}, setup_cpu
     return res
+
+
+def _prepare(case, grid, refine, mirror, level_weight, threshold_db, journal, notify, t_cpu):
+    """Before any scene: the grid checked, the comparison setting and base scene, the threshold from the
+    recording's noise, the journal of an earlier run and the cost estimate (said through ``notify``)."""
+    from .identify_run import Journal, comparison_fingerprint, estimate, estimate_text
+    bad = [k for k in grid if k not in PARAMS]
+    if bad or not grid or any(not v for v in grid.values()):
+        raise ValidationCaseError(f"identify: grid keys must be among {', '.join(PARAMS)} with at least one value "
+                                  f"each; got {', '.join(bad) or 'an empty grid'}")
+    if notify is not None:
+        notify("preparing the comparison (the recording, the structural path, the background)")
+    st, base = _setting(case, mirror, level_weight)
+    setup_cpu = time.process_time() - t_cpu
+    thr = float(threshold_db) if threshold_db is not None else max(3 * st.noise_db, MIN_THRESHOLD_DB)
+    jr = Journal(journal, comparison_fingerprint(st, base)) if journal else None
+    old = [e["point"] for e in (jr.entries.values() if jr else []) if set(e["point"]) == set(grid)]
+    est = estimate(base, grid, refine=refine, done=old)
+    if notify is not None:
+        if jr is not None and jr.set_aside is not None:
+            notify(f"the journal {jr.path} was of another comparison: set aside as {jr.set_aside.name}")
+        if jr is not None and jr.entries:
+            notify(f"resuming: {len(jr.entries)} scored scenes in {jr.path} are read back, not simulated")
+        notify(estimate_text(est))
+    return st, base, setup_cpu, thr, jr, old, est
 
 
 def _setting(case, mirror, level_weight):
