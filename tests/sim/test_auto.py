@@ -184,3 +184,21 @@ def test_planar_scenes_decide_on_the_groove_bottom_without_a_3d_start(offset_mm,
     assert choice["track"] == "planar contact track (groove bottom)"
     ds = simulate(sc, duration=0.02, progress=False)
     assert ds.attrs["solver_method"] == choice["method"] and "groove bottom" in ds.attrs["auto_choice"]
+
+
+def test_a_grazed_defect_is_said_in_the_choice_and_warned():
+    """A defect the 3-D track meets only at the contact patch's edge runs the defect rule, whose accuracy is
+    not measured there: the choice says so and a warning names the setting to use; a defect the track runs
+    over (the same pit without the axial load) gets neither."""
+    import warnings
+
+    from bearing_lab.sim import load_scene
+    from bearing_lab.sim.auto import resolve
+    from bearing_lab.sim.scene import SceneWarning
+    with pytest.warns(SceneWarning, match="grazed.*dp54"):
+        r = resolve(load_scene("cwru-or007-6", **{"load.axial_n": 300.0}))
+    assert r["kind"] == "defect" and "only grazed" in r["reason"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", SceneWarning)
+        r = resolve(load_scene("cwru-or007-6"))
+    assert "grazed" not in r["reason"]
