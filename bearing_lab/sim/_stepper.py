@@ -397,19 +397,20 @@ def fir_decimate3(a_fine, taps_rev, s0, R, out, out_z):
         out_z[kk] = acc2
 
 
-def _drop_stale_cache():
-    """numba keys a cached function on its own source file only, and these functions compile the
-    right-hand side of ``_kernels.py`` into themselves: when that file changes (a development
-    install), drop this module's cached machine code so it is compiled anew."""
+def drop_stale_machine_code(fns, sources) -> None:
+    """numba keys a cached function on its own source file only; ``fns`` also depend on the files
+    ``sources`` (the right-hand side of ``_kernels.py`` is compiled into them): when one of those
+    changes (a development install), drop the functions' cached machine code so it is compiled anew."""
     import hashlib
+    import inspect
     from pathlib import Path
-    stamp = hashlib.sha256(Path(K.__file__).read_bytes() + Path(__file__).read_bytes()).hexdigest()
-    for fn in (integrate, loads_at, step_limit, contact_angles_at):
+    stamp = hashlib.sha256(b"".join(Path(f).read_bytes() for f in sources)).hexdigest()
+    for fn in fns:
         cache = getattr(fn, "_cache", None)
         path = getattr(cache, "cache_path", None)
         if not path:
             continue
-        marker = Path(path) / f"{__name__.rsplit('.', 1)[-1]}.{fn.__name__}.sources"
+        marker = Path(path) / f"{Path(inspect.getfile(fn.py_func)).stem}.{fn.py_func.__qualname__}.sources"
         try:
             if not marker.is_file() or marker.read_text() != stamp:
                 cache.flush()
@@ -418,4 +419,4 @@ def _drop_stale_cache():
             pass
 
 
-_drop_stale_cache()
+drop_stale_machine_code((integrate, loads_at, step_limit, contact_angles_at), (K.__file__, __file__))

@@ -24,10 +24,8 @@ kind with the full kernel bit for bit.
 """
 from __future__ import annotations
 
-import hashlib
 import inspect
 import math
-from pathlib import Path
 import types
 
 from numba import njit
@@ -81,22 +79,8 @@ def _copy(dispatcher, qualname, *, cache, **glb):
 
 
 def _drop_stale(fns):
-    """numba keys a cached function on its own source file only; these copies also depend on
-    ``_kernels.py``, ``_stepper.py`` and this file: when one changes, drop their machine code."""
-    stamp = hashlib.sha256(b"".join(Path(m.__file__).read_bytes() for m in (K, S))
-                           + Path(__file__).read_bytes()).hexdigest()
-    for fn in fns:
-        cache = getattr(fn, "_cache", None)
-        path = getattr(cache, "cache_path", None)
-        if not path:
-            continue
-        marker = Path(path) / f"{Path(inspect.getfile(fn.py_func)).stem}.{fn.py_func.__qualname__}.sources"
-        try:
-            if not marker.is_file() or marker.read_text() != stamp:
-                cache.flush()
-                marker.write_text(stamp)
-        except OSError:  # a read-only cache: numba will not write there either
-            pass
+    """These copies also depend on ``_kernels.py``, ``_stepper.py`` and this file."""
+    S.drop_stale_machine_code(fns, (K.__file__, S.__file__, __file__))
 
 
 def _stages_of(method):

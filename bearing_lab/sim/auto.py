@@ -57,7 +57,6 @@ def _track_3d(scene, fid):
     from ..errors import BearingLabError, SolverError
     from .assembly import track_offset, load_zone_angle, static_3d
     from .bearing3d import groove_offsets
-    from .defects.geometry import RaceGeometry
     try:
         with np.errstate(all="ignore"):
             st = static_3d(scene, fid)
@@ -75,8 +74,7 @@ def _track_3d(scene, fid):
             continue
         met, alpha = track_offset(d, st, d.race, lz + d.angle, b)
         r_g = groove_offsets(b)[0 if d.race == "inner" else 1] + b.ball_diameter / 2
-        gap = max(float(RaceGeometry.from_bearing(b, d.race, clearance=scene.clearance)
-                        .approach(0.0, met.min_abs_axial())), 0.0)
+        gap = max(_gap(scene, met), 0.0)
         parts.append(f"defect {k} ({d.race}): contact angle {math.degrees(alpha):.2f} deg, track "
                      f"{r_g * math.sin(alpha) * 1e3:+.3f} mm across the groove from its bottom, the defect's "
                      f"nearest point {met.min_abs_axial() * 1e3:.3f} mm from the track ({gap * 1e6:.3g} um "
@@ -158,6 +156,13 @@ def resolve(scene) -> dict:
     return out
 
 
+def _gap(scene, defect) -> float:
+    """The approach (m) a ball on the track needs before it reaches the race defect's nearest point."""
+    from .defects.geometry import RaceGeometry
+    return float(RaceGeometry.from_bearing(scene.bearing, defect.race, clearance=scene.clearance)
+                 .approach(0.0, defect.min_abs_axial()))
+
+
 #: an approach below this is float noise, not a gap: the track runs over the defect
 GRAZE_MIN = 1e-8
 
@@ -165,13 +170,11 @@ GRAZE_MIN = 1e-8
 def _grazed(scene, defects) -> list:
     """[(index, gap)]: the race defects the track meets only off its centre line, ``gap`` (m) the approach
     the ball needs before it reaches the defect's nearest point (0 < gap < :data:`MISS_DELTA`)."""
-    from .defects.geometry import RaceGeometry
     out = []
     for k, d in enumerate(defects):
         if d.race == "ball":
             continue
-        gap = float(RaceGeometry.from_bearing(scene.bearing, d.race, clearance=scene.clearance)
-                    .approach(0.0, d.min_abs_axial()))
+        gap = _gap(scene, d)
         if GRAZE_MIN < gap < MISS_DELTA:
             out.append((k, gap))
     return out
