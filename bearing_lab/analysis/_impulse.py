@@ -57,11 +57,18 @@ HARMONIC_WEIGHT = 2
 Impulses = namedtuple("Impulses", ["time", "peak", "duration", "entry", "exit", "resolved"])
 Impulses.__doc__ = """Result of :func:`impulses`: one entry per impulse (1-D arrays).
 
-time : instant of the envelope maximum, s (parabolic sub-sample interpolation).
-peak : largest |x| of the impulse (sampled peak, baseline removed), unit of x.
-duration : excitation duration, s (module docstring).
-entry, exit : the level crossings that bound it, s.
-resolved : duration spans at least two sample intervals.
+Attributes
+----------
+time : ndarray
+    Instant of the envelope maximum, s (parabolic sub-sample interpolation).
+peak : ndarray
+    Largest ``|x|`` of the impulse (sampled peak, baseline removed), unit of x.
+duration : ndarray
+    Excitation duration, s (module docstring).
+entry, exit : ndarray
+    The level crossings that bound it, s.
+resolved : ndarray of bool
+    Duration spans at least two sample intervals.
 """
 
 

@@ -350,14 +350,21 @@ def squared_envelope_spectrum(x, fs, *, window, band=None, prewhiten=False, fmax
 Kurtogram = namedtuple("Kurtogram", ["kurtosis", "levels", "frequency", "band", "level", "kurtosis_max"])
 Kurtogram.__doc__ = """Result of :func:`fast_kurtogram`.
 
-kurtosis : 2-D array (level, frequency); each cell's spectral kurtosis (excess,
-    0 for Gaussian noise) repeated over the finest frequency grid; NaN where a
-    level was not computed (narrower than ``min_bandwidth``).
-levels : 1-D array of level numbers 0, 1, 1.6, 2, 2.6, ... (band width fs/2**(level+1)).
-frequency : 1-D array, centre of each grid column, Hz.
-band : (low, high) of the cell with the largest kurtosis, Hz.
-level : level of that cell.
-kurtosis_max : its spectral kurtosis.
+Attributes
+----------
+kurtosis : 2-D array (level, frequency)
+    Each cell's spectral kurtosis (excess, 0 for Gaussian noise) repeated over the finest
+    frequency grid; NaN where a level was not computed (narrower than ``min_bandwidth``).
+levels : 1-D array
+    Level numbers 0, 1, 1.6, 2, 2.6, ... (band width fs/2**(level+1)).
+frequency : 1-D array
+    Centre of each grid column, Hz.
+band : (low, high)
+    The cell with the largest kurtosis, Hz.
+level : float
+    Level of that cell.
+kurtosis_max : float
+    Its spectral kurtosis.
 """
 
 

@@ -2,16 +2,18 @@
 
 Public API
 ----------
-open_recording(path, format=None, **options) -- file -> xarray.Dataset (format sniffed from content)
-list_engines()                                -- {name: description} of the readers, and what each needs
-to_netcdf(ds, path)                           -- compressed, lossless netCDF4
-to_uff58b(ds, path, channels=None, ...)       -- UFF 58b (binary) for Testlab and other tools
-get_warnings(ds)                              -- the recording's warnings as a list
-ENGINES                                       -- name -> reader class, in sniffing order (SNIFF_ORDER,
-                                                 then the entry-point group "bearing_lab.readers",
-                                                 then FALLBACK_READERS)
-RecordingReader                               -- base class of the readers
-RecordingWarning                              -- category of the non-fatal warnings
+::
+
+    open_recording(path, format=None, **options) -- file -> xarray.Dataset (format sniffed from content)
+    list_engines()                                -- {name: description} of the readers, and what each needs
+    to_netcdf(ds, path)                           -- compressed, lossless netCDF4
+    to_uff58b(ds, path, channels=None, ...)       -- UFF 58b (binary) for Testlab and other tools
+    get_warnings(ds)                              -- the recording's warnings as a list
+    ENGINES                                       -- name -> reader class, in sniffing order (SNIFF_ORDER,
+                                                     then the entry-point group "bearing_lab.readers",
+                                                     then FALLBACK_READERS)
+    RecordingReader                               -- base class of the readers
+    RecordingWarning                              -- category of the non-fatal warnings
 
 Options every reader understands: ``channels``, ``units`` (label or channel ->
 label, for unknown or missing unit labels), ``checksum``; most also take ``fs``
