@@ -17,7 +17,7 @@ IN_CI = os.environ.get("CI", "").lower() in ("1", "true", "yes")
 
 #: the modules whose docstrings hold examples (run here as doctests)
 DOCTEST_MODULES = [
-    "bearing_lab._docdict",
+    "bearing_lab._docdict", "bearing_lab.bearings",
     "bearing_lab.sim.integrate", "bearing_lab.sim.scene", "bearing_lab.sim.auto",
     "bearing_lab.validation.case", "bearing_lab.validation.runner", "bearing_lab.validation.rows",
     "bearing_lab.validation.quantities", "bearing_lab.validation.standin",

@@ -398,6 +398,12 @@ def analyze(x, fs, *, bearing, rpm=None, shaft_hz=None, channel="", units="m s-2
         runner-up and margin, demodulation band and its spectral kurtosis, each
         route's families, flags).  ``docs/analysis.md`` describes every field.
 
+    See Also
+    --------
+    plot_analysis : the same analysis as a figure.
+    shaft_speed : the speed step alone.
+    bearing_lab.io.open_recording, bearing_lab.sim.simulate : signals to analyse.
+
     Notes
     -----
     Without a speed, a noise-free simulation (no shaft lines) or any record

@@ -89,6 +89,10 @@ def list_engines() -> dict[str, str]:
 
     A reader whose optional library is missing says what to install.
 
+    See Also
+    --------
+    open_recording
+
     Examples
     --------
     >>> "uff58" in list_engines()
@@ -217,6 +221,12 @@ def open_recording(path, format=None, **options):
     ------
     RecordingError
         For any unreadable, corrupt or ambiguous input; the message names the file.
+
+    See Also
+    --------
+    list_engines : the readers and the options each takes.
+    to_netcdf, to_uff58b : write a Dataset.
+    bearing_lab.analysis.analyze : analyse a channel.
 
     Examples
     --------
