@@ -58,8 +58,6 @@ docdict["out_dir"] = """out_dir : str or Path
 # ---- report
 docdict["rows"] = """rows : list of dict
     Validation rows as :func:`~bearing_lab.validation.make_row` makes them."""
-docdict["title"] = """title : str
-    Section heading (also its entry in the page's table of contents)."""
 
 _PLACEHOLDER = re.compile(r"^([ \t]*)%\((\w+)\)s[ \t]*$", re.MULTILINE)
 
