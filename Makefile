@@ -5,22 +5,23 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 
-.PHONY: install lock validate test bench study verdicts clean
+.PHONY: install lock validate test docs bench study verdicts clean
 
 install: $(STAMP)
 
-# the locked versions (constraints.txt) the suite is tested with; `make lock` refreshes them
+# the locked versions (constraints.txt) the suite is tested with; `make lock` refreshes them.
+# The docs extra is installed too: the test suite builds the API reference (tests/test_api_docs.py).
 $(STAMP): pyproject.toml constraints.txt
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet -c constraints.txt pip
-	$(PY) -m pip install --quiet -c constraints.txt -e ".[test]"
+	$(PY) -m pip install --quiet -c constraints.txt -e ".[test,docs]"
 	touch $(STAMP)
 
 # re-resolve the newest versions pip finds today into constraints.txt (then run `make test`)
 lock:
 	rm -rf .lock-venv && $(PYTHON) -m venv .lock-venv
 	.lock-venv/bin/python -m pip install --quiet --upgrade pip
-	.lock-venv/bin/python -m pip install --quiet -e ".[test]"
+	.lock-venv/bin/python -m pip install --quiet -e ".[test,docs]"
 	{ sed -n '1,3p' constraints.txt; .lock-venv/bin/python -m pip freeze --all --exclude-editable \
 	    | grep -v -i -e '^bearing.lab' -e '^setuptools=' -e '^wheel='; } > constraints.txt.new
 	mv constraints.txt.new constraints.txt && rm -rf .lock-venv
@@ -31,6 +32,12 @@ validate: install
 # one file per worker, handed out in the order tests/conftest.py sets (the longest first)
 test: install
 	$(PY) -m pytest -n 2 --dist loadfile --no-loadscope-reorder -q $(PYTEST_ARGS)
+
+# the API reference from the docstrings, and the docs/*.md pages, as HTML in docs/_build/html
+# (git-ignored); any Sphinx warning fails the build
+docs: install
+	$(PY) -m sphinx -b html -W --keep-going -q docs docs/_build/html
+	@echo "open docs/_build/html/api/index.html"
 
 bench: install
 	$(VENV)/bin/bearing-lab bench

@@ -3,19 +3,19 @@ both the same way, and write validation reports.
 
 Public API
 ----------
-``__all__`` holds every name below; each is served lazily from the module named.
+``__all__`` holds every name below; each is served lazily from the module named::
 
-simulate, load_scene, Scene, list_scenes  -- scene -> xarray.Dataset (bearing_lab.sim)
-open_recording, list_engines              -- file -> xarray.Dataset, the readers (bearing_lab.io)
-to_netcdf, to_uff58b                      -- write a Dataset (bearing_lab.io)
-analyze                                   -- signal -> speed, band, envelope spectrum, diagnosis (bearing_lab.analysis)
-get_bearing, BearingGeometry, CATALOG     -- catalog geometry and kinematic fault frequencies (bearing_lab.bearings)
-check_dataset                             -- the Dataset contract shared by recordings and simulations (bearing_lab.schema)
-sweep                                     -- many scenes on Dask (bearing_lab.sweeps)
-identify                                  -- defect geometry from a recording (bearing_lab.validation.identify)
-BearingLabError, SceneError, RecordingError, AnalysisError, SolverError, ValidationCaseError
-                                          -- the error types (bearing_lab.errors)
-__version__
+    simulate, load_scene, Scene, list_scenes  -- scene -> xarray.Dataset (bearing_lab.sim)
+    open_recording, list_engines              -- file -> xarray.Dataset, the readers (bearing_lab.io)
+    to_netcdf, to_uff58b                      -- write a Dataset (bearing_lab.io)
+    analyze                                   -- signal -> speed, band, envelope spectrum, diagnosis (bearing_lab.analysis)
+    get_bearing, BearingGeometry, CATALOG     -- catalog geometry and kinematic fault frequencies (bearing_lab.bearings)
+    check_dataset                             -- the Dataset contract shared by recordings and simulations (bearing_lab.schema)
+    sweep                                     -- many scenes on Dask (bearing_lab.sweeps)
+    identify                                  -- defect geometry from a recording (bearing_lab.validation.identify)
+    BearingLabError, SceneError, RecordingError, AnalysisError, SolverError, ValidationCaseError
+                                              -- the error types (bearing_lab.errors)
+    __version__
 
 Subpackages (``dir(bearing_lab)`` lists them, ``import *`` does not): analysis, datasets, io,
 report, sim, validation.

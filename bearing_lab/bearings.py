@@ -37,6 +37,10 @@ class BearingGeometry:
     element : "ball" or "roller".
     rows : number of rows.
     source : where the numbers come from.
+
+    See Also
+    --------
+    get_bearing : a catalog bearing.
     """
 
     name: str
@@ -130,7 +134,23 @@ CATALOG: dict[str, BearingGeometry] = {
 
 
 def get_bearing(name: str) -> BearingGeometry:
-    """Return the catalog bearing ``name`` (e.g. "6308", "6205")."""
+    """Return the catalog bearing ``name`` (e.g. "6308", "6205").
+
+    Raises
+    ------
+    SceneError
+        An unknown name, with the catalog's names.
+
+    See Also
+    --------
+    BearingGeometry, CATALOG, bearing_lab.sim.load_scene
+
+    Examples
+    --------
+    >>> b = get_bearing("6308")
+    >>> b.n_balls, round(b.fault_frequencies(30.0)["bpfo"], 2)     # Z/2 (1 - D_b/d_m) f_r at 30 Hz
+    (8, 92.16)
+    """
     try:
         return CATALOG[str(name)]
     except KeyError:

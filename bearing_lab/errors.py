@@ -8,7 +8,12 @@ stderr and exit status 2; nothing else is allowed to escape as a traceback.
 
 
 class BearingLabError(Exception):
-    """Base of all errors bearing_lab raises on purpose."""
+    """Base of all errors bearing_lab raises on purpose.
+
+    See Also
+    --------
+    SceneError, RecordingError, AnalysisError, SolverError, ValidationCaseError
+    """
 
 
 class SceneError(BearingLabError, ValueError):

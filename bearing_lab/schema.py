@@ -54,6 +54,10 @@ def check_dataset(ds, *, kind: str | None = None) -> None:
     ----------
     ds : xarray.Dataset
     kind : "simulation", "recording" or None (common checks only).
+
+    See Also
+    --------
+    bearing_lab.io.open_recording, bearing_lab.sim.simulate : make Datasets that pass it.
     """
     problems = []
     if "time" not in ds.coords:

@@ -8,31 +8,33 @@ registered on import.
 
 Public API
 ----------
-amplitude_spectrum(x, fs, *, window, axis=-1)           -- (f, peak amplitude in U)
-welch_psd(x, fs, *, window, nperseg, noverlap, axis)    -- (f, PSD in U**2/Hz)
-cepstral_prewhitening(x, *, axis=-1)                    -- whitened signal (dimensionless)
-bandpass(x, fs, *, band, axis=-1)                       -- ideal FFT band-pass
-squared_envelope(x, fs, *, band, prewhiten, axis)       -- |analytic(x)|**2 in U**2
-squared_envelope_spectrum(x, fs, *, window, band, prewhiten, fmax, axis) -- (f, SES in U**2)
-fast_kurtogram(x, fs, *, nlevel, min_bandwidth, fmin)   -- Kurtogram(kurtosis, levels, frequency, band, level, kurtosis_max)
-envelope_band(x, fs, *, frequency_range, min_bandwidth) -- (band, score): band with the strongest SES line family
-interpolated_peak(X, k, *, method)                      -- fractional bin of a DFT line (Quinn, Jacobsen, Hann)
-shaft_frequency(x, fs, *, window, rpm, ...)             -- (shaft Hz, number of harmonics used): strongest 1x family
-shaft_speed(x, fs, *, bearing, rpm, rpm_source)         -- dict: speed checked against the bearing's fault combs
-tacho_pulses(tacho, fs)                                 -- pulse times of a once-per-rev signal, s
-tacho_speed(pulse_times, *, pulses_per_rev)             -- (mean shaft Hz, per-revolution Hz, variation)
-order_track(x, fs, pulse_times, *, pulses_per_rev)      -- (signal at constant shaft angle, mean shaft Hz)
-enhanced_envelope_spectrum(x, fs, *, alpha_max, nw)     -- (alpha, EES): cyclic spectral coherence averaged over f
-fault_line(f, ses, expected_hz, *, shaft_hz, tolerance, ...) -- dict: measured_hz, snr_db, harmonics, sidebands
-diagnose_ses(f, ses, fault_hz, *, shaft_hz, tolerance)  -- (diagnosis, families): the family rule on one SES
-excitation_period(x, fs, *, frequency_range, band, method) -- (period s, lines or impulses used)
-excitation_duration(x, fs, *, level=0.1, baseline="median", axis=-1) -- (duration s, entry s, exit s) of one pulse
-impulses(x, fs, *, band, threshold, min_separation, level) -- Impulses(time, peak, duration, entry, exit, resolved)
-rms, peak, peak_to_peak, crest_factor, kurtosis, impulse_factor, clearance_factor, shape_factor (x, *, axis)
-metrics(x, *, axis=-1, units="1")                       -- dict of the eight metrics + "units"
-analyze(x, fs, *, bearing, rpm, rpm_source, shaft_hz, tacho, ...) -- dict: speed, graded verdict and evidence (docs/analysis.md)
-plot_analysis(x, fs, *, bearing, ..., path)             -- (figure, result): waveform, spectrum, SES with markers
-xr                                                      -- xarray wrappers of the above (apply_ufunc, dask-friendly)
+::
+
+    amplitude_spectrum(x, fs, *, window, axis=-1)           -- (f, peak amplitude in U)
+    welch_psd(x, fs, *, window, nperseg, noverlap, axis)    -- (f, PSD in U**2/Hz)
+    cepstral_prewhitening(x, *, axis=-1)                    -- whitened signal (dimensionless)
+    bandpass(x, fs, *, band, axis=-1)                       -- ideal FFT band-pass
+    squared_envelope(x, fs, *, band, prewhiten, axis)       -- |analytic(x)|**2 in U**2
+    squared_envelope_spectrum(x, fs, *, window, band, prewhiten, fmax, axis) -- (f, SES in U**2)
+    fast_kurtogram(x, fs, *, nlevel, min_bandwidth, fmin)   -- Kurtogram(kurtosis, levels, frequency, band, level, kurtosis_max)
+    envelope_band(x, fs, *, frequency_range, min_bandwidth) -- (band, score): band with the strongest SES line family
+    interpolated_peak(X, k, *, method)                      -- fractional bin of a DFT line (Quinn, Jacobsen, Hann)
+    shaft_frequency(x, fs, *, window, rpm, ...)             -- (shaft Hz, number of harmonics used): strongest 1x family
+    shaft_speed(x, fs, *, bearing, rpm, rpm_source)         -- dict: speed checked against the bearing's fault combs
+    tacho_pulses(tacho, fs)                                 -- pulse times of a once-per-rev signal, s
+    tacho_speed(pulse_times, *, pulses_per_rev)             -- (mean shaft Hz, per-revolution Hz, variation)
+    order_track(x, fs, pulse_times, *, pulses_per_rev)      -- (signal at constant shaft angle, mean shaft Hz)
+    enhanced_envelope_spectrum(x, fs, *, alpha_max, nw)     -- (alpha, EES): cyclic spectral coherence averaged over f
+    fault_line(f, ses, expected_hz, *, shaft_hz, tolerance, ...) -- dict: measured_hz, snr_db, harmonics, sidebands
+    diagnose_ses(f, ses, fault_hz, *, shaft_hz, tolerance)  -- (diagnosis, families): the family rule on one SES
+    excitation_period(x, fs, *, frequency_range, band, method) -- (period s, lines or impulses used)
+    excitation_duration(x, fs, *, level=0.1, baseline="median", axis=-1) -- (duration s, entry s, exit s) of one pulse
+    impulses(x, fs, *, band, threshold, min_separation, level) -- Impulses(time, peak, duration, entry, exit, resolved)
+    rms, peak, peak_to_peak, crest_factor, kurtosis, impulse_factor, clearance_factor, shape_factor (x, *, axis)
+    metrics(x, *, axis=-1, units="1")                       -- dict of the eight metrics + "units"
+    analyze(x, fs, *, bearing, rpm, rpm_source, shaft_hz, tacho, ...) -- dict: speed, graded verdict and evidence (docs/analysis.md)
+    plot_analysis(x, fs, *, bearing, ..., path)             -- (figure, result): waveform, spectrum, SES with markers
+    xr                                                      -- xarray wrappers of the above (apply_ufunc, dask-friendly)
 """
 from ._spectral import (amplitude_spectrum, bandpass, cepstral_prewhitening, envelope_band,  # noqa: F401
                         fast_kurtogram, Kurtogram, squared_envelope, squared_envelope_spectrum, welch_psd)

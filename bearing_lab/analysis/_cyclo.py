@@ -29,6 +29,7 @@ import functools
 import numpy as np
 from scipy import fft as _fft
 
+from .._docdict import fill_doc
 from ..errors import AnalysisError
 from ._util import check_fs, check_signal
 
@@ -44,6 +45,7 @@ def _window_response(nw, oversample=64):
     return g
 
 
+@fill_doc
 def enhanced_envelope_spectrum(x, fs, *, alpha_max, nw=None):
     """Enhanced envelope spectrum: cyclic spectral coherence averaged over frequency.
 
@@ -51,8 +53,7 @@ def enhanced_envelope_spectrum(x, fs, *, alpha_max, nw=None):
     ----------
     x : array_like, 1-D
         Signal (any unit).
-    fs : float
-        Sampling rate, Hz.
+    %(fs)s
     alpha_max : float
         Highest cyclic frequency wanted, Hz (below fs / 4).
     nw : int, optional

@@ -31,6 +31,7 @@ from collections import namedtuple
 
 import numpy as np
 
+from .._docdict import fill_doc
 from ..errors import AnalysisError, check_choice
 from ._spectral import envelope_band, fast_kurtogram, squared_envelope
 from ._speed import harmonic_family
@@ -57,11 +58,18 @@ HARMONIC_WEIGHT = 2
 Impulses = namedtuple("Impulses", ["time", "peak", "duration", "entry", "exit", "resolved"])
 Impulses.__doc__ = """Result of :func:`impulses`: one entry per impulse (1-D arrays).
 
-time : instant of the envelope maximum, s (parabolic sub-sample interpolation).
-peak : largest |x| of the impulse (sampled peak, baseline removed), unit of x.
-duration : excitation duration, s (module docstring).
-entry, exit : the level crossings that bound it, s.
-resolved : duration spans at least two sample intervals.
+Attributes
+----------
+time : ndarray
+    Instant of the envelope maximum, s (parabolic sub-sample interpolation).
+peak : ndarray
+    Largest ``|x|`` of the impulse (sampled peak, baseline removed), unit of x.
+duration : ndarray
+    Excitation duration, s (module docstring).
+entry, exit : ndarray
+    The level crossings that bound it, s.
+resolved : ndarray of bool
+    Duration spans at least two sample intervals.
 """
 
 
@@ -85,6 +93,7 @@ def _duration_1d(y, fs, level, baseline=None):
     return (t1 - t0) / fs, t0 / fs, t1 / fs
 
 
+@fill_doc
 def excitation_duration(x, fs, *, level=0.1, baseline="median", axis=-1):
     """Excitation duration of one pulse (e.g. one defect passage), with entry and exit times.
 
@@ -106,8 +115,7 @@ def excitation_duration(x, fs, *, level=0.1, baseline="median", axis=-1):
     x : array_like
         One pulse per signal (displacement, acceleration, force, ...), with
         quiet margins before and after it.
-    fs : float
-        Sampling rate, Hz.
+    %(fs)s
     level : float
         Crossing level relative to the peak, 0 < level < 1 (default 0.1, -20 dB).
     baseline : "median", "first" or float
@@ -168,6 +176,7 @@ def _band_arg(x, fs, band, func, min_bandwidth=None, frequency_range=None):
     return band
 
 
+@fill_doc
 def impulses(x, fs, *, band=None, threshold=None, min_separation=1e-3, level=0.1):
     """Detect and segment impulses: time, peak, excitation duration, entry and exit.
 
@@ -182,8 +191,7 @@ def impulses(x, fs, *, band=None, threshold=None, min_separation=1e-3, level=0.1
     ----------
     x : array_like, 1-D
         Signal.
-    fs : float
-        Sampling rate, Hz.
+    %(fs)s
     band : None, (low, high) or "kurtogram"
         Band-pass before detection and measurement (None: whole band).
     threshold : float, optional
@@ -267,6 +275,7 @@ def impulses(x, fs, *, band=None, threshold=None, min_separation=1e-3, level=0.1
                       for k in Impulses._fields))
 
 
+@fill_doc
 def excitation_period(x, fs, *, frequency_range, band=None, method="ses", n_harmonics=10):
     """Mean interval between impacts, with sub-sample precision.
 
@@ -274,8 +283,7 @@ def excitation_period(x, fs, *, frequency_range, band=None, method="ses", n_harm
     ----------
     x : array_like, 1-D
         Signal (several tens of impacts or more).
-    fs : float
-        Sampling rate, Hz.
+    %(fs)s
     frequency_range : (float, float)
         Range of the impact rate to search, Hz (e.g. the slip window around a
         fault frequency, or a wide range such as (5, 500)).

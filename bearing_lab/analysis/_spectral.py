@@ -24,6 +24,7 @@ import numpy as np
 from scipy import fft as _fft
 from scipy import signal as _sig
 
+from .._docdict import fill_doc
 from ..errors import AnalysisError
 from ._util import check_band, check_fs, check_signal, get_window
 
@@ -31,6 +32,7 @@ __all__ = ["amplitude_spectrum", "welch_psd", "cepstral_prewhitening", "bandpass
            "squared_envelope", "squared_envelope_spectrum", "fast_kurtogram", "Kurtogram"]
 
 
+@fill_doc
 def amplitude_spectrum(x, fs, *, window, axis=-1):
     """One-sided amplitude spectrum on a physical (peak) scale.
 
@@ -41,8 +43,7 @@ def amplitude_spectrum(x, fs, *, window, axis=-1):
     ----------
     x : array_like
         Signal, in any unit U.
-    fs : float
-        Sampling rate, Hz.
+    %(fs)s
     window : str, tuple or array_like
         Window applied before the DFT (``scipy.signal.get_window`` name or an
         array of length ``x.shape[axis]``).  Required: use ``"boxcar"`` for none.
@@ -82,6 +83,7 @@ def amplitude_spectrum(x, fs, *, window, axis=-1):
     return np.fft.rfftfreq(n, 1.0 / fs), np.moveaxis(spec, -1, axis)
 
 
+@fill_doc
 def welch_psd(x, fs, *, window, nperseg, noverlap=None, axis=-1):
     """Power spectral density by Welch's method, in U**2/Hz (one-sided).
 
@@ -92,8 +94,7 @@ def welch_psd(x, fs, *, window, nperseg, noverlap=None, axis=-1):
     ----------
     x : array_like
         Signal in U.
-    fs : float
-        Sampling rate, Hz.
+    %(fs)s
     window : str, tuple or array_like
         Segment window (required).
     nperseg : int
@@ -200,6 +201,7 @@ def _analytic_band(x, fs, band, nfft):
     return _fft.ifft(Z, axis=-1, workers=1)[..., : x.shape[-1]]
 
 
+@fill_doc
 def bandpass(x, fs, *, band, axis=-1):
     """Ideal (brick-wall) band-pass filter applied to the DFT of the whole record.
 
@@ -207,8 +209,7 @@ def bandpass(x, fs, *, band, axis=-1):
     ----------
     x : array_like
         Signal in U.
-    fs : float
-        Sampling rate, Hz.
+    %(fs)s
     band : (float, float)
         Pass band (low, high) in Hz, inclusive.
     axis : int
@@ -235,6 +236,7 @@ def bandpass(x, fs, *, band, axis=-1):
     return np.moveaxis(_analytic_band(xm, fs, band, xm.shape[-1]).real, -1, axis)
 
 
+@fill_doc
 def squared_envelope(x, fs, *, band=None, prewhiten=False, axis=-1):
     """Squared envelope ``|x_a(t)|**2`` of the (band-passed) analytic signal, in U**2.
 
@@ -242,8 +244,7 @@ def squared_envelope(x, fs, *, band=None, prewhiten=False, axis=-1):
     ----------
     x : array_like
         Signal in U.
-    fs : float
-        Sampling rate, Hz.
+    %(fs)s
     band : (float, float), optional
         Demodulation band in Hz (ideal filter); None keeps (0, fs/2].
     prewhiten : bool
@@ -278,6 +279,7 @@ def squared_envelope(x, fs, *, band=None, prewhiten=False, axis=-1):
     return np.moveaxis(z.real ** 2 + z.imag ** 2, -1, axis)
 
 
+@fill_doc
 def squared_envelope_spectrum(x, fs, *, window, band=None, prewhiten=False, fmax=None, axis=-1):
     """Squared envelope spectrum (SES): amplitude spectrum of the squared envelope.
 
@@ -292,8 +294,7 @@ def squared_envelope_spectrum(x, fs, *, window, band=None, prewhiten=False, fmax
     ----------
     x : array_like
         Signal in U.
-    fs : float
-        Sampling rate, Hz.
+    %(fs)s
     window : str, tuple or array_like
         Window for the squared envelope's DFT (required; ``"boxcar"`` for none,
         which is what interpolated line estimates expect).
@@ -350,14 +351,21 @@ def squared_envelope_spectrum(x, fs, *, window, band=None, prewhiten=False, fmax
 Kurtogram = namedtuple("Kurtogram", ["kurtosis", "levels", "frequency", "band", "level", "kurtosis_max"])
 Kurtogram.__doc__ = """Result of :func:`fast_kurtogram`.
 
-kurtosis : 2-D array (level, frequency); each cell's spectral kurtosis (excess,
-    0 for Gaussian noise) repeated over the finest frequency grid; NaN where a
-    level was not computed (narrower than ``min_bandwidth``).
-levels : 1-D array of level numbers 0, 1, 1.6, 2, 2.6, ... (band width fs/2**(level+1)).
-frequency : 1-D array, centre of each grid column, Hz.
-band : (low, high) of the cell with the largest kurtosis, Hz.
-level : level of that cell.
-kurtosis_max : its spectral kurtosis.
+Attributes
+----------
+kurtosis : 2-D array (level, frequency)
+    Each cell's spectral kurtosis (excess, 0 for Gaussian noise) repeated over the finest
+    frequency grid; NaN where a level was not computed (narrower than ``min_bandwidth``).
+levels : 1-D array
+    Level numbers 0, 1, 1.6, 2, 2.6, ... (band width fs/2**(level+1)).
+frequency : 1-D array
+    Centre of each grid column, Hz.
+band : (low, high)
+    The cell with the largest kurtosis, Hz.
+level : float
+    Level of that cell.
+kurtosis_max : float
+    Its spectral kurtosis.
 """
 
 
@@ -373,6 +381,7 @@ def _level_bands(nlevel):
     return layout
 
 
+@fill_doc
 def fast_kurtogram(x, fs, *, nlevel=None, min_bandwidth=None, fmin=0.0):
     """Fast kurtogram: spectral kurtosis over a 1/3-binary tree of frequency bands.
 
@@ -392,8 +401,7 @@ def fast_kurtogram(x, fs, *, nlevel=None, min_bandwidth=None, fmin=0.0):
     ----------
     x : array_like, 1-D
         Signal (any unit).
-    fs : float
-        Sampling rate, Hz.
+    %(fs)s
     nlevel : int, optional
         Deepest level.  Default ``floor(log2(len(x))) - 7`` (Antoni's rule: the
         narrowest band keeps at least ~64 complex samples), at most 10.
@@ -482,6 +490,7 @@ def fast_kurtogram(x, fs, *, nlevel=None, min_bandwidth=None, fmin=0.0):
     return Kurtogram(grid, np.array([lv for lv, _ in layout]), freq, best[2], best[1], best[0])
 
 
+@fill_doc
 def envelope_band(x, fs, *, frequency_range, min_bandwidth=None, nlevel=None, n_harmonics=3):
     """Demodulation band chosen by the strength of a line family in its SES.
 
@@ -501,8 +510,7 @@ def envelope_band(x, fs, *, frequency_range, min_bandwidth=None, nlevel=None, n_
     ----------
     x : array_like, 1-D
         Signal.
-    fs : float
-        Sampling rate, Hz.
+    %(fs)s
     frequency_range : (float, float)
         Where the fundamental (impact rate) may lie, Hz.
     min_bandwidth : float, optional

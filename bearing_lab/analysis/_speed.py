@@ -26,6 +26,7 @@ import numpy as np
 from scipy import fft as _fft
 from scipy.ndimage import median_filter
 
+from .._docdict import fill_doc
 from ..errors import AnalysisError
 from ._util import check_fs, check_signal
 
@@ -123,6 +124,7 @@ def _method_for(window):
                         f"(Quinn's estimator) and 'hann', but got {window!r} instead.")
 
 
+@fill_doc
 def shaft_frequency(x, fs, *, window, rpm=None, prior_tolerance=0.05, fmin=5.0, fmax=100.0,
                     n_harmonics=20, mains_hz=(50.0, 60.0)):
     """Shaft (rotation) frequency from a vibration signal, without a tachometer.
@@ -131,8 +133,7 @@ def shaft_frequency(x, fs, *, window, rpm=None, prior_tolerance=0.05, fmin=5.0, 
     ----------
     x : array_like, 1-D
         Vibration signal (any unit), ideally several seconds long.
-    fs : float
-        Sampling rate, Hz.
+    %(fs)s
     window : {"boxcar", "hann"}
         Window of the DFT used for the search and the interpolation
         (``"boxcar"``: Quinn's estimator, best for an isolated line;

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._docdict import fill_doc
 from ..errors import AnalysisError
 from ._util import check_fs, check_signal
 
@@ -34,6 +35,7 @@ ORDER_TRACK_VARIATION = 0.004
 SMOOTH_REVS = 8
 
 
+@fill_doc
 def tacho_pulses(tacho, fs):
     """Times of the pulses of a tachometer signal, s.
 
@@ -41,8 +43,7 @@ def tacho_pulses(tacho, fs):
     ----------
     tacho : array_like, 1-D
         Tacho signal (any unit), pulses going up.
-    fs : float
-        Sampling rate, Hz.
+    %(fs)s
 
     Returns
     -------
@@ -124,6 +125,7 @@ def tacho_speed(pulse_times, *, pulses_per_rev=1):
     return float(shaft), per_rev, float(np.ptp(smooth) / shaft)
 
 
+@fill_doc
 def order_track(x, fs, pulse_times, *, pulses_per_rev=1):
     """Resample a signal at constant shaft angle (computed order tracking).
 
@@ -131,8 +133,7 @@ def order_track(x, fs, pulse_times, *, pulses_per_rev=1):
     ----------
     x : array_like, 1-D
         Signal sampled at ``fs``.
-    fs : float
-        Sampling rate, Hz.
+    %(fs)s
     pulse_times : array_like
         Tacho pulse times, s.
     pulses_per_rev : int

@@ -45,6 +45,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._docdict import fill_doc
 from ..errors import AnalysisError
 from .impacts import between_impacts
 
@@ -190,6 +191,7 @@ def _gated_psd(y, fs, mask):
     return np.fft.rfftfreq(m, 1 / fs), p
 
 
+@fill_doc
 def estimate_background(x, fs, *, times=None, period=None, exclude_hz=(), shaft_hz=None, max_tones=20,
                         tone_snr_db=15.0, source="", model=None, model_times=None) -> Background:
     """Measure the non-impulsive background of a recording (module docstring).
@@ -198,8 +200,7 @@ def estimate_background(x, fs, *, times=None, period=None, exclude_hz=(), shaft_
     ----------
     x : array_like, 1-D
         Acceleration, m s-2.
-    fs : float
-        Sampling rate, Hz.
+    %(fs)s
     times, period : array_like and float, optional
         Impact times (s) and period (s): the broadband part is then measured between impacts.
     exclude_hz : sequence of float

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._docdict import fill_doc
 from ..errors import AnalysisError
 
 __all__ = ["impact_times", "impulse_strength", "impact_peaks", "impact_segments", "mean_envelope",
@@ -34,6 +35,7 @@ def _envelope(x, fs, band=None):
     return np.abs(hilbert(y))
 
 
+@fill_doc
 def impact_times(x, fs, period, *, band=None, start=None):
     """Impact instants: the envelope maximum in each window of one period.
 
@@ -45,8 +47,7 @@ def impact_times(x, fs, period, *, band=None, start=None):
     ----------
     x : array_like, 1-D
         Signal.
-    fs : float
-        Sampling rate, Hz.
+    %(fs)s
     period : float
         Impact period, s (e.g. 1 / BPFO).
     band : (float, float), optional

@@ -17,6 +17,7 @@ import math
 
 import numpy as np
 
+from .._docdict import fill_doc
 from ..errors import AnalysisError
 from .impacts import impact_times, impulse_strength
 
@@ -101,6 +102,7 @@ def _fault_families(res, out, notes) -> dict:
     return families
 
 
+@fill_doc
 def measure(x, fs, *, bearing, rpm=None, shaft_hz=None, fault=None, duration_level=0.1):
     """The quantities of a validation table for one signal, measured the same way for recording
     and simulation.
@@ -109,8 +111,7 @@ def measure(x, fs, *, bearing, rpm=None, shaft_hz=None, fault=None, duration_lev
     ----------
     x : array_like, 1-D
         Acceleration, m s-2.
-    fs : float
-        Sampling rate, Hz.
+    %(fs)s
     bearing : str or BearingGeometry
         Catalog name or geometry.
     rpm : float, optional

@@ -36,6 +36,7 @@ import warnings
 
 import numpy as np
 
+from .._docdict import fill_doc
 from ..bearings import BearingGeometry, get_bearing
 from ..errors import AnalysisError, BearingLabError, check_choice
 from ._diagnosis import (coincidences, combine, deciding_route, interpretations, line_stats, route_summary,
@@ -291,6 +292,7 @@ def _unresolved(speed, geom, fs, n, m, tolerance, n_harmonics):
     return result, extras
 
 
+@fill_doc
 def shaft_speed(x, fs, *, bearing, rpm=None, rpm_source="given", tolerance=0.02, n_harmonics=5,
                 units="m s-2"):
     """Shaft speed of a vibration signal, checked against the bearing's kinematics.
@@ -302,8 +304,7 @@ def shaft_speed(x, fs, *, bearing, rpm=None, rpm_source="given", tolerance=0.02,
     Parameters
     ----------
     x : array_like, 1-D
-    fs : float
-        Sampling rate, Hz.
+    %(fs)s
     bearing : str or BearingGeometry
     rpm : float, optional
         Prior speed, r/min (None: blind).
@@ -345,6 +346,7 @@ def shaft_speed(x, fs, *, bearing, rpm=None, rpm_source="given", tolerance=0.02,
     return sp
 
 
+@fill_doc
 def analyze(x, fs, *, bearing, rpm=None, shaft_hz=None, channel="", units="m s-2", tolerance=0.02,
             n_harmonics=5, prewhiten=False, rpm_source="given", tacho=None, pulses_per_rev=1):
     """Analyse one vibration channel: metrics, shaft speed, fault families and a graded diagnosis.
@@ -353,8 +355,7 @@ def analyze(x, fs, *, bearing, rpm=None, shaft_hz=None, channel="", units="m s-2
     ----------
     x : array_like, 1-D
         Acceleration (or any vibration signal), in ``units``.
-    fs : float
-        Sampling rate, Hz.
+    %(fs)s
     bearing : str or BearingGeometry
         Catalog name (``"6205"``, ``"ZA-2115"``, ``"MFPT"``, ...) or geometry.
     rpm : float, optional
@@ -396,6 +397,12 @@ def analyze(x, fs, *, bearing, rpm=None, shaft_hz=None, channel="", units="m s-2
         "uncertain", "no fault evidence") and ``evidence`` (candidates,
         runner-up and margin, demodulation band and its spectral kurtosis, each
         route's families, flags).  ``docs/analysis.md`` describes every field.
+
+    See Also
+    --------
+    plot_analysis : the same analysis as a figure.
+    shaft_speed : the speed step alone.
+    bearing_lab.io.open_recording, bearing_lab.sim.simulate : signals to analyse.
 
     Notes
     -----

@@ -2,16 +2,18 @@
 
 Public API
 ----------
-open_recording(path, format=None, **options) -- file -> xarray.Dataset (format sniffed from content)
-list_engines()                                -- {name: description} of the readers, and what each needs
-to_netcdf(ds, path)                           -- compressed, lossless netCDF4
-to_uff58b(ds, path, channels=None, ...)       -- UFF 58b (binary) for Testlab and other tools
-get_warnings(ds)                              -- the recording's warnings as a list
-ENGINES                                       -- name -> reader class, in sniffing order (SNIFF_ORDER,
-                                                 then the entry-point group "bearing_lab.readers",
-                                                 then FALLBACK_READERS)
-RecordingReader                               -- base class of the readers
-RecordingWarning                              -- category of the non-fatal warnings
+::
+
+    open_recording(path, format=None, **options) -- file -> xarray.Dataset (format sniffed from content)
+    list_engines()                                -- {name: description} of the readers, and what each needs
+    to_netcdf(ds, path)                           -- compressed, lossless netCDF4
+    to_uff58b(ds, path, channels=None, ...)       -- UFF 58b (binary) for Testlab and other tools
+    get_warnings(ds)                              -- the recording's warnings as a list
+    ENGINES                                       -- name -> reader class, in sniffing order (SNIFF_ORDER,
+                                                     then the entry-point group "bearing_lab.readers",
+                                                     then FALLBACK_READERS)
+    RecordingReader                               -- base class of the readers
+    RecordingWarning                              -- category of the non-fatal warnings
 
 Options every reader understands: ``channels``, ``units`` (label or channel ->
 label, for unknown or missing unit labels), ``checksum``; most also take ``fs``
@@ -86,6 +88,10 @@ def list_engines() -> dict[str, str]:
     """Return ``{name: description}`` for every registered reader.
 
     A reader whose optional library is missing says what to install.
+
+    See Also
+    --------
+    open_recording
 
     Examples
     --------
@@ -215,6 +221,12 @@ def open_recording(path, format=None, **options):
     ------
     RecordingError
         For any unreadable, corrupt or ambiguous input; the message names the file.
+
+    See Also
+    --------
+    list_engines : the readers and the options each takes.
+    to_netcdf, to_uff58b : write a Dataset.
+    bearing_lab.analysis.analyze : analyse a channel.
 
     Examples
     --------

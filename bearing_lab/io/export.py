@@ -81,6 +81,10 @@ def to_netcdf(ds, path, *, complevel: int = 4, checksum_file: bool = False, erro
     -------
     Path
 
+    See Also
+    --------
+    to_uff58b, open_recording
+
     Examples
     --------
     >>> to_netcdf(ds, "out.nc")   # doctest: +SKIP
@@ -169,6 +173,10 @@ def to_uff58b(ds, path, *, channels=None, units: str = "si", id1=None, id2=None,
     Returns
     -------
     Path
+
+    See Also
+    --------
+    to_netcdf, open_recording
 
     Notes
     -----

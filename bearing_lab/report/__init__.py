@@ -9,17 +9,19 @@ switches the plotting backend); provenance and the citation are report methods.
 
 Public API
 ----------
-Report(title, *, subtitle="")                         -- one page
-Report.add_rows(rows, title, *, show_reference, show_paper, intro) -- the validation table
-Report.add_comparison(result, title, *, figures=True)  -- a ComparisonResult's table (+ figures)
-Report.add_figure(fig, title, *, caption) / add_figures([(fig, caption)], title)
-Report.add_table(rows, title, *, columns, intro)       -- a list of dicts as a table
-Report.add_html(html, title) / add_notice(heading, body, level=)
-Report.add_provenance(info=None, *, software=True)     -- inputs, checksums, versions, revision, host, date
-Report.add_citation()                                  -- how to cite (software version, the paper)
-Report.save(path) / Report.load(path)                  -- ".html" (self-contained) or ".json"
-write_index(path, entries, *, title, notes)            -- the page listing all cases
-rows_table(rows), table_html(rows), figure_png(fig), fmt(v), esc(text) -- the HTML pieces
+::
+
+    Report(title, *, subtitle="")                         -- one page
+    Report.add_rows(rows, title, *, show_reference, show_paper, intro) -- the validation table
+    Report.add_comparison(result, title, *, figures=True)  -- a ComparisonResult's table (+ figures)
+    Report.add_figure(fig, title, *, caption) / add_figures([(fig, caption)], title)
+    Report.add_table(rows, title, *, columns, intro)       -- a list of dicts as a table
+    Report.add_html(html, title) / add_notice(heading, body, level=)
+    Report.add_provenance(info=None, *, software=True)     -- inputs, checksums, versions, revision, host, date
+    Report.add_citation()                                  -- how to cite (software version, the paper)
+    Report.save(path) / Report.load(path)                  -- ".html" (self-contained) or ".json"
+    write_index(path, entries, *, title, notes)            -- the page listing all cases
+    rows_table(rows), table_html(rows), figure_png(fig), fmt(v), esc(text) -- the HTML pieces
 """
 from ..utils.figures import figure_png  # noqa: F401
 from .html import esc, fmt, rows_table, table_html  # noqa: F401

@@ -14,6 +14,7 @@ import re
 from pathlib import Path
 from string import Template
 
+from .._docdict import fill_doc
 from ..utils.figures import figure_png
 
 __all__ = ["template", "css", "esc", "fmt", "figure_html", "table_html", "rows_table",
@@ -31,11 +32,39 @@ def css() -> str:
 
 
 def esc(text) -> str:
+    """``text`` (any object, as ``str``) escaped for HTML, quotes included.
+
+    See Also
+    --------
+    fmt : a number for a table cell.
+
+    Examples
+    --------
+    >>> esc('<b>"6308" & 6205</b>')
+    '&lt;b&gt;&quot;6308&quot; &amp; 6205&lt;/b&gt;'
+    """
     return html.escape(str(text), quote=True)
 
 
 def fmt(v, digits=5) -> str:
-    """A number for a table: NaN / None as an em dash, otherwise ``digits`` significant digits."""
+    """A number for a table: NaN / None as an em dash, otherwise ``digits`` significant digits.
+
+    Parameters
+    ----------
+    v : number, bool, None or other
+        A bool gives "yes"/"no"; what is not a number is escaped (:func:`esc`).
+    digits : int
+        Significant digits.
+
+    See Also
+    --------
+    table_html, esc
+
+    Examples
+    --------
+    >>> fmt(92.1875), fmt(float("nan")), fmt(None), fmt(True)
+    ('92.188', '—', '—', 'yes')
+    """
     if v is None:
         return "—"
     if isinstance(v, bool):
@@ -65,7 +94,35 @@ def _cell(v) -> str:
 
 
 def table_html(rows: list, *, columns=None, intro="", row_class=None) -> str:
-    """A list of dicts as a table (numbers right-aligned with 5 significant digits)."""
+    """A list of dicts as a table (numbers right-aligned with 5 significant digits).
+
+    Parameters
+    ----------
+    rows : list of dict
+        One dict per row; missing keys give empty cells.
+    columns : list of str, optional
+        Column keys in order (default: the first row's keys).
+    intro : str
+        A paragraph above the table (escaped).
+    row_class : callable, optional
+        ``row -> CSS class`` of the row.
+
+    Returns
+    -------
+    str
+        HTML (the ``table.html`` template).
+
+    See Also
+    --------
+    rows_table : the validation table.
+    Report.add_table : adds one to a page.
+
+    Examples
+    --------
+    >>> html = table_html([{"quantity": "BPFO", "value": 92.1875}])
+    >>> '<th class="l">quantity</th>' in html, "92.188" in html
+    (True, True)
+    """
     if not rows:
         return (f"<p>{esc(intro)}</p>" if intro else "") + "<p>(no rows)</p>"
     columns = columns or list(rows[0])
@@ -89,8 +146,37 @@ def _shorten(text, n=120) -> str:
 _STATUS = {"pass": ("pass", "pass"), "known limitation": ("known", "known limitation"), "fail": ("fail", "FAIL")}
 
 
+@fill_doc
 def rows_table(rows: list, *, show_reference=False, show_paper=False, intro="") -> str:
-    """The validation table: quantity, simulation, experiment, difference, tolerance, status, reason."""
+    """The validation table: quantity, simulation, experiment, difference, tolerance, status, reason.
+
+    Parameters
+    ----------
+    %(rows)s
+    show_reference : bool
+        Add the column of a reference value (not the experiment).
+    show_paper : bool
+        Add the column of the paper's own simulation.
+    intro : str
+        A paragraph above the table (escaped).
+
+    Returns
+    -------
+    str
+        HTML; a failing row is marked FAIL, a failing declared limitation "known limitation".
+
+    See Also
+    --------
+    bearing_lab.validation.make_row, Report.add_rows, table_html
+
+    Examples
+    --------
+    >>> from bearing_lab.validation import Tolerance, make_row
+    >>> tol = Tolerance("pct", 1.0, reason="kinematic frequencies hold to 1-2 % under slip")
+    >>> html = rows_table([make_row("bpfo", 95.0, 92.19, tol, label="BPFO", units="Hz")])
+    >>> "FAIL" in html                      # 3 % off against a 1 % tolerance
+    True
+    """
     head = ["quantity", "units", "simulation", "experiment"]
     if show_reference:
         head.append("reference (not the experiment)")

@@ -32,7 +32,32 @@ class Report:
     """One page: sections added in order (MNE's ``Report`` style), saved as self-contained HTML.
 
     Figures are matplotlib :class:`~matplotlib.figure.Figure` objects (no backend is switched),
-    embedded as PNG.  ``rows`` collects the validation rows added with :meth:`add_rows`.
+    embedded as PNG.  ``rows`` collects the validation rows added with :meth:`add_rows`.  Every
+    ``add_*`` method returns the report, so calls chain.
+
+    Parameters
+    ----------
+    title : str
+        The page's heading.
+    subtitle : str
+        A line under it.
+
+    See Also
+    --------
+    write_index : the page listing several reports.
+    bearing_lab.validation.run_case : writes one per case.
+
+    Examples
+    --------
+    >>> from bearing_lab.validation import Tolerance, make_row
+    >>> tol = Tolerance("pct", 1.0, reason="kinematic frequencies hold to 1-2 % under slip")
+    >>> report = Report("Rig 3, outer race").add_rows([make_row("bpfo", 91.5, 92.19, tol, label="BPFO",
+    ...                                                          units="Hz")])
+    >>> report.status()
+    ('pass', 'PASS: every row agrees')
+    >>> path = report.save("rig3.html")
+    >>> Report.load(report.save("rig3.json")).rows[0]["label"]
+    'BPFO'
     """
 
     def __init__(self, title: str, *, subtitle: str = ""):
@@ -162,12 +187,35 @@ class Report:
 
 
 def write_index(path, entries: list, *, title="bearing_lab validation", notes=(), opening=""):
-    """The page listing all cases.
+    """The page listing all cases, written atomically; returns its path.
 
-    ``entries``: dicts with ``case``, ``title``, ``status`` ("pass", "fail", "skip", "error"),
-    ``n_pass``, ``n_rows``, ``wall_time_s``, ``failing`` and ``known`` (row labels), ``link``
-    (relative, or None), ``reason`` (for skipped or errored cases); optionally ``verdict``,
-    ``verdict_text`` and ``declared_by``.  ``opening``: HTML shown above the table.
+    Parameters
+    ----------
+    path : str or path
+        The ``.html`` file to write (its folder is created).
+    entries : list of dict
+        ``case``, ``title``, ``status`` ("pass", "fail", "skip", "error"), ``n_pass``, ``n_rows``,
+        ``wall_time_s``, ``failing`` and ``known`` (row labels), ``link`` (relative, or None),
+        ``reason`` (for skipped or errored cases); optionally ``verdict``, ``verdict_text`` and
+        ``declared_by``.
+    title : str
+        The page's heading.
+    notes : sequence of str
+        Paragraphs under the table (escaped).
+    opening : str
+        HTML shown above the table.
+
+    See Also
+    --------
+    Report, bearing_lab.validation.run_validation
+
+    Examples
+    --------
+    >>> p = write_index("reports/index.html", [
+    ...     {"case": "rig3", "title": "Rig 3, outer race", "status": "pass", "n_pass": 1, "n_rows": 1,
+    ...      "wall_time_s": 12.0, "failing": [], "known": [], "link": "rig3/index.html"}])
+    >>> 'href="rig3/index.html"' in p.read_text(encoding="utf-8")
+    True
     """
     from ..utils._files import atomic_open
     notes_html = "".join(f'<p class="note">{esc(n)}</p>' for n in notes)

@@ -41,6 +41,12 @@ SLOW_RPM = 300.0
 
 @lru_cache(maxsize=1)
 def load_rules() -> dict:
+    """The measured rules, ``{kind: rule}`` from ``auto_rules.toml`` (``{}`` when the file is absent).
+
+    See Also
+    --------
+    resolve : the rule a scene gets.
+    """
     if not RULES_FILE.is_file():
         return {}
     with open(RULES_FILE, "rb") as fh:
@@ -86,7 +92,12 @@ def _track_3d(scene, fid):
 def track_defects(scene, fid=None):
     """(the defects as the scene's contact track meets them, which track): the planar track (groove
     bottom) for a planar scene; for a 3-D scene (axial load or preload) the track at the static
-    contact angles of fidelity ``fid`` (default: the scene's, multibody for "auto")."""
+    contact angles of fidelity ``fid`` (default: the scene's, multibody for "auto").
+
+    See Also
+    --------
+    scene_kind, resolve
+    """
     from .bearing3d import needs_3d
     if not scene.defects or not needs_3d(scene):
         return scene.defects, "planar contact track (groove bottom)"
@@ -95,8 +106,19 @@ def track_defects(scene, fid=None):
 
 
 def scene_kind(scene, defects=None) -> str:
-    """The rule kind; ``defects`` as the contact track meets them (:func:`track_defects`; default:
-    the scene's, on the groove bottom)."""
+    """The rule kind, "healthy", "defect-slow" or "defect" (module docstring); ``defects`` as the
+    contact track meets them (:func:`track_defects`; default: the scene's, on the groove bottom).
+
+    See Also
+    --------
+    resolve, track_defects
+
+    Examples
+    --------
+    >>> from bearing_lab.sim import load_scene
+    >>> scene_kind(load_scene("paper-healthy")), scene_kind(load_scene("paper-slot", speed_rpm=300))
+    ('healthy', 'defect-slow')
+    """
     defects = scene.defects if defects is None else defects
     if all(d.misses_track(scene.bearing, MISS_DELTA, clearance=scene.clearance) for d in defects):
         return "healthy"
@@ -105,7 +127,22 @@ def scene_kind(scene, defects=None) -> str:
 
 def rate_rule(rule: dict, fs: float) -> tuple[dict, str]:
     """(the rule for output rate ``fs`` Hz, how it was chosen) from a kind's rule and its
-    ``by_rate`` bands; the kind's rule itself when it has none."""
+    ``by_rate`` bands; the kind's rule itself when it has none.  Above the highest studied rate the
+    highest band is used and the text says that rate was not studied.
+
+    See Also
+    --------
+    resolve
+
+    Examples
+    --------
+    >>> rule = {"method": "dp54", "by_rate": [{"max_rate_hz": 20e3, "rtol": 1e-4},
+    ...                                       {"max_rate_hz": 100e3, "rtol": 1e-5}]}
+    >>> rate_rule(rule, 50e3)
+    ({'max_rate_hz': 100000.0, 'rtol': 1e-05}, 'measured at 100 kHz output (rule for up to it)')
+    >>> rate_rule(rule, 200e3)[1]
+    'measured at up to 100 kHz output only: the 200 kHz asked for was not studied'
+    """
     bands = sorted(rule.get("by_rate", ()), key=lambda b: b["max_rate_hz"])
     if not bands:
         return rule, "measured at 20 kHz output"
@@ -122,7 +159,31 @@ def resolve(scene) -> dict:
 
     The kind is decided on the contact track the scene runs on (:func:`track_defects`); with
     ``fidelity = "auto"`` the 3-D track is that of the rule's fidelity (decided again on it if the
-    rule's fidelity is not the one first assumed)."""
+    rule's fidelity is not the one first assumed).  A defect the track only grazes gets a
+    ``SceneWarning`` naming the setting to use.
+
+    Parameters
+    ----------
+    scene : Scene
+
+    Returns
+    -------
+    dict
+        ``fidelity``, ``method``, ``rtol``, ``max_step_s``, ``expected_peak_error``, ``kind``,
+        ``reason`` (the rule and how it was measured) and ``track``.
+
+    See Also
+    --------
+    bearing_lab.sim.simulate : uses it for ``"auto"`` settings and records it in the attributes.
+    scene_kind, rate_rule
+
+    Examples
+    --------
+    >>> from bearing_lab.sim import load_scene
+    >>> choice = resolve(load_scene("paper-healthy"))
+    >>> choice["kind"], choice["track"]
+    ('healthy', 'planar contact track (groove bottom)')
+    """
     defects, track = track_defects(scene)
     kind = scene_kind(scene, defects)
     rules = load_rules()

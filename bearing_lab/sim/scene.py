@@ -1,39 +1,32 @@
 """Declarative scenes: what to simulate, in physical units, validated on entry.
 
-A scene is a TOML file (or a dict, or a built-in name) whose keys carry their
-unit in the name (``radial_n``, ``length_mm``, ``stiffness_y_n_m``).  A value may
-also be a string with a unit (``"1 mm"``, ``"1800 rpm"``, ``"150 N"``); it is
-converted, and a unit of the wrong kind is refused.  Unknown keys, wrong types
-and impossible values raise :class:`~bearing_lab.errors.SceneError` naming the
-key and the reason.
+A scene is a TOML file (or a dict, or a built-in name) whose keys carry their unit in the name
+(``radial_n``, ``length_mm``, ``stiffness_y_n_m``). A value may also be a string with a unit (``"1 mm"``,
+``"1800 rpm"``, ``"150 N"``); it is converted, and a unit of the wrong kind is refused. Unknown keys, wrong
+types and impossible values raise :class:`~bearing_lab.errors.SceneError` naming the key and the reason.
 
-Defaults where the paper is silent (each settable; see ``docs`` in
-:data:`SCHEMA`):
+Defaults where the paper is silent (each settable; see ``docs`` in :data:`SCHEMA`):
 
-- steel balls and rings: E = 208 GPa, ν = 0.3, ρ = 7850 kg/m³ (AISI 52100
-  handbook values);
-- groove conformities f_i = 0.52, f_o = 0.53 (Harris & Kotzalas,
-  *Rolling Bearing Analysis*, typical deep-groove values);
-- radial internal clearance 0 (mounted: an interference fit takes most of a C0
-  6308's 6–20 µm, ISO 5753-1);
-- ring masses from the ring envelope (steel annuli between bore / outer
-  diameter and the raceway shoulders), ball mass from D_b and ρ;
-- shaft (inner ring to ground) and mount (outer-ring bushing) stiffness
-  1e8 N/m: the order of the bearing's own linearised radial stiffness
-  (≈1.2e8 N/m near 1 kN from the Hertz
-  constants, and the 13e6·Z^(2/3)·D_b^(1/3)·F^(1/3) rule of thumb), as in lumped rotor–bearing–pedestal
-  models (e.g. Sawalhi & Randall, MSSP 22 (2008) 1924–1951);
-- their damping 1000 N·s/m: ~1e-5 × stiffness, inside the paper's
-  0.25–2.5e-5 rule (its section 2.1, citing Liu & Shao);
-- contact damping c_max = 350 N·s/m (paper) reached at penetration d = 1 µm
-  (not given by the paper; 1 µm is ~10 % of the static deflection, so damping
-  is fully on in a loaded contact and fades smoothly at touch-down);
-- load path "bearing": the support spring of the ring that takes the external
-  load is preloaded (its rest position is the ring's static equilibrium), so the
-  whole load goes through the balls, as in the paper's experiment where the
-  load is applied through the bearing.  ``load.path = "springs"`` leaves both
-  supports unstressed at the nominal centre (most load then bypasses the
-  bearing and amplitudes drop three- to five-fold).
+- steel balls and rings: E = 208 GPa, ν = 0.3, ρ = 7850 kg/m³ (AISI 52100 handbook values);
+- groove conformities f_i = 0.52, f_o = 0.53 (Harris & Kotzalas, *Rolling Bearing Analysis*, typical
+  deep-groove values);
+- radial internal clearance 0 (mounted: an interference fit takes most of a C0 6308's 6–20 µm, ISO 5753-1);
+- ring masses from the ring envelope (steel annuli between bore / outer diameter and the raceway shoulders),
+  ball mass from D_b and ρ;
+- shaft (inner ring to ground) and mount (outer-ring bushing) stiffness 1e8 N/m: the order of the bearing's
+  own linearised radial stiffness (≈1.2e8 N/m near 1 kN from the Hertz constants, and the
+  13e6·Z^(2/3)·D_b^(1/3)·F^(1/3) rule of thumb), as in lumped rotor–bearing–pedestal models (e.g. Sawalhi &
+  Randall, MSSP 22 (2008) 1924–1951);
+- their damping 1000 N·s/m: ~1e-5 × stiffness, inside the paper's 0.25–2.5e-5 rule (its section 2.1, citing
+  Liu & Shao);
+- contact damping c_max = 350 N·s/m (paper) reached at penetration d = 1 µm (not given by the paper; 1 µm is
+  ~10 % of the static deflection, so damping is fully on in a loaded contact and fades smoothly at
+  touch-down);
+- load path "bearing": the support spring of the ring that takes the external load is preloaded (its rest
+  position is the ring's static equilibrium), so the whole load goes through the balls, as in the paper's
+  experiment where the load is applied through the bearing. ``load.path = "springs"`` leaves both supports
+  unstressed at the nominal centre (most load then bypasses the bearing and amplitudes drop three- to
+  five-fold).
 """
 from __future__ import annotations
 
@@ -46,6 +39,7 @@ import tomllib
 
 import numpy as np
 
+from .._docdict import fill_doc
 from ..bearings import BearingGeometry, CATALOG, get_bearing
 from ..errors import SceneError, check_choice
 from ..units import G
@@ -210,8 +204,13 @@ def _validate_mapping(raw: dict) -> dict:
 # ---------------------------------------------------------------- the Scene
 @dataclass(frozen=True)
 class Scene:
-    """A validated scene.  ``data`` holds the user-unit mapping (what TOML shows);
-    the properties give SI values."""
+    """A validated scene: ``data`` holds the user-unit mapping (what TOML shows), the properties
+    SI values; :func:`load_scene` makes one, :meth:`replace` a changed copy.
+
+    See Also
+    --------
+    load_scene, simulate, list_scenes
+    """
 
     data: dict
     bearing: BearingGeometry
@@ -534,7 +533,17 @@ _SCENE_DIR = Path(__file__).with_name("scenes")
 
 
 def list_scenes() -> dict[str, str]:
-    """Built-in scene names with their one-line descriptions."""
+    """Built-in scene names with their one-line descriptions.
+
+    See Also
+    --------
+    load_scene, simulate
+
+    Examples
+    --------
+    >>> list_scenes()["paper-healthy"]
+    'Paper section 4: healthy 6308 at 1800 r/min, 150 N on the outer ring along -Y'
+    """
     out = {}
     for p in sorted(_SCENE_DIR.glob("*.toml")):
         with open(p, "rb") as fh:
@@ -542,11 +551,25 @@ def list_scenes() -> dict[str, str]:
     return out
 
 
+@fill_doc
 def load_scene(scene, **overrides) -> Scene:
-    """Return a :class:`Scene` from a built-in name, a TOML path, a dict or a Scene.
+    """Return a checked :class:`Scene` (nothing is simulated); an unknown scene or key, or a value
+    out of range, raises :class:`~bearing_lab.errors.SceneError` naming the key.
 
-    ``overrides`` use the ``--set`` keys (``speed_rpm``, ``load.radial_n``,
-    ``defect.offset_mm``, ``fidelity`` ...).
+    Parameters
+    ----------
+    %(scene)s
+    %(overrides)s
+
+    See Also
+    --------
+    simulate, list_scenes, Scene.replace
+
+    Examples
+    --------
+    >>> sc = load_scene("paper-healthy", **{"load.radial_n": 480, "clearance.radial_um": "10 um"})
+    >>> sc.data["load"]["radial_n"], sc.nominal_rpm, round(sc.clearance, 12)   # user units; SI: m
+    (480.0, 1800.0, 1e-05)
     """
     if isinstance(scene, Scene):
         return scene.replace(**overrides) if overrides else scene

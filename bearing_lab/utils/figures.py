@@ -33,7 +33,19 @@ def new_figure(figsize=None, *, layout=None, **kwargs):
 
 def figure_png(fig, dpi=80) -> str:
     """Base64 PNG of a matplotlib figure (a pyplot figure is closed afterwards), for an ``<img>``
-    in a self-contained page."""
+    in a self-contained page.
+
+    See Also
+    --------
+    new_figure, bearing_lab.report.Report.add_figure
+
+    Examples
+    --------
+    >>> import base64
+    >>> fig = new_figure(figsize=(2, 1))
+    >>> base64.b64decode(figure_png(fig, dpi=50))[1:4]      # the PNG signature
+    b'PNG'
+    """
     import base64
     import io
     buf = io.BytesIO()

@@ -16,17 +16,19 @@ recordings), :mod:`.newcase` (``bearing-lab case new``).
 
 Public API
 ----------
-load_case(name_or_path)                        -- a checked ValidationCase
-list_cases()                                   -- {name: title} of the shipped cases
-shipped_cases()                                -- {name: Traversable} (package data bearing_lab/validation/cases)
-check_case(case, mirror=None)                  -- raise if a recording is missing
-default_set(mirror=None)                       -- (cases, skipped) of the default set
-run_case(case, out_dir, ...) / run_validation(specs, out_dir, ...)
-QUANTITIES                                     -- the table of quantities
-Tolerance, make_row                            -- pass rules and rows
-make_standin_recording(path, ...)              -- a simulated recording with a hidden defect, jitter,
-                                                  a resonance, tones and noise (UFF58b or Testlab .mat)
-new_case_text(recording_path, ...)             -- the commented starting case `bearing-lab case new` writes
+::
+
+    load_case(name_or_path)                        -- a checked ValidationCase
+    list_cases()                                   -- {name: title} of the shipped cases
+    shipped_cases()                                -- {name: Traversable} (package data bearing_lab/validation/cases)
+    check_case(case, mirror=None)                  -- raise if a recording is missing
+    default_set(mirror=None)                       -- (cases, skipped) of the default set
+    run_case(case, out_dir, ...) / run_validation(specs, out_dir, ...)
+    QUANTITIES                                     -- the table of quantities
+    Tolerance, make_row                            -- pass rules and rows
+    make_standin_recording(path, ...)              -- a simulated recording with a hidden defect, jitter,
+                                                      a resonance, tones and noise (UFF58b or Testlab .mat)
+    new_case_text(recording_path, ...)             -- the commented starting case `bearing-lab case new` writes
 """
 from .case import DEFAULT_CASE, RecordingSpec, ValidationCase, list_cases, load_case, shipped_cases  # noqa: F401
 from .quantities import QUANTITIES, Quantity  # noqa: F401

@@ -104,7 +104,13 @@ def case_error(case, msg):
 
 @dataclass
 class RecordingSpec:
-    """Where a recording is and how to read it."""
+    """Where a recording is and how to read it: the ``[recording]`` (or ``[reference]``) table of a
+    case, keys as in ``docs/case-format.md``.
+
+    See Also
+    --------
+    ValidationCase, bearing_lab.io.open_recording
+    """
 
     file: Path | None = None
     name: str | None = None
@@ -129,7 +135,13 @@ class RecordingSpec:
 
 @dataclass
 class ValidationCase:
-    """A checked case.  ``data`` keeps the TOML mapping, ``text`` the file as written."""
+    """A checked case.  ``data`` keeps the TOML mapping, ``text`` the file as written.
+
+    See Also
+    --------
+    load_case : makes one from a shipped name or a TOML file.
+    run_case : runs it.
+    """
 
     name: str
     title: str
@@ -172,7 +184,19 @@ def _case_dir():
 
 
 def shipped_cases() -> dict:
-    """``{name: Traversable}`` of the cases shipped in ``bearing_lab/validation/cases`` (package data)."""
+    """``{name: Traversable}`` of the cases shipped in ``bearing_lab/validation/cases`` (package data).
+
+    See Also
+    --------
+    list_cases : the same names with their titles.
+    load_case : a shipped case by its name.
+
+    Examples
+    --------
+    >>> cases = shipped_cases()
+    >>> "paper" in cases, cases["paper"].name
+    (True, 'paper.toml')
+    """
     d = _case_dir()
     items = sorted((p for p in d.iterdir() if p.name.endswith(".toml") and not p.name.endswith("_reference.toml")),
                    key=lambda p: p.name)
@@ -180,7 +204,17 @@ def shipped_cases() -> dict:
 
 
 def list_cases() -> dict:
-    """``{name: title}`` of the shipped cases."""
+    """``{name: title}`` of the shipped cases (``bearing-lab validate --list``).
+
+    See Also
+    --------
+    shipped_cases, load_case, default_set
+
+    Examples
+    --------
+    >>> list_cases()["cwru-130"]
+    'CWRU record 130: drive end, outer race 0.007 in at 6:00 (load zone), 0 hp, 12 kHz'
+    """
     return {n: load_case(n).title for n in shipped_cases()}
 
 
@@ -320,12 +354,33 @@ def _read(spec):
 def load_case(spec) -> ValidationCase:
     """Load and check a case: a shipped name (``paper``, ``cwru-130``) or a TOML path.
 
+    Parameters
+    ----------
+    spec : str or path
+        A shipped case's name (:func:`list_cases`) or a case file (``docs/case-format.md``).
+
+    Returns
+    -------
+    ValidationCase
+
     Raises
     ------
     ValidationCaseError
         Unknown case, invalid TOML, an unknown key (named), an invalid value, a tolerance
         without a reason, an invalid scene or scene key.  (A missing recording file is
-        checked by :func:`bearing_lab.validation.runner.check_case`.)
+        checked by :func:`check_case`.)
+
+    See Also
+    --------
+    list_cases, check_case, run_case
+
+    Examples
+    --------
+    >>> case = load_case("paper")
+    >>> case.kind, case.default
+    ('paper', True)
+    >>> case.tolerances["excitation_period"].text()       # every tolerance carries its reason
+    '±0.5 %'
     """
     stem, source, base_dir, text = _read(spec)
     try:

@@ -400,6 +400,10 @@ def identify(case, *, grid=None, refine=True, scheduler="serial", n_workers=None
     ------
     IdentificationInterrupted (a KeyboardInterrupt) when stopped: its ``result`` is the partial
     identification of the scenes done (``partial`` True), or None if none had finished.
+
+    See Also
+    --------
+    bearing_lab.validation.load_case, bearing_lab.validation.make_standin_recording
     """
     from . import load_case
     from .identify_run import Progress

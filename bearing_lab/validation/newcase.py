@@ -134,7 +134,42 @@ def _seconds(v: float) -> str:
 def new_case_text(recording, *, name=None, bearing=None, speed=None, channel=None, fmt=None, case_dir=None) -> str:
     """The text of a starting case for ``recording`` (see the module docstring).
 
-    ``case_dir``: where the case will be written; the recording is then named relative to it.
+    What the file tells (rate, length, channels, speed) is filled in; what it cannot tell (bearing,
+    load, defect) is left commented for the user, with the rows a short record cannot support.
+
+    Parameters
+    ----------
+    recording : str or path
+        The recording file (any format :func:`~bearing_lab.io.open_recording` reads).
+    name : str, optional
+        Case name (default: the file's stem).
+    bearing : str, optional
+        Catalog bearing (``6308``, ``6205`` ...).
+    speed : float, optional
+        Shaft speed, r/min (default: the one the file stores).
+    channel, fmt : str, optional
+        Channel to compare and reader name (default: the file's default channel, sniffed format).
+    case_dir : str or path, optional
+        Where the case will be written; the recording is then named relative to it.
+
+    Returns
+    -------
+    str
+        TOML text; every key is explained in ``docs/case-format.md``.
+
+    See Also
+    --------
+    load_case : reads the case once it is written.
+    make_standin_recording
+
+    Examples
+    --------
+    >>> from bearing_lab.sim import simulate
+    >>> from bearing_lab.io import to_uff58b
+    >>> path = to_uff58b(simulate("paper-healthy", duration=0.05, progress=False), "rig.uff")
+    >>> text = new_case_text("rig.uff", bearing="6308", speed=1800)
+    >>> [line for line in text.splitlines() if line.startswith(("bearing", "speed"))]
+    ['bearing = "6308"', 'speed = 1800.0                 # r/min, given (the file stores no speed)']
     """
     from ..io import open_recording
     path = Path(recording)

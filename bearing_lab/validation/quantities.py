@@ -55,6 +55,18 @@ class Quantity:
     function ``(x, fs, measured_dict) -> float``.  ``path_fit`` marks quantities the
     structural-path fit uses (not independent evidence on the recording the path was fitted on).
     ``ratio`` compares this recording against the case's ``[ratio]`` companion.
+
+    See Also
+    --------
+    QUANTITIES : every quantity by its key.
+    make_row, Tolerance
+
+    Examples
+    --------
+    >>> from bearing_lab.validation import QUANTITIES
+    >>> q = QUANTITIES["bpfo"]
+    >>> q.units, q.tolerance.text()
+    ('Hz', '±1 %')
     """
 
     key: str

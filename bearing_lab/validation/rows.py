@@ -51,7 +51,18 @@ class Tolerance:
     """A pass rule with its reason, and optionally why a failure is a known model limitation.
 
     ``kind`` "pct": ``|sim - exp| <= value % of |exp|``; "factor": ``1/value <= sim/exp <= value``
-    (both of the same sign).  Any NaN fails.
+    (both of the same sign).  Any NaN fails.  A tolerance without a reason, a value that is not a
+    positive number, or a factor not above 1 raises ``ValidationCaseError``.
+
+    See Also
+    --------
+    make_row : a table row checked against it.
+
+    Examples
+    --------
+    >>> tol = Tolerance("factor", 2.0, reason="the rig's load and mount are known to tens of percent")
+    >>> tol.check(1.9, 1.0), tol.check(0.4, 1.0), tol.check(float("nan"), 1.0)
+    (True, False, False)
     """
 
     kind: str
@@ -135,7 +146,28 @@ def make_row(quantity: str, simulation, experiment, tolerance: Tolerance, *, lab
     ``untrusted`` (a reason) makes the row fail whatever its numbers: used when a number
     depends on a structural-path fit that is degraded.  ``absence_agrees``: the quantity is a
     detection (a fault line family); when *neither* signal shows it the row passes as an agreement
-    on its absence (one side showing it and the other not still fails).
+    on its absence (one side showing it and the other not still fails).  A missing value (None,
+    NaN) fails the row and the note says which side is missing.
+
+    Returns
+    -------
+    dict
+        ``quantity``, ``label``, ``units``, ``simulation``, ``experiment``, ``difference``,
+        ``difference_pct``, ``tolerance``, ``pass``, ``status`` ("pass", "known limitation",
+        "fail"), ``reason``, ``known_limitation``, ``note`` and the other arguments.
+
+    See Also
+    --------
+    Tolerance, bearing_lab.report.rows_table, bearing_lab.report.Report.add_rows
+
+    Examples
+    --------
+    >>> tol = Tolerance("pct", 1.0, reason="kinematic frequencies hold to 1-2 % under slip")
+    >>> row = make_row("bpfo", 91.5, 92.19, tol, label="BPFO", units="Hz")
+    >>> row["status"], round(row["difference_pct"], 2)          # (91.5 - 92.19) / 92.19
+    ('pass', -0.75)
+    >>> make_row("bpfo", None, 92.19, tol, label="BPFO", units="Hz")["note"]
+    'missing value (simulation): counts as a failure'
     """
     s, e = _f(simulation), _f(experiment)
     ok = tolerance.check(s, e)

@@ -18,6 +18,7 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from .._docdict import fill_doc
 from ..errors import BearingLabError, ValidationCaseError
 from .case import DEFAULT_CASE, load_case, shipped_cases
 
@@ -60,6 +61,14 @@ class _Steps:
 
 @dataclass
 class CaseOutcome:
+    """What :func:`run_case` gives back: the case's status (``pass``, ``fail``, ``error``,
+    ``skip``), its rows, its run time (s), its folder, and :attr:`verdict` in words.
+
+    See Also
+    --------
+    run_case, run_validation
+    """
+
     name: str
     title: str
     status: str                    # pass | fail | error | skip
@@ -83,17 +92,67 @@ class CaseOutcome:
         return v
 
 
+@fill_doc
 def check_case(case, mirror=None) -> None:
-    """Raise ValidationCaseError when a recording the case needs is not available."""
+    """Raise ValidationCaseError when a recording the case needs is not available.
+
+    Parameters
+    ----------
+    %(case)s
+    %(mirror)s
+
+    Raises
+    ------
+    ValidationCaseError
+        Names the recording and where it was looked for.
+
+    See Also
+    --------
+    load_case, default_set
+
+    Examples
+    --------
+    A paper case needs no recording; a recording case needs its file:
+
+    >>> from bearing_lab.validation import load_case
+    >>> check_case(load_case("paper"))
+    >>> check_case(load_case("cwru-130"), mirror="no-such-folder")
+    Traceback (most recent call last):
+    ...
+    bearing_lab.errors.ValidationCaseError: validation case 'cwru-130': recording 'cwru/130_OR007@6_0.mat' not found in the mirror no-such-folder ...
+    """
     from .recording import locate, missing_reason
     for spec in case.recording_labels:
         if locate(spec, mirror) is None:
             raise ValidationCaseError(f"validation case {case.name!r}: {missing_reason(spec, mirror)}")
 
 
+@fill_doc
 def default_set(mirror=None):
     """The embedded default set: every shipped case marked ``default = true`` whose recordings are
-    available (the paper case first).  Returns (cases, skipped) with skipped = [(name, title, reason)]."""
+    available (the paper case first).
+
+    Parameters
+    ----------
+    %(mirror)s
+
+    Returns
+    -------
+    cases : list of ValidationCase
+    skipped : list of (name, title, reason)
+
+    See Also
+    --------
+    run_validation : runs this set when it is given no case.
+
+    Examples
+    --------
+    Without the recordings only the paper case is left:
+
+    >>> cases, skipped = default_set(mirror="no-such-folder")
+    >>> [c.name for c in cases], sorted(s[0] for s in skipped)[:2]
+    (['paper'], ['cwru-105', 'cwru-130'])
+    """
     cases, skipped = [], []
     for name in shipped_cases():
         c = load_case(name)
@@ -109,8 +168,38 @@ def default_set(mirror=None):
     return cases, skipped
 
 
+@fill_doc
 def run_case(case, out_dir, *, progress=True, mirror=None, position=1) -> CaseOutcome:
-    """Run one case and write ``out_dir/<case>/{index.html, comparison.nc, summary.json}``."""
+    """Run one case and write ``out_dir/<case>/{index.html, comparison.nc, summary.json}``.
+
+    Parameters
+    ----------
+    %(case)s
+    %(out_dir)s
+    %(progress)s
+    %(mirror)s
+    position : int
+        Line of the case's progress bar (under the bar of :func:`run_validation`).
+
+    Returns
+    -------
+    CaseOutcome
+
+    See Also
+    --------
+    run_validation : several cases and the index page.
+    load_case, check_case
+
+    Examples
+    --------
+    A run simulates the compared record (1 s by default) and analyses both signals, tens of seconds
+    of CPU, so this example is not run in the tests:
+
+    >>> from bearing_lab.validation import load_case
+    >>> outcome = run_case(load_case("paper"), "reports", progress=False)   # doctest: +SKIP
+    >>> outcome.verdict["text"]                                             # doctest: +SKIP
+    '... rows pass, ...'
+    """
     from .pages import write_case
     t0 = time.perf_counter()
     out = Path(out_dir) / case.name
@@ -158,14 +247,40 @@ def _run_one(c, out_dir, progress, mirror):
         return CaseOutcome(c.name, c.title, "error", reason=msg)
 
 
+@fill_doc
 def run_validation(specs=None, out_dir="reports", *, strict=False, progress=True, mirror=None):
     """Run cases (default: the embedded default set) and write ``out_dir/index.html``.
 
     Bad input (an unknown case, an invalid file, a missing recording of a named case) raises
     ValidationCaseError before anything runs.  A case that fails while running is listed as an
-    error in the index and the others still run.  Returns (outcomes, exit status): see
-    :func:`exit_status` (1 when a row fails unexplained or a case errors; with ``strict`` also when a
-    declared limitation fails).
+    error in the index and the others still run.
+
+    Parameters
+    ----------
+    specs : list of str or path, optional
+        Shipped case names or case files (default: :func:`default_set`).
+    %(out_dir)s
+    strict : bool
+        Exit status 1 also when a limitation the case declares fails.
+    %(progress)s
+    %(mirror)s
+
+    Returns
+    -------
+    outcomes : list of CaseOutcome
+    status : int
+        :func:`exit_status`: 1 when a row fails unexplained or a case errors, else 0.
+
+    See Also
+    --------
+    run_case, default_set, bearing_lab.report.write_index
+
+    Examples
+    --------
+    ``bearing-lab validate``; a run takes minutes (each case simulates and analyses its record),
+    so this example is not run in the tests:
+
+    >>> outcomes, status = run_validation(["paper"], "reports", progress=False)   # doctest: +SKIP
     """
     from ..report import write_index
     out_dir = Path(out_dir)

@@ -120,6 +120,21 @@ def make_standin_recording(path, *, scene="paper-O2", overrides=None, rpm=1793.0
     -------
     StandIn
         ``hidden`` holds the truth: scene, overrides, rpm, jitter, resonance, tones, noise.
+
+    See Also
+    --------
+    new_case_text : a starting case for the file written.
+    bearing_lab.io.open_recording : reads it back.
+
+    Examples
+    --------
+    Fifty milliseconds of a healthy 6308 as a rig's UFF 58b file:
+
+    >>> s = make_standin_recording("rig.uff", scene="paper-healthy", duration=0.05)
+    >>> from bearing_lab.io import open_recording
+    >>> ds = open_recording("rig.uff")
+    >>> ds.sizes["time"], ds.attrs["sampling_rate_hz"], s.hidden["rpm"]     # 0.05 s at 20 kHz
+    (1000, 20000.0, 1793.0)
     """
     from . import simulation
     path = Path(path)
