@@ -36,6 +36,7 @@ preload_geometry(bearing, clearance, delta)   -- rigid-ring displacement preload
 check_axial_keys(scene)                       -- the displacement preload's checks (SceneError)
 static_equilibrium_3d(scene, phi_c0, k_in, k_out, *, ball_mass, omega_cage, exponent) -> dict
 contact_angles(...)                           -- per ball, from states (see :func:`contact_angles`)
+axial_support(section) -> (k, c)             -- a support's axial stiffness and damping (its Y values if unset)
 """
 from __future__ import annotations
 
@@ -47,7 +48,7 @@ from scipy.optimize import root
 from ..errors import SceneError, SolverError
 
 __all__ = ["needs_3d", "static_equilibrium_3d", "contact_angles", "groove_offsets", "preload_geometry",
-           "check_axial_keys"]
+           "check_axial_keys", "axial_support"]
 
 
 def needs_3d(scene) -> bool:
@@ -229,8 +230,8 @@ def static_equilibrium_3d(scene, phi_c0, k_in, k_out, *, ball_mass=0.0, omega_ca
     grav = np.array([0.0, -g, 0.0])
     f_in = m_i * grav + (0.0 if on_outer else load)
     f_out = m_o * grav + (load if on_outer else 0.0)
-    ks = np.array([d["shaft"]["stiffness_x_n_m"], d["shaft"]["stiffness_y_n_m"], _axial(d["shaft"])[0]])
-    km = np.array([d["mount"]["stiffness_x_n_m"], d["mount"]["stiffness_y_n_m"], _axial(d["mount"])[0]])
+    ks = np.array([d["shaft"]["stiffness_x_n_m"], d["shaft"]["stiffness_y_n_m"], axial_support(d["shaft"])[0]])
+    km = np.array([d["mount"]["stiffness_x_n_m"], d["mount"]["stiffness_y_n_m"], axial_support(d["mount"])[0]])
     a_i, a_o = groove_offsets(b)
     if a_i <= 0 or a_o <= 0:
         raise SceneError(f"bearing {b.name!r}: an axial load needs groove conformities above 0.5 "
@@ -401,7 +402,7 @@ def _axial_angle(fa, z, k_eff, a0, pd, exponent):
     return brentq(f, a_f + 1e-9, 1.4, xtol=1e-14)
 
 
-def _axial(section):
+def axial_support(section):
     """(stiffness N/m, damping N s/m) of a support along the axis: its own keys, else its Y values."""
     k = section.get("stiffness_z_n_m")
     c = section.get("damping_z_n_s_m")
