@@ -175,9 +175,8 @@ def _run(asm, method, rtol, *, progress, t_end_override=None, step=None, max_ste
     kern = V.kernels(V.kind_of(asm.p), int(method) if fixed_method else None)
     work = S.work_arrays(n, z)      # the loop's stage derivatives, state vectors and ball loads
     loads_work = (work[1], work[4], work[5])    # a state-size scratch vector and the two ball-load vectors
-    bar = None
     # the progress bar appears once the run has taken 2 s: a shorter run never imports tqdm (0.05 s)
-    wall0 = _time.perf_counter()
+    bar, wall0 = None, _time.perf_counter()
     bar_at = wall0 + 2.0 if progress else math.inf
     try:
         while t < t_end:
