@@ -2,16 +2,18 @@
 
 Why: with dask installed (the ``sweep`` and ``test`` extras), xarray imports ``dask.array``
 (0.4 s of CPU, scipy.fft and pandas' friends with it) the first time it makes a Variable,
-only to ask "is this a dask array?", and ``dask.distributed`` (0.2 s) each time it writes a
-netCDF file, only to ask "which dask scheduler runs?".  Before the process has imported
-``dask.array`` no dask array can exist, and before it has imported ``distributed`` (with no
-scheduler set in dask's config) no dask scheduler runs, so both answers are known without
-the imports.  Importing this module teaches xarray those two answers; the moment the process
-imports dask itself, xarray asks dask as before.  ``bearing_lab._accessor`` imports it, so
+only to ask "is this a dask array?", ``dask.base`` (0.1-0.17 s, dask's core) for an index
+coordinate, only to ask "is this a dask collection?", and ``dask.distributed`` (0.2 s) each
+time it writes a netCDF file, only to ask "which dask scheduler runs?".  Before the process
+has imported ``dask.array`` no dask array can exist; dask's own collection test only asks the
+object for a ``__dask_graph__()`` that is not None, which needs no dask; and before the process
+has imported ``distributed`` (with no scheduler set in dask's config) no dask scheduler runs,
+so the three answers are known without the imports.  Importing this module teaches xarray
+those answers; the moment the process imports dask itself, xarray asks dask as before.  ``bearing_lab._accessor`` imports it, so
 every path that makes a Dataset (``simulate``, ``open_recording``, ``analysis``) has it.
 
-Both hooks use xarray internals (``namedarray.pycompat._cached_duck_array_modules``,
-``backends.locks.get_dask_scheduler``); on an xarray without them this module does nothing
+The hooks use xarray internals (``namedarray.pycompat._cached_duck_array_modules``,
+``namedarray.utils.is_dask_collection``, ``backends.locks.get_dask_scheduler``); on an xarray without them this module does nothing
 and xarray imports dask as it always did (slower, never wrong).  ``tests/test_imports.py``
 checks both that dask stays out and that chunked Datasets still write through dask.
 """
@@ -83,5 +85,38 @@ def _install_scheduler_hook():
             mod.get_dask_scheduler = hooked
 
 
+def _no_dask_yet(original):
+    def is_dask_collection(x):
+        if "dask" in sys.modules:
+            return original(x)
+        # dask.base.is_dask_collection, which needs nothing of dask: a collection is an object
+        # (not a class) whose __dask_graph__() gives a graph
+        if isinstance(x, type) or not hasattr(x, "__dask_graph__"):
+            return False
+        try:
+            return x.__dask_graph__() is not None
+        except (AttributeError, TypeError):
+            return False
+    is_dask_collection.__wrapped__ = original
+    is_dask_collection.__doc__ = original.__doc__
+    return is_dask_collection
+
+
+def _install_collection_hook():
+    try:
+        from xarray.namedarray import utils
+        original = utils.is_dask_collection
+    except (ImportError, AttributeError):
+        return
+    if hasattr(original, "__wrapped__"):
+        return
+    hooked = _no_dask_yet(original)
+    # every xarray module holding the function by name (xarray.core.utils re-exports it)
+    for name, mod in list(sys.modules.items()):
+        if name.startswith("xarray.") and getattr(mod, "is_dask_collection", None) is original:
+            mod.is_dask_collection = hooked
+
+
 _install_duck_array_hook()
+_install_collection_hook()
 _install_scheduler_hook()

@@ -19,13 +19,17 @@ Run:  .venv/bin/python benchmarks/sim_speed.py [--duration 0.1] [--scene paper-s
 ``bearing-lab simulate SCENE --duration 1 -o x.nc`` (CPU time of the child, user + system,
 ``getrusage(RUSAGE_CHILDREN)``): the first run after install (fresh numba and defect-table caches,
 ``NUMBA_CACHE_DIR`` and ``BEARING_LAB_CACHE`` in new temporary folders; minimum of ``--first``
-runs, each with its own) and runs with both caches warm (minimum of ``--warm`` runs).
+runs, each with its own) and runs with both caches warm (minimum and median of ``--warm`` runs);
+then, the same way (``--warm`` runs each), ``bearing-lab --help`` and ``bearing-lab info FILE`` on
+each ``--info`` file (default: a CWRU .mat and a UFF 58 file of the mirror named by
+``BEARING_LAB_MIRROR``, when it has them).
 """
 import argparse
 import json
 import os
 from pathlib import Path
 import resource
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -53,11 +57,31 @@ def startup(scene="paper-O1", first=2, warm=5):
             firsts.append(_child_cpu(cmd, env))
         for _ in range(warm):
             warms.append(_child_cpu(cmd, env))
-    print(f"| `bearing-lab simulate {scene} --duration 1 -o x.nc` | CPU s, min | all runs |")
-    print("|---|---|---|")
-    print(f"| first run (fresh numba and table caches) | {min(firsts):.2f} | {', '.join(f'{t:.2f}' for t in firsts)} |")
-    print(f"| warm caches | {min(warms):.2f} | {', '.join(f'{t:.2f}' for t in warms)} |")
+    print(f"| `bearing-lab simulate {scene} --duration 1 -o x.nc` | CPU s, min | median | all runs |")
+    print("|---|---|---|---|")
+    print(f"| first run (fresh numba and table caches) | {min(firsts):.2f} | {statistics.median(firsts):.2f} | "
+          f"{', '.join(f'{t:.2f}' for t in firsts)} |")
+    print(f"| warm caches | {min(warms):.2f} | {statistics.median(warms):.2f} | {', '.join(f'{t:.2f}' for t in warms)} |")
     return min(firsts), min(warms)
+
+
+#: files ``--startup`` reads with ``bearing-lab info`` (under BEARING_LAB_MIRROR)
+INFO_FILES = ("cwru/130_OR007@6_0.mat", "lms/sample_58b_microphone.uff")
+
+
+def commands(files, runs=5):
+    """CPU s (min, median) of ``bearing-lab --help`` and ``bearing-lab info FILE`` for each file."""
+    exe = str(Path(sys.executable).with_name("bearing-lab"))
+    env = {**os.environ, "BEARING_LAB_PROGRESS": "0"}
+    print("\n| command | CPU s, min | median | all runs |")
+    print("|---|---|---|---|")
+    out = {}
+    for label, cmd in [("`bearing-lab --help`", [exe, "--help"])] + [
+            (f"`bearing-lab info {Path(f).name}`", [exe, "info", str(f)]) for f in files]:
+        ts = sorted(_child_cpu(cmd, env) for _ in range(runs))
+        out[label] = (ts[0], statistics.median(ts))
+        print(f"| {label} | {ts[0]:.2f} | {statistics.median(ts):.2f} | {', '.join(f'{t:.2f}' for t in ts)} |")
+    return out
 
 
 if __name__ == "__main__":
@@ -65,7 +89,10 @@ if __name__ == "__main__":
     ap.add_argument("--startup", nargs="?", const="paper-O1", default=None, metavar="SCENE",
                     help="whole-process CPU of `bearing-lab simulate SCENE --duration 1 -o x.nc`, first and warm")
     ap.add_argument("--first", type=int, default=2, help="--startup: first runs (fresh caches each)")
-    ap.add_argument("--warm", type=int, default=5, help="--startup: runs with warm caches")
+    ap.add_argument("--warm", type=int, default=5, help="--startup: runs with warm caches (and of each command)")
+    ap.add_argument("--info", action="append", default=None, metavar="FILE",
+                    help="--startup: a file to time `bearing-lab info` on (repeatable; default: a CWRU .mat and a "
+                         "UFF file of the mirror)")
     ap.add_argument("--duration", type=float, default=0.1, help="simulated s of the equal-accuracy records")
     ap.add_argument("--default-duration", type=float, default=1.0)
     ap.add_argument("--scene", action="append", choices=[s[0] for s in SPEED_SCENES])
@@ -74,6 +101,9 @@ if __name__ == "__main__":
     args = ap.parse_args()
     if args.startup:
         startup(args.startup, first=args.first, warm=args.warm)
+        mirror = Path(os.environ.get("BEARING_LAB_MIRROR", "../shared/data"))
+        files = args.info if args.info is not None else [mirror / f for f in INFO_FILES if (mirror / f).is_file()]
+        commands(files, runs=args.warm)
         sys.exit(0)
     md, rows, infos, defaults, qrows = run_speed(args.scene, duration=args.duration, default_duration=args.default_duration,
                                           scipy=not args.no_scipy)

@@ -36,6 +36,27 @@ def test_every_command_takes_quiet_and_the_printing_ones_json():
             assert "--json" in opts, name
 
 
+def test_a_command_alone_parses_as_in_the_whole_command_line():
+    """main() builds only the named command's module (COMMANDS): the table names every command, and
+    each command's parser built alone has the same options as in the whole command line."""
+    import argparse
+    from bearing_lab.cli import COMMANDS
+    whole = dict(_leaves(build_parser()))
+    tops = {name.split()[0] for name in whole}
+    assert set(COMMANDS) == tops
+    for command in COMMANDS:
+        alone = dict(_leaves(build_parser(command)))
+        mine = {k: p for k, p in whole.items() if k.split()[0] == command}
+        assert set(mine) <= set(alone), command
+        for k, p in mine.items():
+            assert ([a.option_strings for a in p._actions if not isinstance(a, argparse._SubParsersAction)]
+                    == [a.option_strings for a in alone[k]._actions if not isinstance(a, argparse._SubParsersAction)]), k
+    # a name that is no command gets the whole command line and its one-line error
+    with pytest.raises(SystemExit) as e:
+        build_parser("simulat").parse_args(["simulat"])
+    assert e.value.code == 2
+
+
 def test_simulate_quiet_is_silent_and_an_existing_output_is_kept(tmp_path, capfd):
     out = tmp_path / "s.nc"
     args = ["simulate", "paper-healthy", "--duration", "0.05", "-o", str(out)]

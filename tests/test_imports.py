@@ -49,16 +49,27 @@ def test_info_reads_without_xarray(datafile):
 
 
 def test_a_dataset_is_made_and_written_without_dask(tmp_path):
-    """A simulation made and written (the ``simulate -o`` path) imports no dask.array, no
-    distributed: 0.6 s of CPU that xarray would spend only to learn that nothing is dask."""
+    """A simulation made and written (the ``simulate -o`` path) imports no dask at all (not
+    dask.array, not distributed, not dask's core): 0.7 s of CPU that xarray would spend only to
+    learn that nothing is dask; and a run shorter than 2 s, which shows no progress bar, no tqdm."""
     code = ("import bearing_lab\nfrom bearing_lab.io import to_netcdf\n"
-            "ds = bearing_lab.simulate('paper-healthy', duration=0.005, progress=False)\n"
+            "ds = bearing_lab.simulate('paper-healthy', duration=0.005)\n"
             f"to_netcdf(ds, {str(tmp_path / 'a.nc')!r})\n")
-    # xarray imports dask's core (0.1 s) to ask dask.base; not dask.array, not distributed
     out = subprocess.run([sys.executable, "-c", code + "import sys\n"
-                          "print('dask.array' in sys.modules, 'distributed' in sys.modules)"],
+                          "print([m for m in ('dask', 'dask.array', 'distributed', 'tqdm') if m in sys.modules])"],
                          capture_output=True, text=True, check=True)
-    assert out.stdout.split() == ["False", "False"]
+    assert out.stdout.strip().splitlines()[-1] == "[]"
+
+
+def test_the_simulator_imports_scipys_root_finders_only_when_it_solves():
+    """``import bearing_lab.sim`` (a scene listed or checked, a sweep's parent process) runs no
+    scipy.optimize and no scipy.special: Hertz constants and bracketed roots are the simulator's
+    own (bearing_lab.sim.numerics); scipy.optimize (lazy_loader) loads at the first 2-D solve."""
+    probe = ("import sys\nimport bearing_lab.sim, bearing_lab.sim.assembly\n"
+             "from bearing_lab.sim.hertz import race_contact\nrace_contact(15.081e-3, 65e-3, 0.53, 'outer')\n"
+             "print([m for m in ('scipy.optimize._optimize', 'scipy.special._ufuncs') if m in sys.modules])")
+    out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, check=True)
+    assert out.stdout.strip().splitlines()[-1] == "[]"
 
 
 def test_dask_still_works_through_xarray_after_the_hooks(tmp_path):

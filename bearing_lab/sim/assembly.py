@@ -11,12 +11,12 @@ import math
 import time
 
 import numpy as np
-from scipy.optimize import brentq
 
 from ..errors import SceneError, check_choice
 from . import _kernels as K
-from .bearing3d import groove_offsets, needs_3d, static_equilibrium_3d
+from .bearing3d import axial_support, groove_offsets, needs_3d, static_equilibrium_3d
 from .hertz import race_contact, series_stiffness
+from .numerics import brentq
 from .scene import Scene
 from .statics import static_equilibrium, unit_vector
 
@@ -220,7 +220,7 @@ def _initial_state(scene: Scene, st, p, fid, dyn, hi, ho, k_eff, m_b, g, omega_c
                 do = q - ou - pd4
                 return (hi.stiffness * max(di, 0) ** 1.5 - ho.stiffness * max(do, 0) ** 1.5 + fc)
             lo_q, hi_q = ou + pd4 - 1e-4, iu - pd4 + 1e-4
-            y0[8 + j] = brentq(gq, lo_q, hi_q, xtol=1e-16, rtol=1e-14)
+            y0[8 + j] = brentq(gq, lo_q, hi_q, xtol=1e-16, rtol=1e-14, where=f"ball {j} start position")
         if dyn:
             # balls at the kinematic positions and speeds, rolling without slip; cage alike
             v_c = b.pitch_diameter / 2 * omega_c
@@ -311,9 +311,8 @@ def _parameters(scene: Scene, fid, st, hi, ho, k_eff, masses, loads, ftf, phi_c0
         a_i, a_o = groove_offsets(b)
         p[K.P_3D] = 1.0
         p[K.P_AGI], p[K.P_AGO] = a_i, a_o
-        from .bearing3d import _axial
-        p[K.P_KZI], p[K.P_CZI] = _axial(d["shaft"])
-        p[K.P_KZO], p[K.P_CZO] = _axial(d["mount"])
+        p[K.P_KZI], p[K.P_CZI] = axial_support(d["shaft"])
+        p[K.P_KZO], p[K.P_CZO] = axial_support(d["mount"])
         p[K.P_ZIR], p[K.P_ZOR] = st["rest_zi"], st["rest_zo"]
         p[K.P_FIZ], p[K.P_FOZ] = st["f_inz"], st["f_outz"]
         from . import scene as _sc

@@ -36,18 +36,24 @@ preload_geometry(bearing, clearance, delta)   -- rigid-ring displacement preload
 check_axial_keys(scene)                       -- the displacement preload's checks (SceneError)
 static_equilibrium_3d(scene, phi_c0, k_in, k_out, *, ball_mass, omega_cage, exponent) -> dict
 contact_angles(...)                           -- per ball, from states (see :func:`contact_angles`)
+axial_support(section) -> (k, c)             -- a support's axial stiffness and damping (its Y values if unset)
 """
 from __future__ import annotations
 
 import math
 
+import lazy_loader as lazy
 import numpy as np
-from scipy.optimize import root
 
 from ..errors import SceneError, SolverError
+from .numerics import brentq
+
+#: scipy.optimize (Powell's hybrid method, Levenberg-Marquardt) for the 3-D starts: imported the first
+#: time a 3-D scene needs it, so a planar run never pays for it (``docs/architecture.md``, "Imports")
+_optimize = lazy.load("scipy.optimize", suppress_warning=True)
 
 __all__ = ["needs_3d", "static_equilibrium_3d", "contact_angles", "groove_offsets", "preload_geometry",
-           "check_axial_keys"]
+           "check_axial_keys", "axial_support"]
 
 
 def needs_3d(scene) -> bool:
@@ -145,10 +151,10 @@ def _ball_multibody(u_i, z_i, u_o, z_o, fc, pd4, a_i, a_o, k_in, k_out, e, guess
             # a ball the rings do not squeeze: its centrifugal force holds it on the outer race
             guess = co + (guess - co) / max(float(np.hypot(*(guess - co))), 1e-30) * (
                 a_o + (max(fc, 0.0) / k_out) ** (1.0 / e))
-    sol = root(res, np.asarray(guess) * 1e6, method="hybr", options={"xtol": 1e-13})
+    sol = _optimize.root(res, np.asarray(guess) * 1e6, method="hybr", options={"xtol": 1e-13})
     x = sol.x
     if max(abs(v) for v in res(x)) > 1e-11:
-        sol = root(res, x, method="lm", options={"xtol": 1e-15, "ftol": 1e-15})
+        sol = _optimize.root(res, x, method="lm", options={"xtol": 1e-15, "ftol": 1e-15})
         if max(abs(v) for v in res(sol.x)) < max(abs(v) for v in res(x)):
             x = sol.x
     return x * 1e-6, parts(x * 1e-6)
@@ -229,8 +235,8 @@ def static_equilibrium_3d(scene, phi_c0, k_in, k_out, *, ball_mass=0.0, omega_ca
     grav = np.array([0.0, -g, 0.0])
     f_in = m_i * grav + (0.0 if on_outer else load)
     f_out = m_o * grav + (load if on_outer else 0.0)
-    ks = np.array([d["shaft"]["stiffness_x_n_m"], d["shaft"]["stiffness_y_n_m"], _axial(d["shaft"])[0]])
-    km = np.array([d["mount"]["stiffness_x_n_m"], d["mount"]["stiffness_y_n_m"], _axial(d["mount"])[0]])
+    ks = np.array([d["shaft"]["stiffness_x_n_m"], d["shaft"]["stiffness_y_n_m"], axial_support(d["shaft"])[0]])
+    km = np.array([d["mount"]["stiffness_x_n_m"], d["mount"]["stiffness_y_n_m"], axial_support(d["mount"])[0]])
     a_i, a_o = groove_offsets(b)
     if a_i <= 0 or a_o <= 0:
         raise SceneError(f"bearing {b.name!r}: an axial load needs groove conformities above 0.5 "
@@ -366,7 +372,7 @@ def _root_best(resid, starts, unit):
     best = None
     for start in starts:
         for method, opts in (("hybr", {"xtol": 1e-15}), ("lm", {"xtol": 1e-15, "ftol": 1e-15})):
-            sol = root(lambda x: resid(x * unit), start / unit, method=method, options=opts)
+            sol = _optimize.root(lambda x: resid(x * unit), start / unit, method=method, options=opts)
             r = np.max(np.abs(resid(sol.x * unit)))
             if best is None or r < best[1]:
                 best = (sol.x * unit, r, sol.message)
@@ -392,16 +398,15 @@ def _axial_angle(fa, z, k_eff, a0, pd, exponent):
     """Contact angle (rad) of a pure axial load ``fa`` shared by ``z`` massless balls (rigid rings,
     Harris & Kotzalas 2007, sec. 7.2): ``fa = z K (a0 (cos a_f / cos a - 1))^e sin a``, a_f the free
     contact angle of the clearance."""
-    from scipy.optimize import brentq
     cf = 1.0 - pd / (2 * a0)
     a_f = math.acos(max(-1.0, min(1.0, cf)))
 
     def f(a):
         return z * k_eff * max(a0 * (cf / math.cos(a) - 1.0), 0.0) ** exponent * math.sin(a) - fa
-    return brentq(f, a_f + 1e-9, 1.4, xtol=1e-14)
+    return brentq(f, a_f + 1e-9, 1.4, xtol=1e-14, where=f"contact angle of a {fa:g} N axial load")
 
 
-def _axial(section):
+def axial_support(section):
     """(stiffness N/m, damping N s/m) of a support along the axis: its own keys, else its Y values."""
     k = section.get("stiffness_z_n_m")
     c = section.get("damping_z_n_s_m")

@@ -23,10 +23,9 @@ from dataclasses import dataclass
 import math
 
 import numpy as np
-from scipy.optimize import brentq
-from scipy.special import ellipe, ellipk
 
 from ..errors import SceneError
+from .numerics import brentq, ellipe, ellipk
 
 
 @dataclass(frozen=True)
@@ -70,7 +69,8 @@ def _kappa_from_f(f_rho: float) -> float:
         ek, ee = ellipk(m), ellipe(m)
         return ((kappa ** 2 + 1) * ee - 2 * ek) / ((kappa ** 2 - 1) * ee) - f_rho
 
-    return brentq(g, 1.0 + 1e-9, 1e4, xtol=1e-13, rtol=1e-13, maxiter=500)
+    return brentq(g, 1.0 + 1e-9, 1e4, xtol=1e-13, rtol=1e-13, maxiter=500,
+                  where=f"Hertz ellipticity for F(rho)={f_rho}")
 
 
 def e_prime(e1: float, nu1: float, e2: float | None = None, nu2: float | None = None) -> float:

@@ -176,14 +176,17 @@ def _run(asm, method, rtol, *, progress, t_end_override=None, step=None, max_ste
     kern = V.kernels(V.kind_of(asm.p), int(method) if fixed_method else None)
     work = S.work_arrays(n, z)      # the loop's stage derivatives, state vectors and ball loads
     loads_work = (work[1], work[4], work[5])    # a state-size scratch vector and the two ball-load vectors
-    bar = None
-    if progress:
-        from tqdm.auto import tqdm
-        bar = tqdm(total=round(t_end, 6), unit="s sim", delay=2.0, leave=False,
-                   desc=f"simulate {scene.name}",
-                   bar_format="{l_bar}{bar}| {n:.3f}/{total:.3f} s sim [{elapsed}<{remaining}]")
+    # the progress bar appears once the run has taken 2 s: a shorter run never imports tqdm (0.05 s)
+    bar, wall0 = None, _time.perf_counter()
+    bar_at = wall0 + 2.0 if progress else math.inf
     try:
         while t < t_end:
+            if bar is None and _time.perf_counter() >= bar_at:
+                from tqdm.auto import tqdm
+                bar = tqdm(total=round(t_end, 6), initial=round(t, 6), unit="s sim", leave=False,
+                           desc=f"simulate {scene.name}",
+                           bar_format="{l_bar}{bar}| {n:.3f}/{total:.3f} s sim [{elapsed}<{remaining}]")
+                bar.start_t -= _time.perf_counter() - wall0   # elapsed counts from the run's start
             t_stop = min(t + chunk_s, t_end)
             m_hi = min(int(math.floor((t_stop - base) / dt_f + 0.5)) + 1, n_fine + 1)
             while m_hi > m_next and base + (m_hi - 1 - 0.5) * dt_f > t_stop:

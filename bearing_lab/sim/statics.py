@@ -12,12 +12,16 @@ from __future__ import annotations
 
 import math
 
+import lazy_loader as lazy
 import numpy as np
-from scipy.optimize import brentq, root
 
 from ..errors import SceneError, SolverError
 from .hertz import series_stiffness
+from .numerics import brentq
 from .scene import Scene
+
+#: scipy.optimize for the final 2-D solve (Powell's hybrid method): imported at its first use
+_optimize = lazy.load("scipy.optimize", suppress_warning=True)
 
 __all__ = ["unit_vector", "bearing_force", "ball_contact_loads", "static_equilibrium"]
 
@@ -82,7 +86,7 @@ def _solve_relative(target, force_of, scale, where):
         hi *= 2
         if hi > 1e-2:
             raise SceneError(f"{where}: no static equilibrium (load {w:.3g} N too large for the bearing)")
-    a = brentq(along, lo, hi, xtol=1e-16, rtol=1e-14)
+    a = brentq(along, lo, hi, xtol=1e-16, rtol=1e-14, where=f"{where}: static equilibrium along the load")
     return _newton_2d(lambda e: force_of(e) - target, a * direction, max(w, 1.0), abs(scale), where)
 
 
@@ -194,7 +198,7 @@ def static_equilibrium(scene: Scene, phi_c0: float, k_in: float, k_out: float, *
         xi, xo = rings(e)
         return (xi - xo - e) / scale
     e0 = x0[:2] - x0[2:]
-    sol = root(resid, e0, method="hybr", options={"xtol": 1e-15})
+    sol = _optimize.root(resid, e0, method="hybr", options={"xtol": 1e-15})
     xi, xo = rings(sol.x)
     fi, fo, _, _ = forces(xi - xo)
     unbalanced = max(np.max(np.abs(fi + f_in - ks * (xi - rest_i))),
