@@ -90,7 +90,7 @@ def test_no_module_imports_another_modules_private_names():
 def test_the_exceptions_cover_only_what_they_name():
     assert "bearing_lab.sim.assembly: bearing_lab.sim.bearing3d._axial" in private_imports()
     assert _excepted("bearing_lab.bench_speed: bearing_lab.sim.integrate._run")
-    assert not _excepted("bearing_lab.sweeps: bearing_lab.sim.integrate._run")
+    assert not _excepted("bearing_lab.sweep: bearing_lab.sim.integrate._run")
 
 
 def _import_alone(module: str):

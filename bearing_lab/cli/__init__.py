@@ -33,7 +33,7 @@ COMMAND_MODULES = [
     "case",       # case new, case standin
     "identify",   # identify (defect geometry from a recording)
     "bench",      # bench
-    "sweep",      # sweep (bearing_lab.sweep on Dask)
+    "sweep",      # sweep (bearing_lab.run_sweep on Dask)
 ]
 
 
