@@ -18,7 +18,7 @@ BearingLabError, SceneError, RecordingError, AnalysisError, SolverError, Validat
 __version__
 
 Subpackages (``dir(bearing_lab)`` lists them, ``import *`` does not): analysis, datasets, io,
-report, sim, sweep, validation.
+report, sim, studies, sweep, validation.
 
 Imports are lazy (SPEC 1, ``lazy_loader.attach``): ``import bearing_lab`` loads no
 numpy, xarray, scipy, numba or matplotlib; a name above, or a subpackage
@@ -31,7 +31,7 @@ import lazy_loader as _lazy
 
 from ._version import __version__
 
-_SUBPACKAGES = ["analysis", "datasets", "io", "report", "sim", "sweep", "validation"]
+_SUBPACKAGES = ["analysis", "datasets", "io", "report", "sim", "studies", "sweep", "validation"]
 #: module -> the public names it serves
 _PUBLIC = {
     "errors": ["AnalysisError", "BearingLabError", "RecordingError", "SceneError", "SolverError",

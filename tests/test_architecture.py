@@ -16,9 +16,9 @@ PKG = ROOT / "bearing_lab"
 #: private names a module may import from another module, and why (at most five entries);
 #: patterns are ``fnmatch`` patterns over the importing module and the imported dotted name
 EXCEPTIONS = {
-    ("bearing_lab.bench*", "bearing_lab.sim.integrate._*"):
+    ("bearing_lab.studies.bench*", "bearing_lab.sim.integrate._*"):
         "the work-precision benchmark times the solver's own time loop, below simulate()",
-    ("bearing_lab.bench", "bearing_lab.sim._kernels"):
+    ("bearing_lab.studies.bench_common", "bearing_lab.sim._kernels"):
         "scipy's solve_ivp is benchmarked on the same compiled right-hand side",
     ("bearing_lab.sim.scene", "bearing_lab.sim.scene_keys._NUM"):
         "the table of scene keys' number type, which scene.py checks values against",
@@ -89,7 +89,7 @@ def test_no_module_imports_another_modules_private_names():
 
 def test_the_exceptions_cover_only_what_they_name():
     assert "bearing_lab.sim.assembly: bearing_lab.sim.bearing3d._axial" in private_imports()
-    assert _excepted("bearing_lab.bench_speed: bearing_lab.sim.integrate._run")
+    assert _excepted("bearing_lab.studies.bench_speed: bearing_lab.sim.integrate._run")
     assert not _excepted("bearing_lab.sweep: bearing_lab.sim.integrate._run")
 
 
