@@ -16,7 +16,9 @@ RecordingWarning                              -- category of the non-fatal warni
 Options every reader understands: ``channels``, ``units`` (label or channel ->
 label, for unknown or missing unit labels), ``checksum``; most also take ``fs``
 (override the rate) and ``sensitivity`` (``"9.91mV/g"`` for voltage channels).
-An option a reader does not know is refused with the list of those it knows.
+An option a reader does not know is refused with the list of those it knows
+(:class:`~bearing_lab.errors.RecordingOptionError`, a ``RecordingError`` whose ``unknown`` and
+``accepted`` name the options).
 """
 from __future__ import annotations
 
@@ -25,7 +27,7 @@ import os
 from pathlib import Path
 import stat
 
-from ..errors import BearingLabError, RecordingError, check_choice
+from ..errors import BearingLabError, RecordingError, RecordingOptionError, check_choice
 from ._base import (ARRAYS_ONLY, ENGINES, RecordingArrays, RecordingReader,  # noqa: F401
                     RecordingWarning, get_warnings)
 
@@ -248,7 +250,7 @@ def open_recording(path, format=None, **options):
     if unknown:
         msg = (f"{path}: the {format!r} reader does not understand option(s) "
                f"{', '.join(unknown)}; it accepts {', '.join(known)}")
-        raise RecordingError(msg)
+        raise RecordingOptionError(msg, unknown=unknown, accepted=known)
     try:
         return reader.open_dataset(path, **options)
     except RecordingError as exc:
