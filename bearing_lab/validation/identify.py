@@ -401,7 +401,7 @@ def identify(case, *, grid=None, refine=True, scheduler="serial", n_workers=None
     IdentificationInterrupted (a KeyboardInterrupt) when stopped: its ``result`` is the partial
     identification of the scenes done (``partial`` True), or None if none had finished.
     """
-    from . import load_case
+    from .load import load_case
     from .identify_run import Progress
     t_cpu, t_wall = time.process_time(), time.perf_counter()
     case = case if hasattr(case, "section") else load_case(case)
@@ -478,13 +478,13 @@ def _setting(case, mirror, level_weight):
     of a loaded case."""
     from .candidates import setting_for
     from .recording import open_spec
-    from .recording_case import prepare
+    from .recording_case import comparison_band, prepare
     from .rig import background_for, path_for
     prep = prepare(case, mirror=mirror)
     m = prep.measured["record"]
     path = path_for(case, prep.recording, m, prep.simulated["model"], mirror=mirror)
     reference = open_spec(case.reference, case.name, mirror) if case.reference is not None else None
-    bg = background_for(case, prep.recording, m, reference)
+    bg = background_for(case, prep.recording, m, reference, band=comparison_band(prep.fs))
     st = setting_for(prep, path, bg, level_weight=level_weight)
     return st, base_scene(case, prep)
 
@@ -493,7 +493,7 @@ def base_scene(case, prep):
     """The scene every candidate is a change of: the case's, at the recording's measured speed, sampling
     rate and length, with the comparison's solver settings (``prep``: the prepared recording)."""
     from . import simulation
-    from .candidates import comparison_overrides
+    from .recording_case import comparison_overrides
     return simulation.build_scene(case, rpm=prep.speed.rpm, fs=prep.fs, duration=prep.n / prep.fs,
                                   overrides=comparison_overrides(case))
 

@@ -120,7 +120,7 @@ def _studies(case, out_dir):
 
 def run_paper_case(case, out_dir, *, steps):
     from ..bearings import get_bearing
-    from .recording_case import CaseResult
+    from .evaluate import CaseResult
     ref = case.data["_reference_data"]
     rpm = float(ref["speed_rpm"])
     geom = get_bearing(case.data.get("bearing", ref.get("bearing", "6308")))
@@ -147,7 +147,7 @@ def run_paper_case(case, out_dir, *, steps):
         extra["compute"][label] = {"wall_time_s": float(ds.attrs["wall_time_s"]),
                                    "compile_time_s": float(ds.attrs.get("compile_time_s", 0.0))}
         prov[f"scene ({label})"] = scene.to_toml()
-        from .recording_parts import model_details
+        from .simulation import model_details
         extra.setdefault("model", {})[label] = model_details(ds)
         steps.step(f"simulate {label}")
     studies = _studies(case, out_dir)
