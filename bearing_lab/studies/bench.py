@@ -30,7 +30,6 @@ import numpy as np
 import xarray as xr
 
 from .._version import __version__
-from ..sim import load_scene
 from ..sim.assembly import assemble
 from ..sim.integrate import METHODS, _run, _warm_up, anti_alias_taps
 from ..utils._files import savefig, write_text
