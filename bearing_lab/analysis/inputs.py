@@ -11,6 +11,7 @@ time_channels(ds)                          -- names of the 1-D variables along `
 pick_channel(ds, name=None, *, source="")  -- the channel to analyse (given, the default one, else the first)
 pick_tacho(ds, name=None, *, channel=None, source="") -- the tacho channel (given, found by name, or None)
 bearing_name(ds, given=None, *, source="") -- the catalog bearing the Dataset names
+not_an_acceleration(da, name, units)       -- a warning when the channel is not an acceleration ("" if it is)
 TACHO_NAME                                 -- the channel names taken for a tacho
 """
 from __future__ import annotations
@@ -19,7 +20,8 @@ import re
 
 from ..errors import AnalysisError
 
-__all__ = ["time_channels", "pick_channel", "pick_tacho", "bearing_name", "TACHO_NAME"]
+__all__ = ["time_channels", "pick_channel", "pick_tacho", "bearing_name", "not_an_acceleration", "TACHO_NAME",
+           "QUANTITY_WORDS"]
 
 #: channel names taken for a once-per-rev tacho (tacho, tach, keyphasor, once-per-rev, 1/rev ...)
 TACHO_NAME = re.compile(r"^(tacho?|tach|tachometer|keyphasor|key_phasor|kph|once[-_ ]?per[-_ ]?rev|1/rev)\d*$",
@@ -93,3 +95,27 @@ def bearing_name(ds, given=None, *, source="") -> str:
         return reader.upper()
     raise AnalysisError(f"{source}: the file names no catalog bearing (bearing attribute {attr!r}); "
                         f"give the bearing (--bearing), one of {', '.join(sorted(CATALOG))}")
+
+
+#: what a channel in these units is, in words (for the warning of :func:`not_an_acceleration`)
+QUANTITY_WORDS = {"Pa": "a sound pressure (a microphone)", "V": "a voltage (no sensor sensitivity applied)",
+                  "m": "a displacement", "m s-1": "a velocity", "N": "a force", "rad s-1": "an angular speed"}
+
+
+def not_an_acceleration(da, name, units) -> str:
+    """A warning when the channel analysed is not an acceleration ("" when it is, or says nothing).
+
+    ``da``: the channel (its ``quantity`` attribute is read), ``name`` its name, ``units`` its unit.
+    The analysis still runs on such a channel; the warning says which of its numbers keep their meaning.
+    """
+    if units in ("m s-2", "g", "m/s^2", "m/s2"):
+        return ""
+    what = QUANTITY_WORDS.get(str(units)) or (f"a quantity in {units!r}" if units not in (None, "", "1") else "")
+    quantity = da.attrs.get("quantity")
+    if quantity and quantity != "acceleration":
+        what = what or f"a {quantity}"
+    if not what:
+        return ""
+    return (f"channel {name!r} is {what}, not an acceleration: the fault frequencies and the diagnosis read "
+            f"the signal's periodicity, but the thresholds were set on accelerometer signals, and rms, peak and "
+            f"the band levels are in {units}, not vibration levels")

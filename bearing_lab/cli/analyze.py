@@ -97,30 +97,11 @@ def _rpm(ds, value, path):
     return rpm, "given"
 
 
-_QUANTITY = {"Pa": "a sound pressure (a microphone)", "V": "a voltage (no sensor sensitivity applied)",
-             "m": "a displacement", "m s-1": "a velocity", "N": "a force", "rad s-1": "an angular speed"}
-
-
-def _not_an_acceleration(da, name, units) -> str:
-    """A warning when the channel analysed is not an acceleration ("" when it is, or says nothing)."""
-    if units in ("m s-2", "g", "m/s^2", "m/s2"):
-        return ""
-    what = _QUANTITY.get(str(units)) or (f"a quantity in {units!r}" if units not in (None, "", "1") else "")
-    quantity = da.attrs.get("quantity")
-    if quantity and quantity != "acceleration":
-        what = what or f"a {quantity}"
-    if not what:
-        return ""
-    return (f"channel {name!r} is {what}, not an acceleration: the fault frequencies and the diagnosis read "
-            f"the signal's periodicity, but the thresholds were set on accelerometer signals, and rms, peak and "
-            f"the band levels are in {units}, not vibration levels")
-
-
 def run(args) -> int:
     import numpy as np
 
     from ..analysis import analyze, plot_analysis
-    from ..analysis.inputs import bearing_name, pick_channel, pick_tacho
+    from ..analysis.inputs import bearing_name, not_an_acceleration, pick_channel, pick_tacho
     from ..analysis.xr import sampling_rate
 
     path = Path(args.file)
@@ -149,7 +130,7 @@ def run(args) -> int:
             result = analyze(x, fs, **kw)
     if note:
         result["notes"] = [note]
-    not_acc = _not_an_acceleration(da, name, units)
+    not_acc = not_an_acceleration(da, name, units)
     if not_acc:
         result.setdefault("notes", []).append(not_acc)
         print(f"bearing-lab analyze: warning: {path.name} [{name}]: {not_acc}", file=sys.stderr)

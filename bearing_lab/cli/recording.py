@@ -80,7 +80,7 @@ def _cmd_import(args) -> int:
     ds = _open(args)
     if args.rpm is not None:
         from ..errors import RecordingError
-        from ..io._base import speed_problem
+        from ..io import speed_problem
         problem = speed_problem(args.rpm)
         if problem is not None:
             raise RecordingError(f"--rpm {args.rpm:g} {problem}: give the shaft speed as a positive "

@@ -7,6 +7,7 @@ list_engines()                                -- {name: description} of the read
 to_netcdf(ds, path)                           -- compressed, lossless netCDF4
 to_uff58b(ds, path, channels=None, ...)       -- UFF 58b (binary) for Testlab and other tools
 get_warnings(ds)                              -- the recording's warnings as a list
+speed_problem(rpm)                            -- None for a plausible shaft speed (r/min), else what is wrong
 ENGINES                                       -- name -> reader class, in sniffing order (SNIFF_ORDER,
                                                  then the entry-point group "bearing_lab.readers",
                                                  then FALLBACK_READERS)
@@ -29,7 +30,7 @@ import stat
 
 from ..errors import BearingLabError, RecordingError, RecordingOptionError, check_choice
 from ._base import (ARRAYS_ONLY, ENGINES, RecordingArrays, RecordingReader,  # noqa: F401
-                    RecordingWarning, get_warnings)
+                    RecordingWarning, get_warnings, speed_problem)
 
 #: The built-in readers (one module each, named like the format), in sniffing order: the first
 #: reader whose ``guess_can_open`` says yes reads the file.
@@ -81,7 +82,7 @@ _register_readers()
 from .export import to_netcdf, to_uff58b  # noqa: E402
 
 __all__ = ["open_recording", "read_arrays", "list_engines", "to_netcdf", "to_uff58b", "get_warnings",
-           "ENGINES", "RecordingReader", "RecordingWarning"]
+           "speed_problem", "ENGINES", "RecordingReader", "RecordingWarning"]
 
 
 def list_engines() -> dict[str, str]:

@@ -3,7 +3,8 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from bearing_lab.analysis.inputs import bearing_name, pick_channel, pick_tacho, time_channels
+from bearing_lab.analysis.inputs import (bearing_name, not_an_acceleration, pick_channel, pick_tacho,
+                                         time_channels)
 from bearing_lab.errors import AnalysisError
 
 
@@ -52,3 +53,14 @@ def test_bearing_name_given_wins_and_none_is_said():
     assert bearing_name(_ds(["a"], bearing="6205"), "6203") == "6203"
     with pytest.raises(AnalysisError, match=r"x.mat: the file names no catalog bearing \(bearing attribute ''\).*6205"):
         bearing_name(_ds(["a"]), source="x.mat")
+
+
+def test_a_channel_that_is_not_an_acceleration_is_said():
+    acc = xr.DataArray(np.zeros(4), dims="time", attrs={"quantity": "acceleration"})
+    assert not_an_acceleration(acc, "a", "m s-2") == "" and not_an_acceleration(acc, "a", "g") == ""
+    mic = xr.DataArray(np.zeros(4), dims="time")
+    text = not_an_acceleration(mic, "mic", "Pa")
+    assert text.startswith("channel 'mic' is a sound pressure (a microphone), not an acceleration") and "in Pa" in text
+    odd = xr.DataArray(np.zeros(4), dims="time", attrs={"quantity": "strain"})
+    assert "channel 'e' is a strain, not an acceleration" in not_an_acceleration(odd, "e", "1")
+    assert not_an_acceleration(mic, "x", "1") == ""          # a bare number says nothing of its quantity
