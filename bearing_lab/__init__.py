@@ -11,14 +11,14 @@ Public API
     analyze                                   -- signal -> speed, band, envelope spectrum, diagnosis (bearing_lab.analysis)
     get_bearing, BearingGeometry, CATALOG     -- catalog geometry and kinematic fault frequencies (bearing_lab.bearings)
     check_dataset                             -- the Dataset contract shared by recordings and simulations (bearing_lab.schema)
-    sweep                                     -- many scenes on Dask (bearing_lab.sweeps)
+    run_sweep                                 -- many scenes on Dask (bearing_lab.sweep)
     identify                                  -- defect geometry from a recording (bearing_lab.validation.identify)
     BearingLabError, SceneError, RecordingError, AnalysisError, SolverError, ValidationCaseError
                                               -- the error types (bearing_lab.errors)
     __version__
 
 Subpackages (``dir(bearing_lab)`` lists them, ``import *`` does not): analysis, datasets, io,
-report, sim, validation.
+report, sim, studies, sweep, validation.
 
 Imports are lazy (SPEC 1, ``lazy_loader.attach``): ``import bearing_lab`` loads no
 numpy, xarray, scipy, numba or matplotlib; a name above, or a subpackage
@@ -31,7 +31,7 @@ import lazy_loader as _lazy
 
 from ._version import __version__
 
-_SUBPACKAGES = ["analysis", "datasets", "io", "report", "sim", "validation"]
+_SUBPACKAGES = ["analysis", "datasets", "io", "report", "sim", "studies", "sweep", "validation"]
 #: module -> the public names it serves
 _PUBLIC = {
     "errors": ["AnalysisError", "BearingLabError", "RecordingError", "SceneError", "SolverError",
@@ -41,7 +41,7 @@ _PUBLIC = {
     "sim": ["simulate", "load_scene", "Scene", "list_scenes"],
     "io": ["open_recording", "list_engines", "to_netcdf", "to_uff58b"],
     "analysis": ["analyze"],
-    "sweeps": ["sweep"],
+    "sweep": ["run_sweep"],
     "validation.identify": ["identify"],
 }
 __getattr__, _, _ = _lazy.attach(__name__, submodules=_SUBPACKAGES, submod_attrs=_PUBLIC)

@@ -24,6 +24,20 @@ class RecordingError(BearingLabError, ValueError):
     """A recording file cannot be read, or its content is invalid."""
 
 
+class RecordingOptionError(RecordingError):
+    """A reader was given options it does not take.
+
+    ``unknown`` holds those names, ``accepted`` the reader's own; a caller that can do without
+    an option (the command line's ``--fs``, applied after reading when the reader has none)
+    checks ``unknown`` instead of the message.
+    """
+
+    def __init__(self, message: str, *, unknown=(), accepted=()):
+        super().__init__(message)
+        self.unknown = tuple(unknown)
+        self.accepted = tuple(accepted)
+
+
 class AnalysisError(BearingLabError, ValueError):
     """An analysis was asked for something the signal cannot give."""
 

@@ -27,7 +27,7 @@ from bearing_lab.sim.defects.halfspace import ratio_curve
 from bearing_lab.sim.defects.model import Defect
 from bearing_lab.sim.hertz import race_contact
 from bearing_lab.validation import simulation
-from bearing_lab.validation.case import load_case
+from bearing_lab.validation.load import load_case
 from bearing_lab.validation.rig import identify_path
 
 MIRROR = os.environ.get("BEARING_LAB_MIRROR", "../shared/data")

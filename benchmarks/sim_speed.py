@@ -34,7 +34,7 @@ import subprocess
 import sys
 import tempfile
 
-from bearing_lab.bench_speed import SPEED_SCENES, all_rows_table, run_speed
+from bearing_lab.studies.bench_speed import SPEED_SCENES, all_rows_table, run_speed
 
 
 def _child_cpu(cmd, env):

@@ -5,7 +5,7 @@
 
 Two ways of timing a sweep, each for every worker count:
 
-- end to end: ``bearing_lab.sweep(..., n_workers=N)`` as a user calls it (the
+- end to end: ``bearing_lab.run_sweep(..., n_workers=N)`` as a user calls it (the
   LocalCluster is started, the workers import bearing_lab and load the numba
   cache, every scene is simulated, written to a fresh cache directory and
   stacked into one Dataset, the cluster is closed);
@@ -69,7 +69,7 @@ def _end_to_end(scene, params, n, duration):
     cache = tempfile.mkdtemp(prefix="sweep-bench-")
     try:
         b0, o0, t0 = _busy(), _own_cpu(), time.perf_counter()
-        ds = bearing_lab.sweep(scene, params, n_workers=n, cache_dir=cache, progress=False, duration=duration)
+        ds = bearing_lab.run_sweep(scene, params, n_workers=n, cache_dir=cache, progress=False, duration=duration)
         el = time.perf_counter() - t0
         # the worker processes were children of this one and have been reaped: RUSAGE_CHILDREN has them
         own, busy = _own_cpu() - o0, _busy() - b0
@@ -85,17 +85,17 @@ def _steady(scene, params, n, duration):
     import bearing_lab
     from dask.distributed import Client, LocalCluster
     import dask
-    with dask.config.set({"distributed.worker.profile.enabled": False}):  # as bearing_lab.sweep's own cluster
+    with dask.config.set({"distributed.worker.profile.enabled": False}):  # as bearing_lab.run_sweep's own cluster
         cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
                                silence_logs=logging.ERROR)
     client = Client(cluster)
     cache = tempfile.mkdtemp(prefix="sweep-bench-")
     try:
         # warm every worker: compile/cache-load, including the defect kernels
-        bearing_lab.sweep(scene, {"speed_rpm": [1000.0 + i for i in range(2 * n)]}, scheduler=client,
+        bearing_lab.run_sweep(scene, {"speed_rpm": [1000.0 + i for i in range(2 * n)]}, scheduler=client,
                           cache_dir=False, progress=False, duration=0.01)
         b0, o0, w0, t0 = _busy(), _own_cpu(), _worker_cpu(client), time.perf_counter()
-        ds = bearing_lab.sweep(scene, params, scheduler=client, cache_dir=cache, progress=False, duration=duration)
+        ds = bearing_lab.run_sweep(scene, params, scheduler=client, cache_dir=cache, progress=False, duration=duration)
         el = time.perf_counter() - t0
         own = _own_cpu() - o0 + _worker_cpu(client) - w0
         busy = _busy() - b0
@@ -117,7 +117,7 @@ def main(argv=None):
     ap.add_argument("--modes", nargs="+", default=["end_to_end", "steady"], choices=["end_to_end", "steady"])
     ap.add_argument("--json", default=None, help="write the results here")
     args = ap.parse_args(argv)
-    import bearing_lab.sweeps as sw
+    import bearing_lab.sweep as sw
     info = {"simulator_fingerprint": sw.code_fingerprint()[:16], "scene": args.scene, "scenes": args.scenes,
             "duration_s": args.duration, "cpus": os.cpu_count(), "python": platform.python_version(),
             "load_avg_start": os.getloadavg(), "started": time.strftime("%Y-%m-%d %H:%M:%S")}

@@ -51,7 +51,8 @@ def margin(row) -> float:
 
 
 def shipped_names():
-    from bearing_lab.validation.case import load_case, shipped_cases
+    from bearing_lab.validation.case import shipped_cases
+    from bearing_lab.validation.load import load_case
     return [n for n in shipped_cases() if load_case(n).default or n == "paper"]
 
 
@@ -59,13 +60,13 @@ def _perturb_recordings(eps):
     """Scale every opened recording by (1 + eps): the smallest change a different decoder could make."""
     import dataclasses
 
-    from bearing_lab.validation import recording, recording_case, recording_parts, rig
+    from bearing_lab.validation import recording, recording_case, recording_run, rig
     orig = recording.open_spec
 
     def open_spec(*a, **k):
         rec = orig(*a, **k)
         return dataclasses.replace(rec, x=rec.x * (1.0 + eps))
-    for mod in (recording, recording_case, recording_parts, rig):
+    for mod in (recording, recording_case, recording_run, rig):
         if hasattr(mod, "open_spec"):
             mod.open_spec = open_spec
 

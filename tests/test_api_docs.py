@@ -19,7 +19,7 @@ IN_CI = os.environ.get("CI", "").lower() in ("1", "true", "yes")
 DOCTEST_MODULES = [
     "bearing_lab._docdict", "bearing_lab.bearings",
     "bearing_lab.sim.integrate", "bearing_lab.sim.scene", "bearing_lab.sim.auto",
-    "bearing_lab.validation.case", "bearing_lab.validation.runner", "bearing_lab.validation.rows",
+    "bearing_lab.validation.case", "bearing_lab.validation.load", "bearing_lab.validation.runner", "bearing_lab.validation.rows",
     "bearing_lab.validation.quantities", "bearing_lab.validation.standin",
     "bearing_lab.validation.newcase",
     "bearing_lab.report.html", "bearing_lab.report.page", "bearing_lab.utils.figures",

@@ -16,9 +16,9 @@ PKG = ROOT / "bearing_lab"
 #: private names a module may import from another module, and why (at most five entries);
 #: patterns are ``fnmatch`` patterns over the importing module and the imported dotted name
 EXCEPTIONS = {
-    ("bearing_lab.bench*", "bearing_lab.sim.integrate._*"):
+    ("bearing_lab.studies.bench*", "bearing_lab.sim.integrate._*"):
         "the work-precision benchmark times the solver's own time loop, below simulate()",
-    ("bearing_lab.bench", "bearing_lab.sim._kernels"):
+    ("bearing_lab.studies.bench_common", "bearing_lab.sim._kernels"):
         "scipy's solve_ivp is benchmarked on the same compiled right-hand side",
     ("bearing_lab.sim.scene", "bearing_lab.sim.scene_keys._NUM"):
         "the table of scene keys' number type, which scene.py checks values against",
@@ -87,8 +87,78 @@ def test_no_module_imports_another_modules_private_names():
 
 def test_the_exceptions_cover_only_what_they_name():
     assert not [e for e in private_imports() if e.startswith("bearing_lab.sim.assembly:")]
-    assert _excepted("bearing_lab.bench_speed: bearing_lab.sim.integrate._run")
-    assert not _excepted("bearing_lab.sweeps: bearing_lab.sim.integrate._run")
+    assert _excepted("bearing_lab.studies.bench_speed: bearing_lab.sim.integrate._run")
+    assert not _excepted("bearing_lab.sweep: bearing_lab.sim.integrate._run")
+
+
+def imported_modules(module: str) -> set:
+    """The bearing_lab modules ``module`` imports anywhere in its file (function-level imports too)."""
+    path = ROOT.joinpath(*module.split("."))
+    path = path / "__init__.py" if path.is_dir() else path.with_suffix(".py")
+    pkg = module if path.name == "__init__.py" else module.rpartition(".")[0]
+    out = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = pkg.split(".")[: len(pkg.split(".")) - (node.level - 1)]
+                source = ".".join(base + ([node.module] if node.module else []))
+            else:
+                source = node.module or ""
+            names = [f"{source}.{a.name}" for a in node.names] + [source]
+        elif isinstance(node, ast.Import):
+            names = [a.name for a in node.names]
+        else:
+            continue
+        for name in names:
+            while name.startswith("bearing_lab") and not _is_module(name):
+                name = name.rpartition(".")[0]
+            if name.startswith("bearing_lab") and name != module:
+                out.add(name)
+                break
+    return out
+
+
+#: the folders in data-flow order: a module imports from its own rank or a lower one
+RANKS = {"_version": 0, "_docdict": 0, "errors": 0, "units": 0, "utils": 0, "schema": 0, "bearings": 0, "_xarray": 0,
+         "io": 1, "datasets": 1, "sim": 1, "analysis": 2, "_accessor": 2, "compare": 3, "sweep": 3, "report": 3,
+         "validation": 4, "studies": 4, "cli": 5}
+#: imports against that order, and why (at most two)
+UPWARD = {("bearing_lab.io", "bearing_lab._accessor"): "every recording carries the da.bearing accessor",
+          ("bearing_lab.sim", "bearing_lab._accessor"): "every simulation carries the da.bearing accessor"}
+#: validation's recording-case layers, in order: a module imports only from its layer or an earlier one
+VALIDATION_LAYERS = [
+    ("quantities", "rows", "recording", "speed", "simulation", "signature"),
+    ("case", "case_checks", "load", "standin", "newcase"),
+    ("recording_case", "rig"),
+    ("evaluate", "candidates", "identify", "identify_run", "identify_report"),
+    ("recording_run", "paper", "figures"),
+    ("pages", "runner"),
+]
+
+
+def test_folders_import_along_the_data_flow():
+    assert {m.split(".")[1] for m in MODULES if "." in m} <= set(RANKS) | {"__main__"}
+    up = {}
+    for m in MODULES:
+        if "." not in m:
+            continue
+        for t in imported_modules(m):
+            if "." in t and RANKS[t.split(".")[1]] > RANKS[m.split(".")[1]]:
+                up[(m, t)] = True
+    assert set(up) <= set(UPWARD), f"imports against the data flow: {sorted(set(up) - set(UPWARD))}"
+    assert len(UPWARD) <= 2
+
+
+def test_validation_modules_import_only_their_layer_or_earlier():
+    layer = {f"bearing_lab.validation.{m}": i for i, ms in enumerate(VALIDATION_LAYERS) for m in ms}
+    assert set(layer) | {"bearing_lab.validation"} >= {m for m in MODULES if m.startswith("bearing_lab.validation")}
+    wrong = sorted(f"{m} -> {t}" for m in layer for t in imported_modules(m) if layer.get(t, -1) > layer[m])
+    assert not wrong, "validation imports a later layer:\n" + "\n".join(wrong)
+
+
+def test_the_layer_checks_can_fail():
+    assert "bearing_lab.validation.recording_case" in imported_modules("bearing_lab.validation.rig")
+    assert "bearing_lab.validation.rig" in imported_modules("bearing_lab.validation.recording_run")
 
 
 #: third-party libraries loaded once by the import server before it forks one child per module: a

@@ -8,7 +8,7 @@ import pytest
 
 
 def test_bench_writes_report_rules_and_rows(tmp_path):
-    from bearing_lab.bench import rows_of, run_bench, summary_table
+    from bearing_lab.studies.bench import rows_of, run_bench, summary_table
     ds = run_bench(tmp_path, duration=0.05, scenes=["paper-slot"], progress=False, scipy=False,
                    rate_duration=0.05)
     for name in ("index.html", "performance.nc", "auto_rules.toml", "work_precision_paper-slot.png",
@@ -43,7 +43,7 @@ def test_bench_writes_report_rules_and_rows(tmp_path):
                                and not r["err_period"] > js["tolerance"]["period"])
     # the rate study: every candidate at 20, 100 and 200 kHz, each against its own reference at that
     # rate, and a rule per rate made from those rows
-    from bearing_lab.bench import RATE_SETTINGS, RATES_HZ, rate_choices, read_rate_study
+    from bearing_lab.studies.bench import RATE_SETTINGS, RATES_HZ, rate_choices, read_rate_study
     rrows = read_rate_study(tmp_path / "auto_rate_study.csv")
     assert {(r["rate_hz"], r["method"], r["rtol"]) for r in rrows} == {
         (fs, m, rt) for fs in RATES_HZ for m, rt in RATE_SETTINGS}

@@ -30,13 +30,14 @@ def test_every_public_name_resolves_and_stays_importable():
     import bearing_lab
     for name in bearing_lab.__all__:
         assert getattr(bearing_lab, name) is not None, name
-    for name in ("analysis", "io", "sim", "validation", "datasets", "report"):
+    for name in ("analysis", "io", "sim", "sweep", "validation", "datasets", "report"):
         assert name in dir(bearing_lab)
     from bearing_lab import (AnalysisError, BearingGeometry, BearingLabError, CATALOG,  # noqa: F401
                              RecordingError, Scene, analyze, check_dataset, get_bearing, identify,
-                             list_engines, list_scenes, load_scene, open_recording, simulate, sweep,
+                             list_engines, list_scenes, load_scene, open_recording, run_sweep, simulate,
                              to_netcdf, to_uff58b)
     assert bearing_lab.simulate is bearing_lab.sim.simulate
+    assert bearing_lab.run_sweep is bearing_lab.sweep.run_sweep      # the package and its function
     assert bearing_lab.identify.__module__ == "bearing_lab.validation.identify"
 
 

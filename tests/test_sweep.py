@@ -1,4 +1,4 @@
-"""bearing_lab.sweep: grid Dataset, Dask == serial bit for bit, cache/resume, errors, CLI.
+"""bearing_lab.run_sweep (the bearing_lab.sweep package): grid Dataset, Dask == serial bit for bit, cache/resume, errors, CLI.
 
 Small scenes (paper-O1, 0.05 s) keep the module well under a minute; the one Dask
 test starts a two-process LocalCluster.
@@ -26,7 +26,7 @@ def cache(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def serial(cache):
-    return bearing_lab.sweep(SCENE, PARAMS, scheduler="serial", cache_dir=cache, progress=False,
+    return bearing_lab.run_sweep(SCENE, PARAMS, scheduler="serial", cache_dir=cache, progress=False,
                              duration=DUR)
 
 
@@ -68,7 +68,7 @@ def test_cell_is_the_simulation_of_that_scene(serial):
 
 
 def test_dask_equals_serial_bit_for_bit(serial):
-    dsk = bearing_lab.sweep(SCENE, PARAMS, n_workers=2, cache_dir=False, progress=False, duration=DUR)
+    dsk = bearing_lab.run_sweep(SCENE, PARAMS, n_workers=2, cache_dir=False, progress=False, duration=DUR)
     assert dsk.attrs["sweep_scheduler"].startswith("local cluster, 2 worker")
     assert dsk.attrs["sweep_computed"] == 4
     a, b = serial.drop_vars(VOLATILE), dsk.drop_vars(VOLATILE)
@@ -79,7 +79,7 @@ def test_dask_equals_serial_bit_for_bit(serial):
 
 
 def test_resume_from_cache(serial, cache):
-    again = bearing_lab.sweep(SCENE, PARAMS, scheduler="serial", cache_dir=cache, progress=False,
+    again = bearing_lab.run_sweep(SCENE, PARAMS, scheduler="serial", cache_dir=cache, progress=False,
                               duration=DUR)
     assert again.attrs["sweep_cache_hits"] == 4 and again.attrs["sweep_computed"] == 0
     assert int(again["cached"].sum()) == 4
@@ -88,15 +88,27 @@ def test_resume_from_cache(serial, cache):
     victim = cache / f"{serial.scene_hash.values[1, 1]}.nc"
     victim.unlink()
     grown = dict(PARAMS, speed_rpm=[900, 1800, 2400])
-    res = bearing_lab.sweep(SCENE, grown, scheduler="serial", cache_dir=cache, progress=False, duration=DUR)
+    res = bearing_lab.run_sweep(SCENE, grown, scheduler="serial", cache_dir=cache, progress=False, duration=DUR)
     assert res.attrs["sweep_cache_hits"] == 3 and res.attrs["sweep_computed"] == 3
     assert res["cached"].values.tolist() == [[1, 1, 0], [1, 0, 0]]
     xr.testing.assert_equal(res.sel(speed_rpm=[900, 1800]).drop_vars(VOLATILE), serial.drop_vars(VOLATILE))
     assert victim.is_file()
 
 
+def test_code_fingerprint_reads_the_simulator_source():
+    """The cache key covers the simulator's code wherever the sweep package sits: the files read
+    are bearings.py and the sim/ modules, found from the package root."""
+    from pathlib import Path
+    from bearing_lab.sweep import _simulator_sources
+    root = Path(bearing_lab.__file__).resolve().parent
+    names = {str(f.relative_to(root)).replace("\\", "/") for f in _simulator_sources()}
+    assert {"bearings.py", "sim/integrate.py", "sim/_kernels.py", "sim/scene.py"} <= names
+    assert names == {"bearings.py"} | {str(f.relative_to(root)).replace("\\", "/")
+                                       for f in (root / "sim").rglob("*.py")}
+
+
 def test_hash_depends_on_scene_and_options():
-    from bearing_lab.sweeps import scene_hash
+    from bearing_lab.sweep import scene_hash
     toml = bearing_lab.load_scene(SCENE).to_toml()
     assert scene_hash(toml) == scene_hash(toml)
     assert scene_hash(toml) != scene_hash(toml.replace("1800.0", "1801.0"))
@@ -118,15 +130,15 @@ def test_hash_depends_on_scene_and_options():
 ])
 def test_bad_sweep_raises_scene_error_naming_the_key(params, needle, tmp_path):
     with pytest.raises(SceneError, match=None) as info:
-        bearing_lab.sweep(SCENE, params, scheduler="serial", cache_dir=tmp_path, progress=False, duration=DUR)
+        bearing_lab.run_sweep(SCENE, params, scheduler="serial", cache_dir=tmp_path, progress=False, duration=DUR)
     assert needle in str(info.value)
     assert not list(tmp_path.iterdir())  # refused before anything ran
 
 
-def test_units_in_values_and_callable_module(tmp_path):
-    import bearing_lab.sweeps  # noqa: F401  (importing the module must not shadow the function)
-    assert callable(bearing_lab.sweep)
-    from bearing_lab.sweeps import _resolve
+def test_units_in_values_and_one_public_spelling(tmp_path):
+    import bearing_lab.sweep  # the package; its function is served at the top as bearing_lab.run_sweep
+    assert bearing_lab.run_sweep is bearing_lab.sweep.run_sweep
+    from bearing_lab.sweep import _resolve
     keys, values, base, scenes = _resolve(SCENE, {"defect.offset_mm": ["0 mm", "250 um"]}, {"duration": DUR})
     assert values == [[0.0, 0.25]]
     assert scenes[1].data["defect"][0]["offset_mm"] == 0.25
@@ -166,7 +178,7 @@ def test_cli_errors_are_one_line_exit_2(argv, needle, tmp_path, capsys):
 def test_text_parameter_and_per_scene_attributes():
     """A text key (fidelity) gives a text coordinate without units; attributes that
     differ between scenes (the fidelity used) become per-scene variables."""
-    ds = bearing_lab.sweep(SCENE, {"fidelity": ["multibody", "quasi-static"]}, scheduler="serial",
+    ds = bearing_lab.run_sweep(SCENE, {"fidelity": ["multibody", "quasi-static"]}, scheduler="serial",
                            cache_dir=False, progress=False, duration=DUR)
     assert ds["fidelity"].values.tolist() == ["multibody", "quasi-static"]
     assert "units" not in ds["fidelity"].attrs
@@ -180,7 +192,7 @@ def test_damaged_cache_entry_is_recomputed_and_reported(serial, cache, tmp_path,
     """NaN written into a cache file, a flipped byte, a lost checksum file or a wrong shape:
     the scene is computed again (never used), the sweep warns and says how many."""
     import shutil
-    from bearing_lab.sweeps import CacheWarning, _checksum_path, _write_cache
+    from bearing_lab.sweep import CacheWarning, _checksum_path, _write_cache
     own = tmp_path / "cache"
     shutil.copytree(cache, own)
     victim = own / f"{serial.scene_hash.values[0, 1]}.nc"
@@ -197,14 +209,14 @@ def test_damaged_cache_entry_is_recomputed_and_reported(serial, cache, tmp_path,
     else:
         _checksum_path(victim).unlink()
     with pytest.warns(CacheWarning, match="1 damaged cache entry"):
-        res = bearing_lab.sweep(SCENE, PARAMS, scheduler="serial", cache_dir=own, progress=False,
+        res = bearing_lab.run_sweep(SCENE, PARAMS, scheduler="serial", cache_dir=own, progress=False,
                                 duration=DUR)
     assert res.attrs["sweep_cache_hits"] == 3 and res.attrs["sweep_computed"] == 1
     assert res.attrs["sweep_cache_rejected"] == 1
     assert np.all(np.isfinite(res["outer_ring_acc_y"].values))
     assert np.all(np.isfinite(res["kurtosis"].values))
     xr.testing.assert_equal(res.drop_vars(VOLATILE), serial.drop_vars(VOLATILE))
-    again = bearing_lab.sweep(SCENE, PARAMS, scheduler="serial", cache_dir=own, progress=False,
+    again = bearing_lab.run_sweep(SCENE, PARAMS, scheduler="serial", cache_dir=own, progress=False,
                               duration=DUR)
     assert again.attrs["sweep_cache_hits"] == 4 and again.attrs["sweep_cache_rejected"] == 0
 

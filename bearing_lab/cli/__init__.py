@@ -33,7 +33,7 @@ COMMAND_MODULES = [
     "case",       # case new, case standin
     "identify",   # identify (defect geometry from a recording)
     "bench",      # bench
-    "sweep",      # sweep (bearing_lab.sweep on Dask)
+    "sweep",      # sweep (bearing_lab.run_sweep on Dask)
 ]
 #: the module that registers each sub-command: a command's own run builds only that module's
 #: parsers (importing the other command modules costs 0.04 s); tests/test_cli_conventions.py

@@ -13,13 +13,9 @@ once-per-rev), is used first.
 from __future__ import annotations
 
 import sys
-import re
 from pathlib import Path
 
-from ..errors import AnalysisError, RecordingError
-
-TACHO_NAME = re.compile(r"^(tacho?|tach|tachometer|keyphasor|key_phasor|kph|once[-_ ]?per[-_ ]?rev|1/rev)\d*$",
-                        re.IGNORECASE)
+from ..errors import AnalysisError, RecordingError, RecordingOptionError
 
 
 def register(subparsers):
@@ -72,61 +68,12 @@ def _open(path: Path, fs):
         raise AnalysisError(f"--fs {fs!r} must be a positive sampling rate in Hz")
     try:
         return open_recording(path, fs=fs), fs, ""
-    except RecordingError as exc:
-        if "does not understand option" not in str(exc):
+    except RecordingOptionError as exc:   # a reader without an fs option: the rate is set after reading
+        if "fs" not in exc.unknown:
             raise
     ds = open_recording(path)
     stored = ds.attrs.get("sampling_rate_hz")
     return ds, fs, f"--fs {fs:g} Hz overrides the file's {stored} Hz"
-
-
-def _time_channels(ds):
-    return [v for v, da in ds.data_vars.items() if "time" in da.dims and da.ndim == 1]
-
-
-def _pick_channel(ds, name, path):
-    candidates = _time_channels(ds)
-    if name is not None:
-        if name not in ds.data_vars:
-            raise AnalysisError(f"{path}: no channel {name!r}; the file has {', '.join(map(str, ds.data_vars))}")
-        if name not in candidates:
-            raise AnalysisError(f"{path}: channel {name!r} is not a 1-D time signal "
-                                f"(dims {ds[name].dims}); pick one of {', '.join(candidates)}")
-        return name
-    default = ds.attrs.get("default_channel")
-    if default in candidates:
-        return default
-    candidates = [c for c in candidates if not TACHO_NAME.match(str(c))]
-    if not candidates:
-        raise AnalysisError(f"{path}: no 1-D time signal to analyse")
-    return candidates[0]
-
-
-def _tacho(ds, value, channel, path):
-    """Name of the tacho channel to use, or None."""
-    if value is not None and value.lower() == "none":
-        return None
-    if value is not None:
-        return _pick_channel(ds, value, path)
-    hits = [c for c in _time_channels(ds) if TACHO_NAME.match(str(c)) and c != channel]
-    return hits[0] if hits else None
-
-
-def _bearing_name(ds, given, path):
-    from ..bearings import CATALOG
-    if given is not None:
-        return given
-    attr = str(ds.attrs.get("bearing", ""))
-    if attr in CATALOG:
-        return attr
-    hits = [k for k in CATALOG if k.lower() in attr.lower()]
-    if attr and len(hits) == 1:
-        return hits[0]
-    reader = str(ds.attrs.get("reader", ""))
-    if reader.upper() in CATALOG:
-        return reader.upper()
-    raise AnalysisError(f"{path}: the file names no catalog bearing (bearing attribute {attr!r}); "
-                        f"give --bearing, one of {', '.join(sorted(CATALOG))}")
 
 
 def _rpm(ds, value, path):
@@ -150,29 +97,11 @@ def _rpm(ds, value, path):
     return rpm, "given"
 
 
-_QUANTITY = {"Pa": "a sound pressure (a microphone)", "V": "a voltage (no sensor sensitivity applied)",
-             "m": "a displacement", "m s-1": "a velocity", "N": "a force", "rad s-1": "an angular speed"}
-
-
-def _not_an_acceleration(da, name, units) -> str:
-    """A warning when the channel analysed is not an acceleration ("" when it is, or says nothing)."""
-    if units in ("m s-2", "g", "m/s^2", "m/s2"):
-        return ""
-    what = _QUANTITY.get(str(units)) or (f"a quantity in {units!r}" if units not in (None, "", "1") else "")
-    quantity = da.attrs.get("quantity")
-    if quantity and quantity != "acceleration":
-        what = what or f"a {quantity}"
-    if not what:
-        return ""
-    return (f"channel {name!r} is {what}, not an acceleration: the fault frequencies and the diagnosis read "
-            f"the signal's periodicity, but the thresholds were set on accelerometer signals, and rms, peak and "
-            f"the band levels are in {units}, not vibration levels")
-
-
 def run(args) -> int:
     import numpy as np
 
     from ..analysis import analyze, plot_analysis
+    from ..analysis.inputs import bearing_name, not_an_acceleration, pick_channel, pick_tacho
     from ..analysis.xr import sampling_rate
 
     path = Path(args.file)
@@ -180,13 +109,13 @@ def run(args) -> int:
         from . import check_output_path
         check_output_path(args.plot, force=args.force, suffixes=PLOT_SUFFIXES, flag="--plot")
     ds, fs, note = _open(path, args.fs)
-    name = _pick_channel(ds, args.channel, path)
+    name = pick_channel(ds, args.channel, source=path)
     da = ds[name]
     if fs is None:
         fs = float(ds.attrs["sampling_rate_hz"]) if "sampling_rate_hz" in ds.attrs else sampling_rate(da)
-    bearing = _bearing_name(ds, args.bearing, path)
+    bearing = bearing_name(ds, args.bearing, source=path)
     rpm, rpm_source = _rpm(ds, args.rpm, path)
-    tacho_name = _tacho(ds, args.tacho, name, path)
+    tacho_name = pick_tacho(ds, args.tacho, channel=name, source=path)
     x = np.asarray(da.values, dtype=float)
     units = da.attrs.get("units", "1")
     kw = dict(bearing=bearing, rpm=rpm, rpm_source=rpm_source, channel=str(name), units=units,
@@ -201,7 +130,7 @@ def run(args) -> int:
             result = analyze(x, fs, **kw)
     if note:
         result["notes"] = [note]
-    not_acc = _not_an_acceleration(da, name, units)
+    not_acc = not_an_acceleration(da, name, units)
     if not_acc:
         result.setdefault("notes", []).append(not_acc)
         print(f"bearing-lab analyze: warning: {path.name} [{name}]: {not_acc}", file=sys.stderr)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 def json_summary(ds, output) -> dict:
     """What ``bench --json`` prints: every run and, per scene, the fastest setting within tolerance."""
-    from ..bench import fastest_within_tolerance, rows_of
+    from ..studies.bench import fastest_within_tolerance, rows_of
     rows = rows_of(ds)
     scenes = list(dict.fromkeys(r["scene"] for r in rows))
     return {"output": str(output),
@@ -16,7 +16,7 @@ def json_summary(ds, output) -> dict:
 
 
 def _bench(args) -> int:
-    from ..bench import SCENES, run_bench, summary_table
+    from ..studies.bench import SCENES, run_bench, summary_table
     names = [s[0] for s in SCENES]
     if args.scene:
         from ..errors import check_choice

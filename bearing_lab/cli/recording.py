@@ -1,8 +1,8 @@
 """Sub-commands ``import``, ``info`` and ``data`` (``data fetch``, ``data list``).
 
 Why here: the CLI only parses arguments and prints; reading is
-:func:`bearing_lab.io.open_recording`, writing :func:`bearing_lab.io.to_netcdf`
-and fetching :func:`bearing_lab.datasets.fetch`.  Every problem with the input
+:func:`bearing_lab.io.open_recording`, the summary :func:`bearing_lab.io.summary.describe`,
+writing :func:`bearing_lab.io.to_netcdf` and fetching :func:`bearing_lab.datasets.fetch`.  Every problem with the input
 is a :class:`~bearing_lab.errors.RecordingError`, which the CLI prints as one
 line with exit status 2.
 """
@@ -74,12 +74,13 @@ def _open(args, arrays_only=False):
 
 def _cmd_import(args) -> int:
     from ..io import get_warnings, to_netcdf
+    from ..io.summary import dataset_kind, describe
     from . import check_output_path
     check_output_path(args.output, force=args.force)  # before reading: a bad -o is said at once
     ds = _open(args)
     if args.rpm is not None:
         from ..errors import RecordingError
-        from ..io._base import speed_problem
+        from ..io import speed_problem
         problem = speed_problem(args.rpm)
         if problem is not None:
             raise RecordingError(f"--rpm {args.rpm:g} {problem}: give the shaft speed as a positive "
@@ -97,70 +98,8 @@ def _cmd_import(args) -> int:
         print(dumps({**describe(ds, args.file), "output": args.output}, indent=1))
     elif not args.quiet:
         print(f"{args.output}: {len(ds.data_vars)} channel(s) {', '.join(ds.data_vars)}, {n} samples "
-              f"at {fs:g} Hz ({n / fs:.4g} s), reader {ds.attrs.get('reader') or 'netcdf (' + _kind(ds) + ')'}")
+              f"at {fs:g} Hz ({n / fs:.4g} s), reader {ds.attrs.get('reader') or 'netcdf (' + dataset_kind(ds) + ')'}")
     return 0
-
-
-_QUANTITY_OF_UNITS = {"m s-2": "acceleration", "m": "displacement", "N": "force",
-                      "rad s-1": "angular speed", "m s-1": "velocity", "Pa": "pressure", "V": "voltage"}
-
-
-def _kind(ds) -> str:
-    if "reader" in ds.attrs:
-        return "recording"
-    if "scene_toml" in ds.attrs or "fidelity" in ds.attrs:
-        return "sweep" if "sweep_n_scenes" in ds.attrs else "simulation"
-    return "dataset"
-
-
-def _rms(values) -> float | None:
-    import numpy as np
-    x = np.asarray(values, dtype=float).ravel()
-    if not x.size:
-        return None
-    scale = float(np.max(np.abs(x)))
-    if not np.isfinite(scale) or scale == 0.0:
-        return scale if np.isfinite(scale) else None
-    return float(scale * np.sqrt(np.mean(np.square(x / scale))))  # no overflow for huge values
-
-
-def describe(ds, path=None) -> dict:
-    """Return the summary ``bearing-lab info`` prints (also used for ``--json``).
-
-    Works for recordings, simulation outputs and sweeps (``kind``); fields a Dataset
-    does not have are None.
-    """
-    from ..io import get_warnings
-    n = ds.sizes.get("time", 0)
-    fs = float(ds.attrs.get("sampling_rate_hz", 0.0) or 0.0)
-    kind = _kind(ds)
-    default = ds.attrs.get("default_channel")
-    if default is None and "outer_ring_acc_y" in ds.data_vars:
-        default = "outer_ring_acc_y"
-    channels = {}
-    for k, v in ds.data_vars.items():
-        units = v.attrs.get("units")
-        channels[str(k)] = {
-            "units": units, "original_units": v.attrs.get("original_units"),
-            "quantity": v.attrs.get("quantity") or _QUANTITY_OF_UNITS.get(str(units)),
-            "dims": [str(d) for d in v.dims],
-            "rms": _rms(v.values) if v.dtype.kind in "iuf" else None}
-    return {
-        "file": ds.attrs.get("source_file") or (str(path) if path is not None else None),
-        "kind": kind,
-        "reader": ds.attrs.get("reader") or kind,
-        "sampling_rate_hz": fs,
-        "samples": int(n),
-        "duration_s": (n / fs) if fs else None,
-        "start_time_s": float(ds["time"].values[0]) if n else None,
-        "shaft_speed_rpm": ds.attrs.get("shaft_speed_rpm"),
-        "bearing": ds.attrs.get("bearing"),
-        "scene": ds.attrs.get("scene_name"),
-        "default_channel": default,
-        "channels": channels,
-        "sha256": ds.attrs.get("source_sha256"),
-        "warnings": get_warnings(ds),
-    }
 
 
 def _fmt(v, spec="", none="-"):
@@ -180,6 +119,7 @@ def _cmd_info(args) -> int:
     if not args.file:
         from ..errors import RecordingError
         raise RecordingError("info: give a FILE (or --formats)")
+    from ..io.summary import describe
     ds = _open(args, arrays_only=True)  # no Dataset: info prints without importing xarray
     d = describe(ds, args.file)
     if args.json:

@@ -28,7 +28,7 @@ def parse_params(items) -> dict:
 
 
 def _sweep(args) -> int:
-    from ..sweeps import sweep
+    from ..sweep import run_sweep
     from ..sim.scene import parse_set
     params = parse_params(args.param)
     overrides = parse_set(args.set)
@@ -36,12 +36,12 @@ def _sweep(args) -> int:
     out = check_output_path(args.output, force=args.force)
     cache = False if args.no_cache else args.cache_dir
     import warnings
-    from ..sweeps import CacheWarning
+    from ..sweep import CacheWarning
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", CacheWarning)  # said below, in one line
-        ds = sweep(args.scene, params, scheduler=args.scheduler, n_workers=args.workers,
-                   cache_dir=cache, progress=not (args.quiet or args.json), duration=args.duration, fs=args.fs,
-                   **overrides)
+        ds = run_sweep(args.scene, params, scheduler=args.scheduler, n_workers=args.workers,
+                       cache_dir=cache, progress=not (args.quiet or args.json), duration=args.duration, fs=args.fs,
+                       **overrides)
     from ..errors import BearingLabError
     from ..io.export import to_netcdf
     to_netcdf(ds, out, error=BearingLabError)

@@ -6,7 +6,7 @@ recordings are available (``BEARING_LAB_MIRROR``); missing recordings are listed
 unknown case, an invalid case file, key or scene, or a missing recording is bad input (one line
 on stderr, exit status 2) and nothing runs.  A case that fails while running is listed as an
 error in the index; the others still run.  The verdicts and the exit status:
-:data:`bearing_lab.validation.rows.VERDICTS`, :data:`bearing_lab.validation.runner.EXIT_STATUS`.
+:data:`bearing_lab.validation.rows.VERDICTS`, :data:`bearing_lab.validation.rows.EXIT_STATUS`.
 The case format: ``docs/case-format.md``.
 """
 from __future__ import annotations
@@ -19,7 +19,7 @@ import time
 
 def _epilog() -> str:
     from ..validation.rows import VERDICTS
-    from ..validation.runner import EXIT_STATUS
+    from ..validation.rows import EXIT_STATUS
     lines = ["verdict of a case:"]
     lines += [f"  {k.upper():18s} {v}" for k, v in VERDICTS.items()]
     lines += ["", "A declared limitation is a row the case's author gives a known_limitation (a reason the model "

@@ -9,6 +9,7 @@ Public API
     to_netcdf(ds, path)                           -- compressed, lossless netCDF4
     to_uff58b(ds, path, channels=None, ...)       -- UFF 58b (binary) for Testlab and other tools
     get_warnings(ds)                              -- the recording's warnings as a list
+    speed_problem(rpm)                            -- None for a plausible shaft speed (r/min), else what is wrong
     ENGINES                                       -- name -> reader class, in sniffing order (SNIFF_ORDER,
                                                      then the entry-point group "bearing_lab.readers",
                                                      then FALLBACK_READERS)
@@ -18,7 +19,9 @@ Public API
 Options every reader understands: ``channels``, ``units`` (label or channel ->
 label, for unknown or missing unit labels), ``checksum``; most also take ``fs``
 (override the rate) and ``sensitivity`` (``"9.91mV/g"`` for voltage channels).
-An option a reader does not know is refused with the list of those it knows.
+An option a reader does not know is refused with the list of those it knows
+(:class:`~bearing_lab.errors.RecordingOptionError`, a ``RecordingError`` whose ``unknown`` and
+``accepted`` name the options).
 """
 from __future__ import annotations
 
@@ -27,9 +30,9 @@ import os
 from pathlib import Path
 import stat
 
-from ..errors import BearingLabError, RecordingError, check_choice
+from ..errors import BearingLabError, RecordingError, RecordingOptionError, check_choice
 from ._base import (ARRAYS_ONLY, ENGINES, RecordingArrays, RecordingReader,  # noqa: F401
-                    RecordingWarning, get_warnings)
+                    RecordingWarning, get_warnings, speed_problem)
 
 #: The built-in readers (one module each, named like the format), in sniffing order: the first
 #: reader whose ``guess_can_open`` says yes reads the file.
@@ -81,7 +84,7 @@ _register_readers()
 from .export import to_netcdf, to_uff58b  # noqa: E402
 
 __all__ = ["open_recording", "read_arrays", "list_engines", "to_netcdf", "to_uff58b", "get_warnings",
-           "ENGINES", "RecordingReader", "RecordingWarning"]
+           "speed_problem", "ENGINES", "RecordingReader", "RecordingWarning"]
 
 
 def list_engines() -> dict[str, str]:
@@ -260,7 +263,7 @@ def open_recording(path, format=None, **options):
     if unknown:
         msg = (f"{path}: the {format!r} reader does not understand option(s) "
                f"{', '.join(unknown)}; it accepts {', '.join(known)}")
-        raise RecordingError(msg)
+        raise RecordingOptionError(msg, unknown=unknown, accepted=known)
     try:
         return reader.open_dataset(path, **options)
     except RecordingError as exc:

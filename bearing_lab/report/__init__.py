@@ -1,4 +1,4 @@
-"""Reports that open from disk: one page layer for validation (and, later, studies and bench).
+"""Reports that open from disk: one page layer for validation, the studies and the benchmark.
 
 Why self-contained files: a reviewer gets one folder, opens ``index.html`` from a mail
 attachment or an archive, and sees every figure without a server or network.  Modelled
@@ -11,7 +11,7 @@ Public API
 ----------
 ::
 
-    Report(title, *, subtitle="")                         -- one page
+    Report(title, *, subtitle="", verdict=True)           -- one page (verdict=False: no validation verdict)
     Report.add_rows(rows, title, *, show_reference, show_paper, intro) -- the validation table
     Report.add_comparison(result, title, *, figures=True)  -- a ComparisonResult's table (+ figures)
     Report.add_figure(fig, title, *, caption) / add_figures([(fig, caption)], title)

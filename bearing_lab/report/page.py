@@ -33,7 +33,9 @@ class Report:
 
     Figures are matplotlib :class:`~matplotlib.figure.Figure` objects (no backend is switched),
     embedded as PNG.  ``rows`` collects the validation rows added with :meth:`add_rows`.  Every
-    ``add_*`` method returns the report, so calls chain.
+    ``add_*`` method returns the report, so calls chain.  ``verdict=False`` makes a page without the
+    validation verdict (badge, rows passing, link to the case index): the studies' and the benchmark's
+    pages.
 
     Parameters
     ----------
@@ -41,6 +43,8 @@ class Report:
         The page's heading.
     subtitle : str
         A line under it.
+    verdict : bool
+        Show the validation verdict (default); False for pages that hold no validation.
 
     See Also
     --------
@@ -60,39 +64,40 @@ class Report:
     'BPFO'
     """
 
-    def __init__(self, title: str, *, subtitle: str = ""):
+    def __init__(self, title: str, *, subtitle: str = "", verdict: bool = True):
         self.title = title
         self.subtitle = subtitle
+        self.verdict = verdict
         self.sections: list[dict] = []
         self.rows: list[dict] = []
         self.info: dict = {}
 
     # ---- adding content
-    def add_html(self, html_text: str, title: str, *, tags=()):
-        self.sections.append({"title": title, "html": html_text, "tags": list(tags)})
+    def add_html(self, html_text: str, title: str):
+        self.sections.append({"title": title, "html": html_text})
         return self
 
-    def add_figure(self, fig, title: str, *, caption: str = "", tags=(), dpi=80):
-        return self.add_html(figure_html(fig, title, caption, dpi=dpi), title, tags=tags)
+    def add_figure(self, fig, title: str, *, caption: str = "", dpi=80):
+        return self.add_html(figure_html(fig, title, caption, dpi=dpi), title)
 
-    def add_figures(self, figs, title: str, *, tags=(), dpi=80, intro=""):
+    def add_figures(self, figs, title: str, *, dpi=80, intro=""):
         """Several ``(figure, caption)`` pairs in one section."""
         body = "\n".join(figure_html(f, title, c, dpi=dpi) for f, c in figs)
-        return self.add_html((f"<p>{esc(intro)}</p>" if intro else "") + body, title, tags=tags)
+        return self.add_html((f"<p>{esc(intro)}</p>" if intro else "") + body, title)
 
-    def add_table(self, rows: list, title: str, *, columns=None, tags=(), intro=""):
-        return self.add_html(table_html(rows, columns=columns, intro=intro), title, tags=tags)
+    def add_table(self, rows: list, title: str, *, columns=None, intro=""):
+        return self.add_html(table_html(rows, columns=columns, intro=intro), title)
 
     def add_rows(self, rows: list, title: str = "Comparison table", *, show_reference=False, show_paper=False,
-                 intro="", tags=()):
+                 intro=""):
         """Validation rows (see :func:`bearing_lab.validation.rows.make_row`) as the status table."""
         self.rows.extend(rows)
         return self.add_html(rows_table(rows, show_reference=show_reference, show_paper=show_paper, intro=intro),
-                             title, tags=tags)
+                             title)
 
-    def add_comparison(self, result, title: str = "Comparison", *, tags=(), figures=True, intro=""):
+    def add_comparison(self, result, title: str = "Comparison", *, figures=True, intro=""):
         """A :class:`~bearing_lab.compare.ComparisonResult`: its table, and its figures."""
-        self.add_rows(result.rows, title, intro=intro, tags=tags)
+        self.add_rows(result.rows, title, intro=intro)
         if figures:
             from ..utils.figures import new_figure
             fig = new_figure(figsize=(10, 9), layout="constrained")
@@ -100,7 +105,7 @@ class Report:
             result.plot_waveforms(ax=axes[0], window_s=(0, 0.1))
             result.plot_spectra(ax=axes[1])
             result.plot_envelope(ax=axes[2], fmax=600)
-            self.add_figure(fig, f"{title}: figures", tags=tags)
+            self.add_figure(fig, f"{title}: figures")
         return self
 
     def add_notice(self, heading: str, body: str, *, level="warn", title=None):
@@ -112,7 +117,7 @@ class Report:
         self.sections[-1]["html"] += "\n" + block
         return self
 
-    def add_provenance(self, info: dict | None = None, title="Provenance", *, software=True, tags=()):
+    def add_provenance(self, info: dict | None = None, title="Provenance", *, software=True):
         """Where the results came from: ``info`` (inputs, checksums) and, with ``software``, the
         package versions, source revision, host and date."""
         from .provenance import environment
@@ -120,7 +125,7 @@ class Report:
         if software:
             merged.update(environment())
         self.info.update(merged)
-        return self.add_html(kv_html(merged), title, tags=tags)
+        return self.add_html(kv_html(merged), title)
 
     def add_citation(self, title="How to cite", *, note=""):
         from .provenance import citation
@@ -151,6 +156,10 @@ class Report:
             a = _anchor(s["title"], used)
             toc.append(f'<a href="#{a}">{esc(s["title"])}</a>')
             secs.append(template("section.html").substitute(anchor=a, title=esc(s["title"]), body=s["html"]))
+        if not self.verdict:
+            return template("page.html").substitute(
+                title=esc(self.title), subtitle=esc(self.subtitle), css=css(), toc=" ".join(toc),
+                sections="\n".join(secs), date=_now(), version=__version__)
         n_pass = sum(bool(r.get("pass")) for r in self.rows)
         n_known = sum(bool(r.get("known_limitation")) and not r.get("pass") for r in self.rows)
         cls, text = self.status()
@@ -167,7 +176,8 @@ class Report:
         if path.exists() and not overwrite:
             raise FileExistsError(f"{path} exists (pass overwrite=True)")
         if path.suffix == ".json":
-            text = json.dumps({"title": self.title, "subtitle": self.subtitle, "sections": self.sections,
+            text = json.dumps({"title": self.title, "subtitle": self.subtitle, "verdict": self.verdict,
+                               "sections": self.sections,
                                "rows": self.rows, "info": self.info}, default=str, allow_nan=True)
         elif path.suffix in (".html", ".htm"):
             text = self.to_html()
@@ -181,7 +191,7 @@ class Report:
     @classmethod
     def load(cls, path) -> "Report":
         d = json.loads(Path(path).read_text(encoding="utf-8"))
-        r = cls(d["title"], subtitle=d.get("subtitle", ""))
+        r = cls(d["title"], subtitle=d.get("subtitle", ""), verdict=d.get("verdict", True))
         r.sections, r.rows, r.info = d["sections"], d["rows"], d.get("info", {})
         return r
 

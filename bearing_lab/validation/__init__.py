@@ -8,11 +8,13 @@ measured background can be added to the simulation; every row can fail, and a fa
 row says whether it is a known model limitation.
 
 Modules: :mod:`.case` (parsing), :mod:`.quantities` (the table of quantities),
-:mod:`.rows` (tolerances, rows), :mod:`.speed` (speed sources), :mod:`.simulation`
-(scenes and every simulator call), :mod:`.rig` (structural path, background),
-:mod:`.recording_case` / :mod:`.paper` (the two case kinds), :mod:`.figures`,
-:mod:`.pages` (report, summary.json), :mod:`.runner`, :mod:`.standin` (stand-in
-recordings), :mod:`.newcase` (``bearing-lab case new``).
+:mod:`.rows` (tolerances, rows, verdicts), :mod:`.speed` (speed sources), :mod:`.simulation`
+(scenes and every simulator call); a recording case in layers: :mod:`.recording_case`
+(recording and declared scene, measured once), :mod:`.rig` (structural path, background),
+:mod:`.evaluate` (rows), :mod:`.candidates` (geometries scored), :mod:`.recording_run` (the case
+end to end); :mod:`.paper` (a paper case), :mod:`.figures`, :mod:`.pages` (report,
+summary.json), :mod:`.runner`, :mod:`.standin` (stand-in recordings), :mod:`.newcase`
+(``bearing-lab case new``).
 
 Public API
 ----------
@@ -30,7 +32,8 @@ Public API
                                                       a resonance, tones and noise (UFF58b or Testlab .mat)
     new_case_text(recording_path, ...)             -- the commented starting case `bearing-lab case new` writes
 """
-from .case import DEFAULT_CASE, RecordingSpec, ValidationCase, list_cases, load_case, shipped_cases  # noqa: F401
+from .case import DEFAULT_CASE, RecordingSpec, ValidationCase, shipped_cases  # noqa: F401
+from .load import list_cases, load_case  # noqa: F401
 from .quantities import QUANTITIES, Quantity  # noqa: F401
 from .rows import Tolerance, make_row  # noqa: F401
 from .runner import CaseOutcome, check_case, default_set, run_case, run_validation  # noqa: F401

@@ -20,41 +20,15 @@ import numpy as np
 
 from ..analysis.impacts import impact_times
 from ..errors import AnalysisError, ValidationCaseError
+from .evaluate import context
+from .recording_case import comparison_band, comparison_overrides, impact_period
 from .signature import WINDOW_S, impact_signature, misfit
 
-__all__ = ["Setting", "setting_for", "candidate_signature", "score_candidates", "DEFAULT_BAND_HZ"]
-
-#: the signature's band: above the machine tones and the shaft harmonics (all below 1 kHz on
-#: bench rigs), up to 0.45 fs (the anti-alias filter's flat part); a broad band keeps the
-#: entry and exit events apart in time (a narrow band would smear them over 1/bandwidth)
-DEFAULT_BAND_HZ = (1000.0, None)
-
-
-def comparison_band(fs, band_hz=None) -> tuple:
-    """The band (Hz) impacts are timed and enveloped in: ``band_hz`` or :data:`DEFAULT_BAND_HZ`, an open
-    upper edge at 0.45 fs."""
-    lo, hi = band_hz or DEFAULT_BAND_HZ
-    return float(lo), float(hi) if hi else 0.45 * fs
-
-#: solver tolerance of every scene a comparison simulates (candidates, identification grid) unless the
-#: case's ``[scene] set`` gives ``solver.rtol``.  Measured on a stand-in of paper O1 (H = B/3): at the
-#: defect auto rule's rtol 1e-4 the true candidate's score differs from a converged one (dp54, rtol 1e-8,
-#: 2 us ceiling) by 0.16 dB, half the 0.3 dB interval threshold; at 1e-6 by < 0.01 dB
-COMPARISON_RTOL = 1e-6
+__all__ = ["Setting", "setting_for", "candidate_signature", "score_candidates"]
 
 #: a level within LEVEL_K standard uncertainties of the path's signature gain (``fit["signature_gain_sigma_db"]``) costs
 #: nothing in the score: two standard uncertainties cover about 95 % of a normal error
 LEVEL_K = 2.0
-
-
-def comparison_overrides(case) -> dict:
-    """Scene keys every simulated candidate of ``case`` gets: sensor off (a path is applied), the
-    comparison's solver tolerance unless the case sets its own."""
-    from .recording_case import scene_overrides
-    ov = scene_overrides(case)
-    if "solver.rtol" not in (case.section("scene").get("set", {}) or {}):
-        ov["solver.rtol"] = COMPARISON_RTOL
-    return ov
 
 
 @dataclass
@@ -82,7 +56,6 @@ class Setting:
 
 
 def _level_weight(prep, path, level_weight):
-    from .recording_parts import context
     sp = prep.case.section("structural_path")
     fitted_here = context(prep.case, prep, path)["path_fitted_here"]
     if level_weight is not None:
@@ -104,24 +77,6 @@ def _halves_noise(x, fs, times, band, period=None):
     a = impact_signature(x, fs, times[0::2], band=band, period=period)
     b = impact_signature(x, fs, times[1::2], band=band, period=period)
     return float(misfit(a, b, level_weight=1.0)["score_db"])
-
-
-_FAMILY = {"outer": "bpfo", "inner": "bpfi"}
-
-
-def impact_period(case, measured) -> tuple:
-    """The impact period (s) and a note: the measured one, else the declared defect race's measured
-    fault line (``nan`` and no note when neither is there)."""
-    period = float(measured["excitation_period"])
-    if np.isfinite(period):
-        return period, ""
-    races = {str(d.get("race", "outer")) for d in case.data.get("defect", [])}
-    fam = _FAMILY.get(races.pop()) if len(races) == 1 else None
-    if fam and np.isfinite(measured[fam]):
-        return 1.0 / float(measured[fam]), (f"no fault was diagnosed on its own; the impacts are timed at the measured "
-                                            f"{fam.upper()} line ({float(measured[fam]):.2f} Hz) of the declared "
-                                            "defect's race")
-    return float("nan"), ""
 
 
 def _period(prep) -> tuple:
@@ -178,7 +133,6 @@ def setting_for(prep, path, background, *, level_weight=None, band_hz=None, seed
 def _path_residual(prep, path, meas) -> tuple:
     """The path's shape residual to remove (see :mod:`.signature`) and a note: only for a path identified on
     another recording (a calibration of the rig), at this recording's sampling rate and window."""
-    from .recording_parts import context
     r = path.fit.get("signature_residual_db")
     if r is None or context(prep.case, prep, path)["path_fitted_here"]:
         return None, ""

@@ -12,25 +12,26 @@ CASE_KEYS                         -- section -> {key: description} of every acce
 RecordingSpec                     -- one recording: file or registry name, channel, calibration, span
 ValidationCase                    -- a checked case
 shipped_cases()                   -- {name: Traversable} of the cases shipped as package data
-list_cases()                      -- {name: title} of the shipped cases
-load_case(name_or_path)           -- ValidationCase (raises ValidationCaseError naming the problem)
+case_dir()                        -- their folder
+case_error, check_keys, check_number, check_speed, parse_tolerances, recording_spec, ratio_spec
+                                  -- the checks every section uses (:mod:`.case_checks`), one wording
+
+A case is loaded by :func:`bearing_lab.validation.load.load_case`, which runs the checks.
 """
 from __future__ import annotations
 
-from functools import partial
-
 import math
-import tomllib
 from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
 
-from ..errors import BearingLabError, ValidationCaseError, check_choice
+from ..errors import BearingLabError, ValidationCaseError
 from .quantities import QUANTITIES
 from .rows import Tolerance
 
-__all__ = ["CASE_KEYS", "RecordingSpec", "ValidationCase", "shipped_cases", "list_cases", "load_case",
-           "DEFAULT_CASE", "SCALE_RANGE"]
+__all__ = ["CASE_KEYS", "RecordingSpec", "ValidationCase", "shipped_cases", "case_dir", "DEFAULT_CASE",
+           "SCALE_RANGE", "case_error", "check_keys", "check_number", "check_speed", "parse_tolerances",
+           "recording_spec", "ratio_spec"]
 
 DEFAULT_CASE = "paper"
 #: a calibration factor outside this range is a typo, not a sensor
@@ -91,11 +92,6 @@ CASE_KEYS = {
     "run": {"label": "paper cases: run label", "scene": "scene", "duration_s": "simulated s", "set": "scene keys"},
     "studies": {"enabled": "paper cases: run the section-5 studies"},
 }
-_TOP_RECORDING = {"name", "title", "description", "kind", "default", "bearing", "speed", "recording", "reference",
-                  "load", "defect", "scene", "structural_path", "background", "ratio", "numerical_error",
-                  "tolerances"}
-_TOP_PAPER = {"name", "title", "description", "kind", "default", "bearing", "reference", "run", "tolerances",
-              "studies", "numerical_error"}
 
 
 def case_error(case, msg):
@@ -179,7 +175,8 @@ class ValidationCase:
 
 
 # ------------------------------------------------------------------ shipped cases
-def _case_dir():
+def case_dir():
+    """The folder of the shipped cases (package data)."""
     return resources.files("bearing_lab.validation").joinpath("cases")
 
 
@@ -197,25 +194,10 @@ def shipped_cases() -> dict:
     >>> "paper" in cases, cases["paper"].name
     (True, 'paper.toml')
     """
-    d = _case_dir()
+    d = case_dir()
     items = sorted((p for p in d.iterdir() if p.name.endswith(".toml") and not p.name.endswith("_reference.toml")),
                    key=lambda p: p.name)
     return {p.name[:-5]: p for p in items}
-
-
-def list_cases() -> dict:
-    """``{name: title}`` of the shipped cases (``bearing-lab validate --list``).
-
-    See Also
-    --------
-    shipped_cases, load_case, default_set
-
-    Examples
-    --------
-    >>> list_cases()["cwru-130"]
-    'CWRU record 130: drive end, outer race 0.007 in at 6:00 (load zone), 0 hp, 12 kHz'
-    """
-    return {n: load_case(n).title for n in shipped_cases()}
 
 
 # ------------------------------------------------------------------ checks
@@ -333,75 +315,3 @@ def parse_tolerances(name, raw, *, where="tolerances", allowed=None) -> dict:
         except ValidationCaseError as exc:
             raise case_error(name, f"{where}.{q}: {exc}") from None
     return out
-
-
-# ------------------------------------------------------------------ loading
-def _read(spec):
-    """(name guess, source text, base dir, raw text) for a shipped name or a file path."""
-    spec = str(spec)
-    shipped = shipped_cases()
-    if spec in shipped:
-        return spec, f"shipped case {spec}", _case_dir(), shipped[spec].read_text(encoding="utf-8")
-    p = Path(spec).expanduser()
-    if p.suffix == ".toml" or p.exists():
-        if not p.is_file():
-            raise ValidationCaseError(f"validation case file {spec!r} does not exist")
-        return p.stem, str(p), p.resolve().parent, p.read_text(encoding="utf-8")
-    raise ValidationCaseError(f"unknown validation case {spec!r}: not a file, and the shipped cases are "
-                              + ", ".join(shipped))
-
-
-def load_case(spec) -> ValidationCase:
-    """Load and check a case: a shipped name (``paper``, ``cwru-130``) or a TOML path.
-
-    Parameters
-    ----------
-    spec : str or path
-        A shipped case's name (:func:`list_cases`) or a case file (``docs/case-format.md``).
-
-    Returns
-    -------
-    ValidationCase
-
-    Raises
-    ------
-    ValidationCaseError
-        Unknown case, invalid TOML, an unknown key (named), an invalid value, a tolerance
-        without a reason, an invalid scene or scene key.  (A missing recording file is
-        checked by :func:`check_case`.)
-
-    See Also
-    --------
-    list_cases, check_case, run_case
-
-    Examples
-    --------
-    >>> case = load_case("paper")
-    >>> case.kind, case.default
-    ('paper', True)
-    >>> case.tolerances["excitation_period"].text()       # every tolerance carries its reason
-    '±0.5 %'
-    """
-    stem, source, base_dir, text = _read(spec)
-    try:
-        raw = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ValidationCaseError(f"validation case {source!r} is not valid TOML: {exc}") from None
-    name = str(raw.get("name") or stem)
-    kind = raw.get("kind", "recording")
-    check_choice(kind, ("recording", "paper"), "kind", partial(case_error, name))
-    top = _TOP_PAPER if kind == "paper" else _TOP_RECORDING
-    bad = sorted(set(raw) - top)
-    if bad:
-        hint = (" ([[run]] tables belong to paper cases; a healthy recording of the same rig goes in "
-                "[reference])" if bad[0] == "run" else "")
-        raise case_error(name, f"unknown key {bad[0]!r}{hint}; allowed top-level keys are {', '.join(sorted(top))}")
-    case = ValidationCase(name=name, title=str(raw.get("title", name)), kind=kind, source=source, text=text,
-                          data=raw, base_dir=base_dir, default=bool(raw.get("default", False)))
-    from .case_checks import check_paper, check_recording
-    (check_paper if kind == "paper" else check_recording)(case)
-    from dataclasses import replace
-    for attr in ("tolerances", "reference_tolerances"):
-        setattr(case, attr, {q: replace(t, declared_by=case.author) if t.known_limitation else t
-                             for q, t in getattr(case, attr).items()})
-    return case

@@ -1,4 +1,4 @@
-"""Section checks of the two case kinds (recording, paper), run by :func:`~bearing_lab.validation.case.load_case`.
+"""Section checks of the two case kinds (recording, paper), run by :func:`~bearing_lab.validation.load.load_case`.
 
 Every value is checked here, once, with one wording: ``validation case 'NAME':
 section.key = value: what is wrong``.  A scene the case describes is built once with a

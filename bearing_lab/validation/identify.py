@@ -284,14 +284,14 @@ def _run_grid(setting, base, grid, *, scheduler, cache_dir, bar, out, keep, jour
 
 def _digest(base, point) -> str:
     """The sweep's cache key of the scene ``point`` over ``base`` (what the journal is keyed on)."""
-    from ..sweeps import scene_hash
+    from ..sweep import scene_hash
     return scene_hash(base.replace(**point).to_toml(), {})
 
 
 def _sweep_scored(setting, base, params, combos, scored, digests, *, scheduler, cache_dir, bar, keep, journal):
     """One sweep over ``params`` (whose C-order scenes are ``combos``); each scene is scored into ``scored``
     (and the journal) as it finishes."""
-    from ..sweeps import sweep
+    from ..sweep import run_sweep
     from .candidates import candidate_signature
     keys = list(params)
 
@@ -306,11 +306,11 @@ def _sweep_scored(setting, base, params, combos, scored, digests, *, scheduler, 
             keep.update(score_db=m["score_db"], signature=sig)
         if bar is not None:
             bar.scene(built_table=c in bar.builds)
-    sweep(base, params, scheduler=scheduler, cache_dir=cache_dir, progress=False, metrics=False, on_scene=on_scene)
+    run_sweep(base, params, scheduler=scheduler, cache_dir=cache_dir, progress=False, metrics=False, on_scene=on_scene)
 
 
 def ds_dim(key):
-    from ..sweeps import dim_name
+    from ..sweep import dim_name
     return dim_name(key)
 
 
@@ -378,7 +378,7 @@ def identify(case, *, grid=None, refine=True, scheduler="serial", n_workers=None
         parameter moved by 1 % of its grid step; the interval threshold is at least twice the score change),
         profiles walked by minimisation, and the polish (see the module docstring).  False: the coarse grid's
         scores alone (profiles are then upper bounds at the grid values).
-    scheduler, n_workers, cache_dir : as :func:`bearing_lab.sweeps.sweep` (default serial, in process; no sweep
+    scheduler, n_workers, cache_dir : as :func:`bearing_lab.sweep.run_sweep` (default serial, in process; no sweep
         cache: it keeps every simulated variable, about 3.6 MB per scene of 1 s at 20 kHz; the contact tables
         are cached regardless).
     level_weight : float, optional
@@ -405,7 +405,7 @@ def identify(case, *, grid=None, refine=True, scheduler="serial", n_workers=None
     --------
     bearing_lab.validation.load_case, bearing_lab.validation.make_standin_recording
     """
-    from . import load_case
+    from .load import load_case
     from .identify_run import Progress
     t_cpu, t_wall = time.process_time(), time.perf_counter()
     case = case if hasattr(case, "section") else load_case(case)
@@ -482,13 +482,13 @@ def _setting(case, mirror, level_weight):
     of a loaded case."""
     from .candidates import setting_for
     from .recording import open_spec
-    from .recording_case import prepare
+    from .recording_case import comparison_band, prepare
     from .rig import background_for, path_for
     prep = prepare(case, mirror=mirror)
     m = prep.measured["record"]
     path = path_for(case, prep.recording, m, prep.simulated["model"], mirror=mirror)
     reference = open_spec(case.reference, case.name, mirror) if case.reference is not None else None
-    bg = background_for(case, prep.recording, m, reference)
+    bg = background_for(case, prep.recording, m, reference, band=comparison_band(prep.fs))
     st = setting_for(prep, path, bg, level_weight=level_weight)
     return st, base_scene(case, prep)
 
@@ -497,7 +497,7 @@ def base_scene(case, prep):
     """The scene every candidate is a change of: the case's, at the recording's measured speed, sampling
     rate and length, with the comparison's solver settings (``prep``: the prepared recording)."""
     from . import simulation
-    from .candidates import comparison_overrides
+    from .recording_case import comparison_overrides
     return simulation.build_scene(case, rpm=prep.speed.rpm, fs=prep.fs, duration=prep.n / prep.fs,
                                   overrides=comparison_overrides(case))
 

@@ -26,7 +26,7 @@ _VARS = {"score_db": "misfit score (shape + weight x |level|)",
 def landscape(result):
     import xarray as xr
     from .._version import __version__
-    from ..sweeps import dim_name, key_units
+    from ..sweep import dim_name, key_units
     keys = list(result.grid)
     vals = [sorted(result.grid[k]) for k in keys]
     shape = tuple(len(v) for v in vals)

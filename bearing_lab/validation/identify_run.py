@@ -7,7 +7,7 @@
   still to build;
 - :class:`Journal`: every scored scene appended to a small JSON-lines file as it finishes, so a run that is
   stopped (Ctrl-C, a kill) resumes where it stopped: a scene found there is read back, not simulated again.
-  Each entry holds the sweep's scene hash (:func:`bearing_lab.sweeps.scene_hash`: the resolved scene, the
+  Each entry holds the sweep's scene hash (:func:`bearing_lab.sweep.scene_hash`: the resolved scene, the
   simulator's version and source) and the file starts with a fingerprint of the comparison (the recording's
   signature, the path, background, amplitude weight and the scoring code); a journal of another comparison
   is set aside, never mixed in.

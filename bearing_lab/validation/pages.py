@@ -95,8 +95,7 @@ def verdict_html(rows, author) -> str:
 def verdict_legend(entries: list) -> str:
     """The index's opening: the overall verdict in words, then what each verdict and the exit status mean."""
     from ..report import esc
-    from .rows import VERDICTS
-    from .runner import EXIT_STATUS
+    from .rows import EXIT_STATUS, VERDICTS
     n_unexp = sum(len(e.get("failing") or []) for e in entries)
     n_decl = sum(len(e.get("known") or []) for e in entries)
     errors = [e["case"] for e in entries if e.get("status") == "error"]

@@ -4,7 +4,7 @@ The experiment column holds what the paper *measured* (its Table 2 lines, its im
 period, its waveform amplitudes); the kinematic value at the paper's stated speed is
 shown in a separate reference column, never as the experiment.  The paper's own
 simulated numbers are shown beside ours.  The section-5 studies run through a normal
-import of :func:`bearing_lab.studies.run_paper_studies`.
+import of :func:`bearing_lab.studies.paper.run_paper_studies`.
 
 Public API
 ----------
@@ -110,7 +110,7 @@ def study_rows(case, table, reference):
 def _studies(case, out_dir):
     if not case.section("studies").get("enabled", False):
         return None
-    from ..studies import run_paper_studies
+    from ..studies.paper import run_paper_studies
     t0 = time.perf_counter()
     table = run_paper_studies(out_dir / "studies", progress=False)
     rows, trends = study_rows(case, table, case.data["_reference_data"])
@@ -120,7 +120,7 @@ def _studies(case, out_dir):
 
 def run_paper_case(case, out_dir, *, steps):
     from ..bearings import get_bearing
-    from .recording_case import CaseResult
+    from .evaluate import CaseResult
     ref = case.data["_reference_data"]
     rpm = float(ref["speed_rpm"])
     geom = get_bearing(case.data.get("bearing", ref.get("bearing", "6308")))
@@ -147,7 +147,7 @@ def run_paper_case(case, out_dir, *, steps):
         extra["compute"][label] = {"wall_time_s": float(ds.attrs["wall_time_s"]),
                                    "compile_time_s": float(ds.attrs.get("compile_time_s", 0.0))}
         prov[f"scene ({label})"] = scene.to_toml()
-        from .recording_parts import model_details
+        from .simulation import model_details
         extra.setdefault("model", {})[label] = model_details(ds)
         steps.step(f"simulate {label}")
     studies = _studies(case, out_dir)
@@ -166,7 +166,7 @@ def run_paper_case(case, out_dir, *, steps):
         ("figures", "Waveforms and spectra (the paper's Figs 8-11)", figs + [figures.envelope_spectra(result)])]
     if studies:
         sections.append(("table", "Section 5 trends (2-D defect studies)", {"rows": studies["trends"], "intro": (
-            f"From bearing_lab.studies.run_paper_studies ({studies['seconds']:.1f} s); its own page with the pulse "
+            f"From bearing_lab.studies.paper.run_paper_studies ({studies['seconds']:.1f} s); its own page with the pulse "
             "figures: studies/index.html. A trend counts as reproduced when it is monotonic over the study's three "
             "cases.")}))
         extra["studies"] = {"trends": studies["trends"], "table": studies["table"]}

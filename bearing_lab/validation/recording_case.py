@@ -1,9 +1,11 @@
-"""A recording case, step by step: open, speed, simulate, fixed path, background, measure, rows.
+"""A recording case's measuring layer: the recording opened and measured once, the declared scene
+simulated, and how every comparison of the case simulates and times its impacts.
 
 Each step is one function with plain inputs, so the defect identification that follows
 (many candidate geometries against one recording) reuses :func:`prepare` (the
-recording side, done once), :func:`simulate_signals` (one candidate through the fixed
-path and background) and :func:`evaluate_rows`.
+recording side, done once) and :func:`simulate_signals` (one candidate through the fixed
+path and background).  The rows are made by :mod:`.evaluate`, the whole case is run by
+:mod:`.recording_run`.
 
 Public API
 ----------
@@ -11,8 +13,9 @@ Prepared                                  -- recording, speed, bearing, scene, m
 prepare(case, *, mirror=None) -> Prepared -- recording opened and measured; declared scene simulated
 simulate_signals(prep, path, background, *, scene=None) -> (signals, datasets)
 measure_signals(prep, signals) -> {signal: measure() dict}
-evaluate_rows(case, tolerances, exp, sim, *, context, group="") -> rows
-run_recording_case(case, *, steps, mirror=None) -> CaseResult
+scene_overrides(case), comparison_overrides(case) -- scene keys of the declared scene, of every compared scene
+comparison_band(fs, band_hz=None), impact_period(case, measured) -- where and when impacts are timed
+declared_fault(case)                      -- the fault family of the declared defects
 """
 from __future__ import annotations
 
@@ -22,25 +25,11 @@ import numpy as np
 
 from ..analysis.measurement import measure
 from . import simulation
-from .quantities import QUANTITIES, value_of
 from .recording import open_spec
-from .rows import make_row
 from .speed import resolve_speed
 
-__all__ = ["Prepared", "prepare", "simulate_signals", "measure_signals", "evaluate_rows", "run_recording_case",
-           "CaseResult"]
-
-
-@dataclass
-class CaseResult:
-    """What a case computed, for the report and summary.json."""
-
-    rows: list
-    comparison: object
-    extra: dict = field(default_factory=dict)
-    provenance: dict = field(default_factory=dict)
-    sections: list = field(default_factory=list)   # (kind, title, payload) in page order
-    path: object = None
+__all__ = ["Prepared", "prepare", "simulate_signals", "measure_signals", "scene_overrides", "declared_fault",
+           "comparison_overrides", "comparison_band", "impact_period", "DEFAULT_BAND_HZ", "COMPARISON_RTOL"]
 
 
 @dataclass
@@ -125,99 +114,47 @@ def measure_signals(prep, signals: dict) -> dict:
             for k, v in signals.items()}
 
 
-def _notes(q, sim_m, exp_m) -> str:
-    if not isinstance(q.measured, str):
-        return ""
-    parts = []
-    for who, m in (("simulation", sim_m), ("recording", exp_m)):
-        if q.measured in m["extras"]["notes"]:
-            parts.append(f"{who}: " + m["extras"]["notes"][q.measured])
-    margins = [(who, m["extras"].get("families", {}).get(q.measured, {}).get("evidence_margin_score"))
-               for who, m in (("simulation", sim_m), ("recording", exp_m))]
-    if any(v is not None for _, v in margins):
-        parts.append("family evidence score over the decoy threshold (a sum of line-to-floor ratios in dB over "
-                     "the family's lines: a score, not a level): " + ", ".join(
-                         f"{who} {v:+.1f}" for who, v in margins if v is not None))
-    return "; ".join(parts)
+#: the signature's band: above the machine tones and the shaft harmonics (all below 1 kHz on
+#: bench rigs), up to 0.45 fs (the anti-alias filter's flat part); a broad band keeps the
+#: entry and exit events apart in time (a narrow band would smear them over 1/bandwidth)
+DEFAULT_BAND_HZ = (1000.0, None)
 
 
-def evaluate_rows(tolerances: dict, exp: dict, sim: dict, *, context: dict, group="") -> list:
-    """Rows for the case's tolerances from measured dicts.
+def comparison_band(fs, band_hz=None) -> tuple:
+    """The band (Hz) impacts are timed and enveloped in: ``band_hz`` or :data:`DEFAULT_BAND_HZ`, an open
+    upper edge at 0.45 fs."""
+    lo, hi = band_hz or DEFAULT_BAND_HZ
+    return float(lo), float(hi) if hi else 0.45 * fs
 
-    ``exp``: span -> measure() dict of the recording; ``sim``: signal -> measure() dict.
-    ``context``: ``path`` (StructuralPath), ``path_fitted_here``, ``speed_estimated`` and
-    ``background_from_recording`` (bools: the number then is not independent evidence),
-    ``ratio`` (companion: {"experiment": value, "simulation": value, "label": str}) and
-    ``span_text`` (span -> description).
-    """
-    rows = []
-    path = context["path"]
-    for key, tol in tolerances.items():
-        q = QUANTITIES[key]
-        s, e = value_of(q, sim[q.signal]), value_of(q, exp[q.span])
-        note = _notes(q, sim[q.signal], exp[q.span])
-        if q.ratio:
-            other = context.get("ratio") or {}
-            s = s / other["simulation"] if other.get("simulation") else float("nan")
-            e = e / other["experiment"] if other.get("experiment") else float("nan")
-            note = other.get("note", "")
-        untrusted = ""
-        if q.signal != "model" and path.status in ("degraded", "failed"):
-            untrusted = f"the structural path is {path.status} (" + "; ".join(path.problems) + ")"
-        independent = not ((q.path_fit and context.get("path_fitted_here"))
-                           or (key == "shaft_hz" and context.get("speed_estimated"))
-                           or (q.signal == "path+background" and context.get("background_from_recording")))
-        label = (f"{group}: " if group else "") + q.label + (f" ({context['ratio']['label']})" if q.ratio else "")
-        rows.append(make_row((f"{group}: " if group else "") + key, s, e, tol, label=label, units=q.units,
-                             note=note, signal=q.signal, span=context["span_text"][q.span],
-                             independent=independent, untrusted=untrusted,
-                             absence_agrees=key in ("bpfo", "bpfi")))
-    return rows
+#: solver tolerance of every scene a comparison simulates (candidates, identification grid) unless the
+#: case's ``[scene] set`` gives ``solver.rtol``.  Measured on a stand-in of paper O1 (H = B/3): at the
+#: defect auto rule's rtol 1e-4 the true candidate's score differs from a converged one (dp54, rtol 1e-8,
+#: 2 us ceiling) by 0.16 dB, half the 0.3 dB interval threshold; at 1e-6 by < 0.01 dB
+COMPARISON_RTOL = 1e-6
 
 
-def run_recording_case(case, *, steps, mirror=None) -> CaseResult:
-    """Run a recording case (see the module docstring); the report is assembled by the caller."""
-    from . import recording_parts as parts
-    prep = prepare(case, mirror=mirror)
-    steps.step("recording and declared scene")
-    from .rig import background_for, path_for
-    path = path_for(case, prep.recording, prep.measured["record"], prep.simulated["model"], mirror=mirror)
-    reference = open_spec(case.reference, case.name, mirror) if case.reference is not None else None
-    model = path.apply(prep.simulated["model"], prep.fs) if path.status in ("ok", "given") else None
-    background = background_for(case, prep.recording, prep.measured["record"], reference, model=model)
-    steps.step("structural path and background")
-    signals = simulate_signals(prep, path, background)
-    sim_m = measure_signals(prep, signals)
-    context = parts.context(case, prep, path, background)
-    if "ratio" in case.data:
-        context["ratio"] = parts.ratio_companion(case, prep, path, mirror=mirror)
-    rows = evaluate_rows(case.tolerances, prep.measured, sim_m, context=context)
-    steps.step("measure and compare")
-    healthy = parts.healthy_reference(case, prep, path, background, reference) if reference is not None else None
-    if healthy:
-        rows += healthy["rows"]
-    err = (simulation.numerical_error(prep.scene, prep.dataset,
-                                      duration=float(case.section("numerical_error").get("duration_s", 0.25)))
-           if case.section("numerical_error").get("enabled", True) else {})
-    steps.step("numerical error")
-    return parts.assemble(case, prep, path, background, signals, rows, err, healthy, context)
+def comparison_overrides(case) -> dict:
+    """Scene keys every simulated candidate of ``case`` gets: sensor off (a path is applied), the
+    comparison's solver tolerance unless the case sets its own."""
+    ov = scene_overrides(case)
+    if "solver.rtol" not in (case.section("scene").get("set", {}) or {}):
+        ov["solver.rtol"] = COMPARISON_RTOL
+    return ov
 
 
-def compare_candidates(prep, path, background, candidates: dict, *, tolerances=None, context=None) -> dict:
-    """Rows of candidate defect geometries against the recording, through the *same* fixed path and
-    background (never re-fitted per candidate).
+_FAMILY = {"outer": "bpfo", "inner": "bpfi"}
 
-    ``candidates``: label -> scene keys (``{"defect.offset_mm": 0.33}``) applied to the case's scene.
-    Returns label -> rows.
-    """
-    case = prep.case
-    tolerances = tolerances or case.tolerances
-    ctx = context or {"path": path, "span_text": {"record": "recording: whole record", "segment": "recording: segment"}}
-    out = {}
-    for label, ov in candidates.items():
-        scene = simulation.build_scene(case, rpm=prep.speed.rpm, fs=prep.fs, duration=prep.n / prep.fs,
-                                       overrides={**scene_overrides(case), **ov})
-        sig = simulate_signals(prep, path, background, scene=scene)
-        out[label] = evaluate_rows({k: v for k, v in tolerances.items() if not QUANTITIES[k].ratio},
-                                   prep.measured, measure_signals(prep, sig), context=ctx)
-    return out
+
+def impact_period(case, measured) -> tuple:
+    """The impact period (s) and a note: the measured one, else the declared defect race's measured
+    fault line (``nan`` and no note when neither is there)."""
+    period = float(measured["excitation_period"])
+    if np.isfinite(period):
+        return period, ""
+    races = {str(d.get("race", "outer")) for d in case.data.get("defect", [])}
+    fam = _FAMILY.get(races.pop()) if len(races) == 1 else None
+    if fam and np.isfinite(measured[fam]):
+        return 1.0 / float(measured[fam]), (f"no fault was diagnosed on its own; the impacts are timed at the measured "
+                                            f"{fam.upper()} line ({float(measured[fam]):.2f} Hz) of the declared "
+                                            "defect's race")
+    return float("nan"), ""

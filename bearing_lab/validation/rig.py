@@ -17,7 +17,7 @@ Public API
 ----------
 identify_path(case, *, mirror=None) -> StructuralPath   -- (cached per case) the fitted path of a case
 path_for(case, rec, measured, sim_x, *, mirror=None) -> StructuralPath
-background_for(case, rec, measured, reference=None) -> Background | None
+background_for(case, rec, measured, reference=None, *, model=None, band=None) -> Background | None
 """
 from __future__ import annotations
 
@@ -28,6 +28,7 @@ import numpy as np
 
 from ..analysis.structural_path import Resonance, StructuralPath, fit_structural_path
 from ..errors import AnalysisError, ValidationCaseError
+from .recording_case import comparison_band, comparison_overrides, impact_period, prepare
 
 __all__ = ["identify_path", "path_for", "background_for", "PATH_DEFAULT_BOUNDS"]
 
@@ -78,7 +79,6 @@ def _gain_on_signature(case, path, rec, measured, sim_x, period):
     recording's own background, then peaks where the recording's does.  The fitted ``gain`` (matched to the
     impact peaks, for the validation's waveform quantities) is left as it is."""
     from ..analysis.impacts import impact_times
-    from .candidates import comparison_band
     from .signature import impact_signature
     fs = rec.fs
     band = comparison_band(fs)
@@ -151,8 +151,6 @@ def identify_path(case, *, mirror=None) -> StructuralPath:
     key = (case.source, mirror)
     if key not in _CACHE:
         from . import simulation
-        from .candidates import comparison_overrides
-        from .recording_case import prepare
         prep = prepare(case, mirror=mirror)
         scene = simulation.build_scene(case, rpm=prep.speed.rpm, fs=prep.fs, duration=prep.n / prep.fs,
                                        overrides=comparison_overrides(case))
@@ -176,7 +174,8 @@ def path_for(case, rec, measured, sim_x, *, mirror=None) -> StructuralPath:
         path.source = f"read from {p.name} ({path.source})"
         return path
     if sp.get("from_case"):
-        from .case import load_case, shipped_cases
+        from .case import shipped_cases
+        from .load import load_case
         ref = str(sp["from_case"])
         if ref not in shipped_cases() and case.base_dir is not None and not Path(ref).expanduser().is_absolute():
             beside = Path(str(case.base_dir)) / ref      # a relative file is read beside this case's file
@@ -190,18 +189,20 @@ def path_for(case, rec, measured, sim_x, *, mirror=None) -> StructuralPath:
     return path
 
 
-def background_for(case, rec, measured, reference=None, *, model=None):
+def background_for(case, rec, measured, reference=None, *, model=None, band=None):
     """The rig's background (tones and broadband), or None when ``[background] enabled = false``.
 
     ``model``: the declared scene's signal through the path; measured on the recording itself, the
     background is then what that model does not explain (its own power is removed, so a recording the
-    model explains fully gets no background added a second time)."""
+    model explains fully gets no background added a second time).  ``band``: the band (Hz) the
+    comparison times impacts in, where the recording's own impact train is not diagnosed (default
+    :func:`~bearing_lab.validation.recording_case.comparison_band` at the recording's rate)."""
     if not case.section("background").get("enabled", True):
         return None
-    return _measured_background(case, rec, measured, reference, model=model)
+    return _measured_background(case, rec, measured, reference, model=model, band=band)
 
 
-def _measured_background(case, rec, measured, reference, *, model=None):
+def _measured_background(case, rec, measured, reference, *, model=None, band=None):
     from ..analysis.background import estimate_background
     cfg = case.section("background")
     src = cfg.get("source", "auto")
@@ -219,10 +220,9 @@ def _measured_background(case, rec, measured, reference, *, model=None):
         # no impact train diagnosed on its own: time the impacts at the declared defect's fault line,
         # as the comparison does; measured over the whole record the background would hold the impacts
         from ..analysis.impacts import impact_times
-        from .candidates import comparison_band, impact_period
         period, note = impact_period(case, measured)
         if np.isfinite(period):
-            times = impact_times(rec.x, rec.fs, period, band=comparison_band(rec.fs))
+            times = impact_times(rec.x, rec.fs, period, band=band or comparison_band(rec.fs))
             where = f"between impacts ({note})"
     rates = [measured[k] for k in ("bpfo", "bpfi") if np.isfinite(measured[k])]
     if times is None or len(times) < 3:

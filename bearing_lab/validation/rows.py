@@ -15,6 +15,7 @@ make_row(quantity, simulation, experiment, tolerance, ...) -> dict
 row_status(row) -> "pass" | "known limitation" | "fail"
 case_verdict(rows) -> dict                          -- a case's verdict in words and its three counts
 VERDICTS                                            -- verdict -> what it means (CLI, pages, docs)
+EXIT_STATUS                                         -- what `bearing-lab validate` returns, in words (--help, pages, docs)
 ROW_KEYS                                            -- the keys every row has (summary.json, netCDF)
 """
 from __future__ import annotations
@@ -24,7 +25,8 @@ from dataclasses import dataclass
 
 from ..errors import ValidationCaseError, check_choice
 
-__all__ = ["Tolerance", "make_row", "row_status", "case_verdict", "VERDICTS", "ROW_KEYS", "TOLERANCE_KINDS"]
+__all__ = ["Tolerance", "make_row", "row_status", "case_verdict", "VERDICTS", "EXIT_STATUS", "ROW_KEYS",
+           "TOLERANCE_KINDS"]
 
 TOLERANCE_KINDS = ("pct", "factor")
 
@@ -33,6 +35,12 @@ ROW_KEYS = ("quantity", "label", "units", "simulation", "experiment", "reference
             "difference", "difference_pct", "tolerance_pct", "tolerance", "rule", "pass", "status", "reason",
             "known_limitation", "declared_by", "note", "simulated_signal", "experiment_span", "independent",
             "paper_simulation")
+
+#: the exit status of ``bearing-lab validate`` (its --help, the index page and docs/validation.md say this)
+EXIT_STATUS = ("0: every case ran and no row fails unexplained (each failing row is a limitation its case "
+               "declares); 1: a row fails without a declared reason (an unexplained failure) or a case could "
+               "not run, and with --strict also when a declared limitation fails; 2: bad input (an unknown "
+               "case, an invalid case file, a missing recording of a named case), nothing run")
 
 #: a case's verdict -> what it means (the same words on the terminal, the pages and in summary.json)
 VERDICTS = {

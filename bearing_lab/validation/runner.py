@@ -8,7 +8,7 @@ default_set(mirror=None) -> (cases, skipped) -- the shipped cases marked default
 run_case(case, out_dir, *, progress, mirror) -> CaseOutcome
 run_validation(specs, out_dir, *, strict, progress, mirror) -> (outcomes, exit status)
 exit_status(outcomes, strict=False) -> 0 | 1                 -- what `bearing-lab validate` returns
-EXIT_STATUS                                                   -- its meaning, as --help and the docs say it
+                                                                (its meaning: :data:`.rows.EXIT_STATUS`)
 """
 from __future__ import annotations
 
@@ -20,16 +20,10 @@ from pathlib import Path
 
 from .._docdict import fill_doc
 from ..errors import BearingLabError, ValidationCaseError
-from .case import DEFAULT_CASE, load_case, shipped_cases
+from .case import DEFAULT_CASE, shipped_cases
+from .load import load_case
 
-__all__ = ["CaseOutcome", "check_case", "default_set", "run_case", "run_validation", "exit_status", "EXIT_STATUS"]
-
-#: the exit status of ``bearing-lab validate`` (its --help, the index page and docs/validation.md say this)
-EXIT_STATUS = ("0: every case ran and no row fails unexplained (each failing row is a limitation its case "
-               "declares); 1: a row fails without a declared reason (an unexplained failure) or a case could "
-               "not run, and with --strict also when a declared limitation fails; 2: bad input (an unknown "
-               "case, an invalid case file, a missing recording of a named case), nothing run")
-
+__all__ = ["CaseOutcome", "check_case", "default_set", "run_case", "run_validation", "exit_status"]
 
 def exit_status(outcomes, strict=False) -> int:
     """1 when a case errored or has an unexplained failure (with ``strict``: any failing row), else 0."""
@@ -210,7 +204,7 @@ def run_case(case, out_dir, *, progress=True, mirror=None, position=1) -> CaseOu
             from .paper import run_paper_case
             result = run_paper_case(case, out, steps=steps)
         else:
-            from .recording_case import run_recording_case
+            from .recording_run import run_recording_case
             result = run_recording_case(case, steps=steps, mirror=mirror)
     finally:
         steps.close()

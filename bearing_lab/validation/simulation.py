@@ -122,3 +122,10 @@ def scene_from(scene, *, rpm, fs, duration, overrides=None, case_name=""):
         return load_scene(scene, **ov)
     except SceneError as exc:
         raise ValidationCaseError(f"validation case {case_name!r}: scene {scene!r}: {exc}") from None
+
+
+def model_details(ds) -> dict:
+    """What the simulation that ran assumed (fidelity, contact and cage models, load path, solver)."""
+    keys = ("bearing", "fidelity", "defect_contact_models", "cage_model", "load_path", "solver_method",
+            "solver_rtol", "sensor_resonator", "anti_alias")
+    return {k: ds.attrs.get(k) for k in keys if k in ds.attrs}

@@ -164,6 +164,17 @@ def test_cli_fs_for_a_file_without_sampling_rate(tmp_path, capsys):
     assert r["speed_source"] == "file" and r["speed"]["prior_hz"] == pytest.approx(1797 / 60)
 
 
+def test_cli_fs_overrides_the_rate_of_a_reader_without_an_fs_option(tmp_path, capsys):
+    """netCDF files are read as they are (the reader takes no fs): --fs is applied after reading
+    and the result says so; another reader's refusal is not taken for this one."""
+    x, fs, fr = _outer_race_signal()
+    path = _nc(tmp_path, x, fs)
+    assert main(["analyze", str(path), "--fs", str(2 * fs), "--json"]) == 0
+    r = json.loads(capsys.readouterr().out)
+    assert r["sampling_rate_hz"] == 2 * fs
+    assert r["notes"][0] == f"--fs {2 * fs:g} Hz overrides the file's {fs} Hz"
+
+
 def test_cli_rpm_none_ignores_the_stored_speed(tmp_path, capsys):
     x, fs, fr = _outer_race_signal()
     path = _nc(tmp_path, x, fs)

@@ -44,6 +44,23 @@ def test_report_html_is_self_contained_and_round_trips(tmp_path):
     assert not list((tmp_path / "r").glob(".*"))      # no temporary files left by the atomic write
 
 
+def test_a_page_without_verdict_for_studies_and_bench(tmp_path):
+    """verdict=False: the same sections and look, without the validation badge, the rows count and
+    the link up to the case index; kept through the JSON round trip."""
+    r = Report("Speed against error", verdict=False)
+    fig = Figure(figsize=(4, 2))
+    fig.subplots().plot(np.arange(10))
+    r.add_figure(fig, "A figure")
+    r.add_table([{"a": 1.5}], "A table")
+    html = r.save(tmp_path / "index.html").read_text()
+    assert html.count("data:image/png;base64,") == 1 and 'id="a-table"' in html
+    assert "<span class=\"badge" not in html and "rows pass" not in html and "all validation cases" not in html
+    assert "Speed against error" in html and "by bearing_lab 0.1.0" in html
+    back = Report.load(r.save(tmp_path / "r.json"))
+    assert "<span class=\"badge" not in back.to_html()
+    assert "<span class=\"badge" in Report("a case").to_html()      # the default page keeps its verdict
+
+
 def test_rows_table_and_index(tmp_path):
     t = rows_table(_rows(), show_reference=True, show_paper=True)
     assert "reference (not the experiment)" in t and "paper&#x27;s own simulation" in t and t.count("<tr") == 4

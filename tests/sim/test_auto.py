@@ -49,12 +49,12 @@ STUDY = Path(__file__).resolve().parents[2] / "bearing_lab" / "sim" / "auto_rate
 
 
 def _study_rows():
-    from bearing_lab.bench import read_rate_study
+    from bearing_lab.studies.bench import read_rate_study
     return read_rate_study(STUDY)
 
 
 def _within(r):
-    from bearing_lab.bench import TOL_PEAK, TOL_PERIOD
+    from bearing_lab.studies.bench_common import TOL_PEAK, TOL_PERIOD
     period_ok = (not np.isfinite(r["ref_period"])) or (np.isfinite(r["err_period"]) and r["err_period"] <= TOL_PERIOD)
     return np.isfinite(r["err_peak"]) and r["err_peak"] <= TOL_PEAK and period_ok
 
@@ -88,7 +88,7 @@ def test_rule_chosen_at_each_rate_held_on_every_scene_of_the_written_study():
 def test_rate_rules_are_the_cheapest_within_tolerance_in_the_study():
     """The shipped rules by rate are the cheapest setting within tolerance on every scene of the
     shipped study at that rate (so the study shipped is the one behind them)."""
-    from bearing_lab.bench import rate_choices
+    from bearing_lab.studies.bench import rate_choices
     from bearing_lab.sim.auto import load_rules
     rows = _study_rows()
     bands = {b["max_rate_hz"]: b for b in load_rules()["defect"]["by_rate"]}
@@ -128,7 +128,7 @@ def test_a_defect_the_3d_track_leaves_takes_the_healthy_rule_within_its_toleranc
     axial the track runs 1.13 mm the other way and leaves it.  Independent check that it is missed:
     the converged run is the converged run of the same bearing without the defect.  The healthy
     rule is taken, recorded with the track, and holds the 1 % peak tolerance."""
-    from bearing_lab.bench import TOL_PEAK
+    from bearing_lab.studies.bench_common import TOL_PEAK
     from bearing_lab.sim import load_scene
     from bearing_lab.sim.auto import load_rules, resolve
     ov = {"defect.offset_mm": -2.3, "load.axial_n": 300.0}

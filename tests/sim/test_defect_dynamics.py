@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from bearing_lab import get_bearing, simulate
-from bearing_lab.studies import PAPER_OFFSET_RATIOS, run_paper_studies
+from bearing_lab.studies.paper import PAPER_OFFSET_RATIOS, run_paper_studies
 
 
 def _ses_peak(x, fs, lo, hi):

@@ -122,7 +122,7 @@ def test_failed_equilibrium_is_a_solver_error(monkeypatch):
 
 def test_dask_cluster_that_fails_to_start(monkeypatch):
     import dask.distributed
-    from bearing_lab import sweep
+    from bearing_lab import run_sweep
 
     class Broken:
         def __init__(self, *a, **k):
@@ -130,8 +130,8 @@ def test_dask_cluster_that_fails_to_start(monkeypatch):
 
     monkeypatch.setattr(dask.distributed, "LocalCluster", Broken)
     with pytest.raises(BearingLabError, match=r"local Dask cluster .* did not start .*serial"):
-        sweep("paper-healthy", {"speed_rpm": [900, 1800]}, cache_dir=False, progress=False,
-              duration=0.005)
+        run_sweep("paper-healthy", {"speed_rpm": [900, 1800]}, cache_dir=False, progress=False,
+                  duration=0.005)
 
 
 def test_overdamped_sensor_counts_the_stiffness_it_implies():

@@ -72,7 +72,7 @@ def test_progress_moves_with_every_scene_and_counts_the_tables_left(rig):
 
 def _counting_runner(monkeypatch, stop_after=None):
     """Count the scenes simulated (the sweep's scene runner); raise KeyboardInterrupt on scene ``stop_after``+1."""
-    import bearing_lab.sweeps as sw
+    import bearing_lab.sweep as sw
     real, ran = sw._simulate_scene, []
 
     def run(*a, **k):

@@ -8,7 +8,7 @@ from bearing_lab.analysis.structural_path import StructuralPath
 from bearing_lab.errors import ValidationCaseError
 from bearing_lab.validation import QUANTITIES, Tolerance, make_row
 from bearing_lab.validation.quantities import SIGNALS, SPANS
-from bearing_lab.validation.recording_case import evaluate_rows
+from bearing_lab.validation.evaluate import evaluate_rows
 
 NAN = float("nan")
 

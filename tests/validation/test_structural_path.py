@@ -129,7 +129,7 @@ def test_from_case_file_is_read_beside_the_case(tmp_path, monkeypatch):
     """A relative ``from_case`` file names a case beside the case file, wherever the user runs from."""
     from tests.validation._standins import case_text
     from bearing_lab.validation import rig
-    from bearing_lab.validation.case import load_case
+    from bearing_lab.validation.load import load_case
     rigdir, elsewhere = tmp_path / "rig", tmp_path / "elsewhere"
     rigdir.mkdir(), elsewhere.mkdir()
     (rigdir / "calib.toml").write_text(case_text("calib", "calib.uff", length_mm=3.0, width_mm=1.0))

@@ -98,7 +98,8 @@ def test_break_it_a_wrong_speed_fails_the_kinematic_rows(walked):
 def test_break_it_a_wrong_geometry_fails_through_the_fixed_path_but_passes_with_a_refit(walked):
     """The issue the fixed path solves: a path re-fitted to each geometry absorbs the geometry's effect."""
     from bearing_lab.validation import load_case
-    from bearing_lab.validation.recording_case import compare_candidates, prepare
+    from bearing_lab.validation.evaluate import compare_candidates
+    from bearing_lab.validation.recording_case import prepare
     from bearing_lab.validation.rig import background_for, path_for
     case = load_case(walked / "rig.toml")
     prep = prepare(case)

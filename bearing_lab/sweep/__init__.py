@@ -1,6 +1,6 @@
 """Parameter sweeps: many scenes, one labelled Dataset, run in parallel on Dask.
 
-``sweep(scene, {"defect.offset_mm": [0, 0.25, 0.5], "speed_rpm": [900, 1800]})``
+``run_sweep(scene, {"defect.offset_mm": [0, 0.25, 0.5], "speed_rpm": [900, 1800]})``
 simulates every combination of the swept values (a full grid) and returns one
 :class:`xarray.Dataset` with a dimension per swept key:
 
@@ -64,13 +64,13 @@ import uuid
 
 import numpy as np
 
-from ._version import __version__
-from .errors import BearingLabError, SceneError
-from ._sweep_store import (CacheWarning, checksum_path as _checksum_path,  # noqa: F401
+from .._version import __version__
+from ..errors import BearingLabError, SceneError
+from .store import (CacheWarning, checksum_path as _checksum_path,  # noqa: F401
                            from_cache as _from_cache, METRIC_SIGNAL as _METRIC_SIGNAL,
                            SWEEP_METRICS as _METRICS, Stack as _Stack, write_cache as _write_cache)
 
-__all__ = ["sweep", "scene_hash", "code_fingerprint", "default_cache_dir", "dim_name", "key_units",
+__all__ = ["run_sweep", "scene_hash", "code_fingerprint", "default_cache_dir", "dim_name", "key_units",
            "CacheWarning"]
 
 # units of the --set key suffixes (scene.py's _SUFFIX), as CF/UDUNITS strings
@@ -104,11 +104,21 @@ def key_units(key: str) -> str | None:
 
 
 def _canonical(key: str) -> str:
-    from .sim.scene import SET_ALIASES as _ALIASES
+    from ..sim.scene import SET_ALIASES as _ALIASES
     return _ALIASES.get(key, key)
 
 
 _FINGERPRINT: list = []
+_PACKAGE_ROOT = Path(__file__).resolve().parents[1]   # bearing_lab/ (this file is bearing_lab/sweep/__init__.py)
+
+
+def _simulator_sources() -> list:
+    """The files :func:`code_fingerprint` reads: bearings.py and every module under sim/."""
+    files = sorted(f for f in [_PACKAGE_ROOT / "bearings.py", *(_PACKAGE_ROOT / "sim").rglob("*.py")]
+                   if f.is_file())
+    if not files:
+        raise BearingLabError(f"sweep: no simulator source under {_PACKAGE_ROOT} to fingerprint the cache key")
+    return files
 
 
 def code_fingerprint() -> str:
@@ -119,11 +129,10 @@ def code_fingerprint() -> str:
     version alone would hand back results of older code.
     """
     if not _FINGERPRINT:
-        root = Path(__file__).resolve().parent
+        root = _PACKAGE_ROOT
         h = hashlib.sha256()
-        for f in sorted([root / "bearings.py", *(root / "sim").rglob("*.py")]):
-            if f.is_file():
-                h.update(str(f.relative_to(root)).encode() + b"\0" + f.read_bytes() + b"\0")
+        for f in _simulator_sources():
+            h.update(str(f.relative_to(root)).encode() + b"\0" + f.read_bytes() + b"\0")
         _FINGERPRINT.append(h.hexdigest())
     return _FINGERPRINT[0]
 
@@ -140,7 +149,7 @@ def scene_hash(scene_toml: str, simulate_kwargs: dict | None = None) -> str:
 
 def _values(key, values) -> list:
     """The swept values of one key as a list (strings with units converted)."""
-    from .sim.scene import convert_value as _convert, parse_value as _parse_value
+    from ..sim.scene import convert_value as _convert, parse_value as _parse_value
     if isinstance(values, (str, bytes)) or not hasattr(values, "__iter__"):
         raise SceneError(f"sweep parameter {key!r}: give a list of values, got {values!r}")
     out = []
@@ -194,7 +203,7 @@ def _simulate_scene(scene_toml: str, digest: str, cache_path: str | None):
     The same function runs in-process (serial) and on Dask workers.
     """
     import tomllib
-    from .sim import load_scene, simulate
+    from ..sim import load_scene, simulate
     scene = load_scene(tomllib.loads(scene_toml))
     ds = simulate(scene, progress=False)
     ds.attrs["sweep_scene_hash"] = digest
@@ -206,10 +215,10 @@ def _simulate_scene(scene_toml: str, digest: str, cache_path: str | None):
 # ---------------------------------------------------------------- the sweep
 def _resolve(scene, params: dict, simulate_kwargs: dict):
     """Validate the sweep; return (keys, value lists, base Scene, fixed overrides, scenes in C order)."""
-    from .sim import load_scene
+    from ..sim import load_scene
     if not isinstance(params, dict) or not params:
         raise SceneError("sweep: give the swept parameters as a dict {key: [values, ...]}")
-    from .sim.scene import merge_overrides
+    from ..sim.scene import merge_overrides
     unknown_kw = {"progress"} & set(simulate_kwargs)
     if unknown_kw:
         raise BearingLabError("sweep: 'progress' is the sweep's own progress bar, not a simulate option")
@@ -248,7 +257,7 @@ def _resolve(scene, params: dict, simulate_kwargs: dict):
         except SceneError as exc:
             what = ", ".join(f"{k}={v!r}" for k, v in ov.items())
             raise SceneError(f"sweep scene {what}: {exc}") from None
-    from .sim.budget import check_budget
+    from ..sim.budget import check_budget
     for combo, sc in zip(itertools.product(*values), scenes):
         try:
             check_budget(sc)  # every scene, before any runs
@@ -380,7 +389,7 @@ def _assemble(acc, keys, values, shape, digests, metrics):
     out = acc.dataset(sdims, coords)
     if metrics:
         units = out[_METRIC_SIGNAL].attrs.get("units", "") if _METRIC_SIGNAL in out else ""
-        from .analysis._metrics import METRICS, metric_units
+        from ..analysis._metrics import METRICS, metric_units
         for name in _METRICS:
             out[name] = (sdims, acc.metrics[name].reshape(shape),
                          {"units": metric_units(name, units),
@@ -412,8 +421,8 @@ def _assemble(acc, keys, values, shape, digests, metrics):
     return out
 
 
-def sweep(scene, params: dict, *, scheduler=None, n_workers: int | None = None, cache_dir=None,
-          progress: bool = True, metrics: bool = True, on_scene=None, **simulate_kwargs):
+def run_sweep(scene, params: dict, *, scheduler=None, n_workers: int | None = None, cache_dir=None,
+              progress: bool = True, metrics: bool = True, on_scene=None, **simulate_kwargs):
     """Simulate every combination of swept scene keys; return one labelled Dataset.
 
     Parameters

@@ -10,7 +10,7 @@ reference per scene: the most complete model (multibody, "halfspace" contact) wi
 rtol 1e-9 and a 2 µs step ceiling.  Convergence of that reference is established by
 a second run at rtol 1e-10 with a 1 µs ceiling; their difference is reported as the
 reference's own error.  Cost is CPU time (``time.process_time``) per simulated second.
-Speed at equal accuracy (:mod:`bearing_lab.bench_speed`): each of our methods and scipy's
+Speed at equal accuracy (:mod:`bearing_lab.studies.bench_speed`): each of our methods and scipy's
 ``solve_ivp`` (LSODA, RK45, BDF, Radau on the same compiled right-hand side) at its cheapest
 setting within the tolerance, on a 0.1 s record with its own converged reference.
 
@@ -29,14 +29,13 @@ import time
 import numpy as np
 import xarray as xr
 
-from ._version import __version__
-from .sim import load_scene
-from .sim.assembly import assemble
-from .sim.integrate import METHODS, _decimate_acc, _run, _warm_up, anti_alias_taps
-from .utils._files import savefig, write_text
+from .._version import __version__
+from ..sim.assembly import assemble
+from ..sim.integrate import METHODS, _run, _warm_up, anti_alias_taps
+from ..utils._files import savefig, write_text
+from .bench_common import TOL_PEAK, TOL_PERIOD, bench_scene, measures, rel_err
+from .bench_speed import all_rows_table, equal_accuracy, tables
 
-TOL_PEAK = 0.01
-TOL_PERIOD = 0.001
 #: the defect-contact model of the reference and of the solver rows (the default); the
 #: cheaper models run once each at dp54 rtol 1e-5
 REF_CONTACT = "halfspace"
@@ -80,37 +79,6 @@ QS_SETTINGS = ([("dp54", r, None, m) for r in (1e-4, 1e-5) for m in (2.5e-5, 1e-
                + [("bs32", r, None, m) for r in (1e-3, 1e-4) for m in (2.5e-5, 1e-4)])
 
 
-def bench_scene(base, ov, duration, fidelity="multibody", model=None, cage="kinematic"):
-    sc = load_scene(base, fidelity=fidelity, **ov, **{"output.duration_s": duration, "cage.model": cage})
-    if model is not None and sc.data["defect"]:
-        raw = dict(sc.data)
-        raw["defect"] = [dict(d, contact_model=model) for d in raw["defect"]]
-        sc = load_scene(raw)
-    return sc
-
-
-def measures(acc, fs, scene):
-    """peak, RMS, excitation period, median impulse duration of an acceleration record."""
-    from .analysis import excitation_period, impulses
-    b = scene.bearing
-    fr = scene.nominal_rpm / 60
-    f0 = b.fault_frequencies(fr)
-    race = scene.defects[0].race if scene.defects else "outer"
-    fexp = f0["bpfi"] if race == "inner" else (2 * f0["bsf"] if race == "ball" else f0["bpfo"])
-    out = {"peak": float(np.max(np.abs(acc))), "rms": float(np.std(acc))}
-    from .errors import AnalysisError
-    try:
-        out["period"], _ = excitation_period(acc, fs, frequency_range=(0.9 * fexp, 1.1 * fexp))
-    except AnalysisError:  # no line family (e.g. a healthy record): no period
-        out["period"] = math.nan
-    try:
-        imp = impulses(acc, fs, min_separation=0.5 / fexp)
-        out["duration"] = float(np.median(imp.duration)) if len(imp.duration) else math.nan
-    except AnalysisError:
-        out["duration"] = math.nan
-    return out
-
-
 def _timed(asm, method, rtol, step, max_step):
     """(result, CPU seconds per simulated second): process time, so other jobs do not count."""
     t0 = time.process_time()
@@ -126,47 +94,6 @@ def _t_end(asm):
     n_out = int(round(asm.scene.duration * fs))
     m_pad = half + 2
     return asm.scene.settle - m_pad * dt_f + (m_pad + (n_out - 1) * R + m_pad + 0.5) * dt_f + 1e-9
-
-
-def scipy_acc(asm, method, rtol, max_step=2.5e-5):
-    """scipy's solve_ivp integrating the same compiled right-hand side over the same record as
-    ``_run``: (accelerometer Y, CPU seconds of the solve) -- (None, seconds) if it failed."""
-    from scipy.integrate import solve_ivp
-    from .sim import _kernels as K
-    scene = asm.scene
-    fs = scene.fs_out
-    R = int(scene.data["output"]["oversample"])
-    taps = anti_alias_taps(fs, R)
-    half = len(taps) // 2
-    dt_f = 1 / (fs * R)
-    n_out = int(round(scene.duration * fs))
-    m_pad = half + 2
-    n_fine = m_pad + (n_out - 1) * R + m_pad + 1
-    fine_t = scene.settle - m_pad * dt_f + (np.arange(n_fine + 1) - 0.5) * dt_f
-    z = asm.n_balls
-    fi, fo = np.empty(z), np.empty(z)
-    args = (asm.p, asm.sp_t, asm.sp_w, asm.sp_th, asm.dint, asm.dflt, asm.hbuf, asm.gbuf)
-
-    def f(t, y):
-        dy = np.empty_like(y)
-        K.rhs(t, y, *args, dy, fi, fo)
-        return dy
-    t_end = fine_t[-1] + 1e-9
-    tic = time.process_time()
-    sol = solve_ivp(f, (0.0, t_end), asm.y0.copy(), method=method, rtol=rtol,
-                    atol=asm.atol_scale * rtol, max_step=max_step, dense_output=True)
-    cost = time.process_time() - tic
-    if not sol.success:
-        return None, cost
-    v = sol.sol(fine_t)[[6, 7]].T
-    acc = _decimate_acc(dict(fine_out=v, dt_f=dt_f, taps=taps, m_pad=m_pad, R=R, n_out=n_out))
-    return acc[:, 1], cost
-
-
-def _err(a, b):
-    if not (math.isfinite(a) and math.isfinite(b)) or b == 0:
-        return math.nan
-    return abs(a - b) / abs(b)
 
 
 def run_rate_study(out_dir="reports/performance", *, duration=1.0, rates=RATES_HZ, scenes=None,
@@ -195,10 +122,10 @@ def run_rate_study(out_dir="reports/performance", *, duration=1.0, rates=RATES_H
             m = measures(res["acc"][:, 1], fs, sc)
             rows.append(dict(kind=RATE_KIND, scene=label, rate_hz=float(fs), method=method, rtol=float(rtol),
                              max_step=2.5e-5, cost=cost, peak=m["peak"], ref_peak=m_ref["peak"],
-                             ref_period=m_ref["period"], err_peak=_err(m["peak"], m_ref["peak"]),
-                             err_period=_err(m["period"], m_ref["period"]),
-                             ref_check_peak=_err(m_ref2["peak"], m_ref["peak"]),
-                             ref_check_period=_err(m_ref2["period"], m_ref["period"]), duration_s=duration))
+                             ref_period=m_ref["period"], err_peak=rel_err(m["peak"], m_ref["peak"]),
+                             err_period=rel_err(m["period"], m_ref["period"]),
+                             ref_check_peak=rel_err(m_ref2["peak"], m_ref["peak"]),
+                             ref_check_period=rel_err(m_ref2["period"], m_ref["period"]), duration_s=duration))
     if not rows:
         return rows
     with open(out / "auto_rate_study.csv", "w", newline="") as fh:
@@ -302,7 +229,7 @@ def run_bench(out_dir="reports/performance", *, duration=0.3, scipy_duration=0.1
         ref2, _ = _timed(asm, "dp54", 1e-10, None, 1e-6)
         m_ref = measures(ref["acc"][:, 1], fs, sc_ref)
         m_ref2 = measures(ref2["acc"][:, 1], fs, sc_ref)
-        notes[label] = {k: _err(m_ref2[k], m_ref[k]) for k in m_ref}
+        notes[label] = {k: rel_err(m_ref2[k], m_ref[k]) for k in m_ref}
         jobs = [("multibody", REF_CONTACT, *s) for s in MB_SETTINGS]
         jobs += [("quasi-static", REF_CONTACT, *s) for s in QS_SETTINGS]
         jobs += [("multibody+dynamic cage", REF_CONTACT, m, r, None, None)
@@ -320,9 +247,8 @@ def run_bench(out_dir="reports/performance", *, duration=0.3, scipy_duration=0.1
             rows.append(dict(scene=label, kind=kind, fidelity=fid, contact=model if kind != "healthy" else "none",
                              setting=setting, method=method, rtol=rtol, step=step or 0.0, max_step=mx or 0.0,
                              solver="bearing_lab", cost=cost, ref_period=m_ref["period"],
-                             **{f"err_{k}": _err(m[k], m_ref[k]) for k in m_ref}))
+                             **{f"err_{k}": rel_err(m[k], m_ref[k]) for k in m_ref}))
         if scipy:
-            from .bench_speed import equal_accuracy
             rs, info = equal_accuracy(label, base, ov, duration=scipy_duration)
             speed_rows += rs
             speed_infos.append(info)
@@ -336,8 +262,8 @@ def run_bench(out_dir="reports/performance", *, duration=0.3, scipy_duration=0.1
                      "reference_self_check": repr(notes), "tolerance_peak": TOL_PEAK,
                      "tolerance_period": TOL_PERIOD, "sampling_rate_hz": 0.0,
                      "bearing_lab_version": __version__})
-    from .errors import BearingLabError
-    from .io.export import to_netcdf
+    from ..errors import BearingLabError
+    from ..io.export import to_netcdf
     to_netcdf(ds, out / "performance.nc", error=BearingLabError)
     rules = _rules(rows)
     if rates:
@@ -348,7 +274,6 @@ def run_bench(out_dir="reports/performance", *, duration=0.3, scipy_duration=0.1
     write_text(out / "auto_rules.toml", rules)
     speed_md = ""
     if scipy:
-        from .bench_speed import all_rows_table, tables
         speed_md = tables(speed_rows, speed_infos, []) + "\n\n" + all_rows_table(speed_rows)
         write_text(out / "equal_accuracy.md", speed_md + "\n")
     ds.attrs["equal_accuracy_md"] = speed_md
@@ -406,70 +331,70 @@ def _rules(rows) -> str:
     return "\n".join(lines)
 
 
+def _work_precision_figure(sc, rs):
+    """Log cost against log peak-acceleration error of one scene's rows."""
+    from ..utils.figures import new_figure
+    fig = new_figure(figsize=(6.5, 4.2))
+    ax = fig.subplots()
+    groups = [(f"{fid} ({solver})", mk, col,
+               lambda r, fid=fid, solver=solver: (r["fidelity"] == fid and r["solver"] == solver
+                                                  and r["contact"] in (REF_CONTACT, "none")))
+              for fid, mk in (("multibody", "o"), ("quasi-static", "s"), ("multibody+dynamic cage", "^"))
+              for solver, col in (("bearing_lab", None), ("scipy", "k"))]
+    groups.append((f"multibody, cheaper contact ({', '.join(CHEAP_CONTACTS)})", "x", "r",
+                   lambda r: r["contact"] in CHEAP_CONTACTS))
+    for label, mk, col, keep in groups:
+        sel = [r for r in rs if keep(r) and math.isfinite(r["err_peak"])]
+        if sel:
+            ax.scatter([max(r["err_peak"], 1e-9) for r in sel], [r["cost"] for r in sel], marker=mk,
+                       c=col, label=label, alpha=0.8)
+            for r in sel:
+                text = r["setting"].replace(" (short window)", "")
+                if r["contact"] in CHEAP_CONTACTS:
+                    text = f"{r['contact']} contact"
+                ax.annotate(text, (max(r["err_peak"], 1e-9), r["cost"]), fontsize=5, alpha=0.7)
+    ax.axvline(TOL_PEAK, color="r", ls="--", lw=0.8)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("relative error in peak acceleration")
+    ax.set_ylabel("compute s per simulated s")
+    ax.set_title(f"work-precision: {sc}")
+    ax.legend(fontsize=7)
+    ax.grid(alpha=0.3, which="both")
+    fig.tight_layout()
+    return fig
+
+
 def _report(out, rows, notes, speed_md=""):
-    from .utils.figures import figure_png, new_figure
-    scenes = list(dict.fromkeys(r["scene"] for r in rows))
-    html = ["<!DOCTYPE html><html><head><meta charset='utf-8'><title>bearing_lab: speed against error"
-            "</title><style>body{font-family:sans-serif;max-width:1100px;margin:auto}table{border-collapse:"
-            "collapse;font-size:12px}td,th{border:1px solid #999;padding:2px 6px;text-align:right}</style>"
-            "</head><body><h1>Speed against error</h1>",
-            f"<p>{__doc__.split('Outputs')[0]}</p>",
-            f"<p>Tolerance: {TOL_PEAK:.0%} in peak acceleration, {TOL_PERIOD:.1%} in excitation period. "
-            "Cost: CPU seconds (process time) per simulated second, one core, including the settling time.</p>"]
-    for sc in scenes:
+    """The benchmark's page through the report layer: per scene the reference's self-check, the
+    fastest setting within tolerance, the work-precision figure and every row."""
+    from ..report import Report
+    from ..report.html import esc, figure_html, table_html
+    rep = Report("Speed against error", verdict=False)
+    rep.add_html(f"<p>{esc(__doc__.split('Outputs')[0])}</p>"
+                 f"<p>Tolerance: {TOL_PEAK:.0%} in peak acceleration, {TOL_PERIOD:.1%} in excitation period. "
+                 "Cost: CPU seconds (process time) per simulated second, one core, including the settling "
+                 "time.</p>", "What is measured")
+    for sc in dict.fromkeys(r["scene"] for r in rows):
         rs = [r for r in rows if r["scene"] == sc]
-        fig = new_figure(figsize=(6.5, 4.2))
-        ax = fig.subplots()
-        groups = [(f"{fid} ({solver})", mk, col,
-                   lambda r, fid=fid, solver=solver: (r["fidelity"] == fid and r["solver"] == solver
-                                                      and r["contact"] in (REF_CONTACT, "none")))
-                  for fid, mk in (("multibody", "o"), ("quasi-static", "s"), ("multibody+dynamic cage", "^"))
-                  for solver, col in (("bearing_lab", None), ("scipy", "k"))]
-        groups.append((f"multibody, cheaper contact ({', '.join(CHEAP_CONTACTS)})", "x", "r",
-                       lambda r: r["contact"] in CHEAP_CONTACTS))
-        for label, mk, col, keep in groups:
-            sel = [r for r in rs if keep(r) and math.isfinite(r["err_peak"])]
-            if sel:
-                ax.scatter([max(r["err_peak"], 1e-9) for r in sel], [r["cost"] for r in sel], marker=mk,
-                           c=col, label=label, alpha=0.8)
-                for r in sel:
-                    text = r["setting"].replace(" (short window)", "")
-                    if r["contact"] in CHEAP_CONTACTS:
-                        text = f"{r['contact']} contact"
-                    ax.annotate(text, (max(r["err_peak"], 1e-9), r["cost"]), fontsize=5, alpha=0.7)
-        ax.axvline(TOL_PEAK, color="r", ls="--", lw=0.8)
-        ax.set_xscale("log")
-        ax.set_yscale("log")
-        ax.set_xlabel("relative error in peak acceleration")
-        ax.set_ylabel("compute s per simulated s")
-        ax.set_title(f"work-precision: {sc}")
-        ax.legend(fontsize=7)
-        ax.grid(alpha=0.3, which="both")
-        fig.tight_layout()
+        fig = _work_precision_figure(sc, rs)
         savefig(fig, out / f"work_precision_{sc.replace('/', '_').replace('=', '')}.png", dpi=100)
+        body = ["<p>reference self-check (rtol 1e-10 vs 1e-9): "
+                + esc(", ".join(f"{k} {v:.1e}" for k, v in notes[sc].items())) + "</p>"]
         best = fastest_within_tolerance(rows, sc)
-        html.append(f"<h2>{sc}</h2><p>reference self-check (rtol 1e-10 vs 1e-9): "
-                    + ", ".join(f"{k} {v:.1e}" for k, v in notes[sc].items()) + "</p>")
         if best:
-            html.append(f"<p><b>Fastest within tolerance:</b> {best['fidelity']}, {best['contact']}, "
-                        f"{best['setting']}: {best['cost']:.4f} s/s, peak error {best['err_peak']:.2e}</p>")
-        html.append(f"<img src='data:image/png;base64,{figure_png(fig, dpi=90)}'>")
-        html.append("<table><tr><th>fidelity</th><th>contact</th><th>setting</th><th>s/s</th><th>peak err</th>"
-                    "<th>RMS err</th><th>period err</th><th>duration err</th></tr>")
-        for r in sorted(rs, key=lambda r: r["cost"]):
-            def f(x):
-                return "-" if not math.isfinite(x) else f"{x:.1e}"
-            html.append(f"<tr><td>{r['fidelity']}</td><td>{r['contact']}</td><td>{r['setting']}</td>"
-                        f"<td>{r['cost']:.4f}</td><td>{f(r['err_peak'])}</td><td>{f(r['err_rms'])}</td>"
-                        f"<td>{f(r['err_period'])}</td><td>{f(r['err_duration'])}</td></tr>")
-        html.append("</table>")
+            body.append(f"<p><b>Fastest within tolerance:</b> {esc(best['fidelity'])}, {esc(best['contact'])}, "
+                        f"{esc(best['setting'])}: {best['cost']:.4f} s/s, peak error {best['err_peak']:.2e}</p>")
+        body.append(figure_html(fig, f"work-precision: {sc}", dpi=90))
+        body.append(table_html([{"fidelity": r["fidelity"], "contact": r["contact"], "setting": r["setting"],
+                                 "s/s": r["cost"], "peak err": r["err_peak"], "RMS err": r["err_rms"],
+                                 "period err": r["err_period"], "duration err": r["err_duration"]}
+                                for r in sorted(rs, key=lambda r: r["cost"])]))
+        rep.add_html("\n".join(body), sc)
     if speed_md:
-        import html as _html
-        html.append("<h2>Speed at equal accuracy (CPU s per simulated s; cheapest setting within "
-                    f"{TOL_PEAK:.0%} peak and {TOL_PERIOD:.1%} period error)</h2><pre>"
-                    + _html.escape(speed_md) + "</pre>")
-    html.append("</body></html>")
-    write_text(out / "index.html", "\n".join(html))
+        rep.add_html(f"<pre>{esc(speed_md)}</pre>", "Speed at equal accuracy (CPU s per simulated s; cheapest "
+                     f"setting within {TOL_PEAK:.0%} peak and {TOL_PERIOD:.1%} period error)")
+    rep.save(out / "index.html")
 
 
 def rows_of(ds: xr.Dataset) -> list:

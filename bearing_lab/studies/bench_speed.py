@@ -28,10 +28,9 @@ import time
 
 import numpy as np
 
-from .units import G
+from ..units import G
+from .bench_common import TOL_PEAK, TOL_PERIOD, bench_scene, measures, rel_err, scipy_acc
 
-TOL_PEAK = 0.01
-TOL_PERIOD = 0.001
 
 SPEED_SCENES = [
     ("paper-slot", "paper-slot", {}),
@@ -60,12 +59,6 @@ def _cpu(fn, *args, repeats=1, **kw):
     return out, best
 
 
-def _err(a, b):
-    if not (math.isfinite(a) and math.isfinite(b)) or b == 0:
-        return math.nan
-    return abs(a - b) / abs(b)
-
-
 def _ok(row, ref_period):
     if not math.isfinite(row["err_peak"]) or row["err_peak"] > TOL_PEAK:
         return False
@@ -74,9 +67,8 @@ def _ok(row, ref_period):
 
 def equal_accuracy(label, base, ov, *, duration=0.1, scipy=True, repeats=2, progress=None):
     """Rows (one per setting) of ours and scipy's methods against one converged reference."""
-    from .bench import measures, bench_scene, scipy_acc
-    from .sim.assembly import assemble
-    from .sim.integrate import METHODS, _run
+    from ..sim.assembly import assemble
+    from ..sim.integrate import METHODS, _run
     sc = bench_scene(base, ov, duration)
     asm = assemble(sc)
     fs = sc.fs_out
@@ -88,14 +80,14 @@ def equal_accuracy(label, base, ov, *, duration=0.1, scipy=True, repeats=2, prog
     ref2, _ = _cpu(ours, "dp54", 1e-10, None, 1e-6)
     m_ref = measures(ref["acc"][:, 1], fs, sc)
     m_ref2 = measures(ref2["acc"][:, 1], fs, sc)
-    check = {k: _err(m_ref2[k], m_ref[k]) for k in ("peak", "period")}
+    check = {k: rel_err(m_ref2[k], m_ref[k]) for k in ("peak", "period")}
     t_sim = ref["t_end"]
     rows = []
 
     def add(solver, method, setting, acc, cpu, extra=None):
         m = measures(acc, fs, sc) if acc is not None else {"peak": math.nan, "period": math.nan}
         row = dict(scene=label, solver=solver, method=method, setting=setting, cost=cpu / t_sim,
-                   err_peak=_err(m["peak"], m_ref["peak"]), err_period=_err(m["period"], m_ref["period"]),
+                   err_peak=rel_err(m["peak"], m_ref["peak"]), err_period=rel_err(m["period"], m_ref["period"]),
                    **(extra or {}))
         row["ok"] = _ok(row, m_ref["period"])
         rows.append(row)
@@ -103,7 +95,7 @@ def equal_accuracy(label, base, ov, *, duration=0.1, scipy=True, repeats=2, prog
             progress(row)
         return row
 
-    from .errors import SolverError
+    from ..errors import SolverError
     for method, rtol, step in OURS:
         setting = f"h={step:g}" if step else f"rtol={rtol:g}"
         try:
@@ -133,22 +125,21 @@ QS_SETTINGS = [("bs32", 1e-3, 1e-4), ("bs32", 1e-4, 1e-4), ("dp54", 1e-4, 1e-4),
 def quasi_static(label, base, ov, *, duration=0.1, repeats=2):
     """Quasi-static rows: CPU s/s, and the error against the multibody reference (what a user
     gets: model plus numerical error) and against its own converged run (numerical error)."""
-    from .bench import measures, bench_scene
-    from .sim.assembly import assemble
-    from .sim.integrate import _run
+    from ..sim.assembly import assemble
+    from ..sim.integrate import _run
     sc_mb = bench_scene(base, ov, duration)
     sc = bench_scene(base, ov, duration, "quasi-static")
     asm = assemble(sc)
     ref_mb = measures(_run(assemble(sc_mb), 0, 1e-9, progress=False, max_step=2e-6)["acc"][:, 1], sc.fs_out, sc_mb)
     ref_qs = measures(_run(asm, 0, 1e-9, progress=False, max_step=2e-6)["acc"][:, 1], sc.fs_out, sc)
     rows = []
-    from .sim.integrate import METHODS
+    from ..sim.integrate import METHODS
     for method, rtol, mx in QS_SETTINGS:
         res, cpu = _cpu(_run, asm, METHODS[method], rtol, progress=False, max_step=mx, repeats=repeats)
         m = measures(res["acc"][:, 1], sc.fs_out, sc)
         row = dict(scene=label, setting=f"{method} rtol={rtol:g} max_step={mx:g}", cost=cpu / res["t_end"],
-                   err_peak=_err(m["peak"], ref_mb["peak"]), err_period=_err(m["period"], ref_mb["period"]),
-                   num_err_peak=_err(m["peak"], ref_qs["peak"]), steps=int(res["stats"][0]),
+                   err_peak=rel_err(m["peak"], ref_mb["peak"]), err_period=rel_err(m["period"], ref_mb["period"]),
+                   num_err_peak=rel_err(m["peak"], ref_qs["peak"]), steps=int(res["stats"][0]),
                    rejected=int(res["stats"][1]))
         row["ok"] = _ok(row, ref_mb["period"])
         rows.append(row)
@@ -179,8 +170,8 @@ def best_per_method(rows):
 
 def default_cost(label, base, ov, *, duration=1.0, repeats=3):
     """``simulate`` as users call it (auto), warm caches: CPU of the time loop and the whole call."""
-    from . import sim
-    from .sim import integrate as I
+    from .. import sim
+    from ..sim import integrate as I
     loop_cpu = []
     orig = I._run
 
@@ -218,7 +209,7 @@ def default_costs_as_users_get_them(chosen, *, duration=1.0):
     measuring process can differ from what the cache hands out."""
     import subprocess
     import sys
-    code = ("import json, sys; from bearing_lab.bench_speed import default_cost; "
+    code = ("import json, sys; from bearing_lab.studies.bench_speed import default_cost; "
             "print(json.dumps([default_cost(l, b, o, duration=float(sys.argv[2])) "
             "for l, b, o in json.loads(sys.argv[1])]))")
     res = subprocess.run([sys.executable, "-c", code, json.dumps([list(c) for c in chosen]), str(duration)],
@@ -230,10 +221,9 @@ def default_costs_as_users_get_them(chosen, *, duration=1.0):
 
 def default_accuracy(label, base, ov, *, duration=0.1):
     """The default's settings on the equal-accuracy record: its error against the reference."""
-    from .bench import measures, bench_scene
-    from .sim.assembly import assemble
-    from .sim.auto import resolve
-    from .sim.integrate import METHODS, _run
+    from ..sim.assembly import assemble
+    from ..sim.auto import resolve
+    from ..sim.integrate import METHODS, _run
     sc = bench_scene(base, ov, duration)
     ch = resolve(load_auto(base, ov, duration))
     ref = _run(assemble(sc), METHODS["dp54"], 1e-9, progress=False, max_step=2e-6)
@@ -242,12 +232,12 @@ def default_accuracy(label, base, ov, *, duration=0.1):
                step=ch.get("step_s") or None)
     m_ref = measures(ref["acc"][:, 1], sc.fs_out, sc)
     m = measures(res["acc"][:, 1], sc.fs_out, sc)
-    return dict(scene=label, err_peak=_err(m["peak"], m_ref["peak"]), err_period=_err(m["period"], m_ref["period"]),
+    return dict(scene=label, err_peak=rel_err(m["peak"], m_ref["peak"]), err_period=rel_err(m["period"], m_ref["period"]),
                 method=ch["method"], rtol=ch["rtol"])
 
 
 def load_auto(base, ov, duration):
-    from .sim import load_scene
+    from ..sim import load_scene
     return load_scene(base, **ov, **{"output.duration_s": duration})
 
 
@@ -299,7 +289,7 @@ def all_rows_table(rows) -> str:
 def run_speed(scenes=None, *, duration=0.1, default_duration=1.0, scipy=True, progress=True, qs=True):
     """Both measurements (and the quasi-static fidelity) on the speed scenes; returns (markdown
     summary, rows, infos, defaults, quasi-static rows)."""
-    from .sim.integrate import _warm_up
+    from ..sim.integrate import _warm_up
     _warm_up()
     chosen = [s for s in SPEED_SCENES if scenes is None or s[0] in scenes]
     rows, infos, defaults, accs, qrows = [], [], [], [], []

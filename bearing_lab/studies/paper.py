@@ -44,9 +44,9 @@ import time
 import numpy as np
 import xarray as xr
 
-from .units import G
-from .utils._files import savefig, write_text
-from .utils.figures import figure_png, new_figure
+from ..units import G
+from ..utils._files import savefig
+from ..utils.figures import new_figure
 
 STUDY_FS = 100_000.0
 
@@ -121,8 +121,8 @@ def _passage(ds, scene):
 
 
 def _one(scene_name, overrides):
-    from .sim import load_scene, simulate
-    from .analysis import excitation_duration
+    from ..sim import load_scene, simulate
+    from ..analysis import excitation_duration
     sc = load_scene(scene_name, **overrides)
     ds = simulate(sc, duration=0.1, fs=STUDY_FS, progress=False, **{"output.oversample": 4})
     tc, half, ball, t_cross = _passage(ds, sc)
@@ -166,7 +166,7 @@ def _one(scene_name, overrides):
 def _contact_along(sc, t, rpm):
     """Carried share and intact fraction of the Hertz ellipse along the passage (times t
     from the centre crossing) at the static approach of the most loaded ball."""
-    from .sim.assembly import assemble
+    from ..sim.assembly import assemble
     asm = assemble(sc)
     tab = asm.tables[0]
     q_static = float(np.max(asm.static["ball_loads"]))
@@ -214,8 +214,8 @@ def run_paper_studies(out_dir="reports/studies", *, progress=True, studies=None)
     for name, fig in figs.items():
         savefig(fig, out / f"{name}.png", dpi=110 if name != "mechanism" else 100)
     table = _table(rows, time.perf_counter() - t0)
-    from .errors import BearingLabError
-    from .io.export import to_netcdf
+    from ..errors import BearingLabError
+    from ..io.export import to_netcdf
     to_netcdf(table, out / "studies.nc", error=BearingLabError)
     _write_html(out, names, rows, figs)
     return table
@@ -317,33 +317,30 @@ def _findings(s, rs):
     return " ".join(parts)
 
 
+#: the studies page's table: column heading -> (row key, decimals)
+_PAGE_COLUMNS = (("peak displacement (µm)", "peak_disp_um", 4), ("peak acceleration (g)", "peak_acc_g", 2),
+                 ("acceleration peak-to-peak (g)", "p2p_acc_g", 2), ("excitation duration (ms)", "duration_ms", 3),
+                 ("crossing time L/v (ms)", "crossing_ms", 3), ("min load (N)", "min_load", 0),
+                 ("min carried share", "min_share", 3), ("min intact fraction", "min_intact", 3))
+
+
 def _write_html(out, names, rows, figs):
-    parts = ["<!DOCTYPE html><html><head><meta charset='utf-8'><title>bearing_lab: the paper's "
-             "parametric studies</title><style>body{font-family:sans-serif;max-width:1000px;margin:auto}img{max-width:100%;height:auto}"
-             "table{border-collapse:collapse}td,th{border:1px solid #999;padding:3px 8px;text-align:right}"
-             "</style></head><body><h1>The paper's section-5 studies on the 2-D defect model</h1>",
-             "<p>Peak displacement is the largest deviation of the outer-ring Y displacement from its "
-             "median over the passage window; peak acceleration the largest |a| in that window at "
-             f"{STUDY_FS/1e3:.0f} kHz; excitation duration the width of the displacement pulse at 10 % of "
-             "its height. Crossing time = defect extent along the track / ball surface speed. The "
-             "mechanism columns come from the defect's contact table at the static approach of the most "
-             "loaded ball.</p>"]
-    head = ("<table><tr><th>case</th><th>peak displacement (µm)</th><th>peak acceleration (g)</th>"
-            "<th>acceleration peak-to-peak (g)</th><th>excitation duration (ms)</th>"
-            "<th>crossing time L/v (ms)</th><th>min load (N)</th><th>min carried share</th>"
-            "<th>min intact fraction</th><th>contact model</th></tr>")
+    """The studies page through the report layer: per study its table, findings and pulse figure."""
+    from ..report import Report
+    from ..report.html import esc, figure_html, table_html
+    rep = Report("The paper's section-5 studies on the 2-D defect model", verdict=False)
+    rep.add_html(
+        "<p>Peak displacement is the largest deviation of the outer-ring Y displacement from its "
+        "median over the passage window; peak acceleration the largest |a| in that window at "
+        f"{STUDY_FS/1e3:.0f} kHz; excitation duration the width of the displacement pulse at 10 % of "
+        "its height. Crossing time = defect extent along the track / ball surface speed. The "
+        "mechanism columns come from the defect's contact table at the static approach of the most "
+        "loaded ball.</p>", "Measurement")
     for s in names:
+        table = [{"case": r["label"], **{head: round(float(r[key]), nd) for head, key, nd in _PAGE_COLUMNS},
+                  "contact model": r["contact_model"]} for r in rows if r["study"] == s]
         rs = [r for r in rows if r["study"] == s]
-        parts.append(f"<h2>{s} ({STUDIES[s][2]}; paper: {STUDIES[s][3]})</h2>" + head)
-        for r in rs:
-            parts.append(f"<tr><td>{r['label']}</td><td>{r['peak_disp_um']:.4f}</td><td>{r['peak_acc_g']:.2f}</td>"
-                         f"<td>{r['p2p_acc_g']:.2f}</td><td>{r['duration_ms']:.3f}</td>"
-                         f"<td>{r['crossing_ms']:.3f}</td><td>{r['min_load']:.0f}</td><td>{r['min_share']:.3f}</td>"
-                         f"<td>{r['min_intact']:.3f}</td><td>{r['contact_model']}</td></tr>")
-        parts.append("</table>")
-        parts.append(f"<p>{_findings(s, rs)}</p>")
-        parts.append(f"<img src='data:image/png;base64,{figure_png(figs[s], dpi=90)}'>")
-    parts.append("<h2>Mechanism</h2>")
-    parts.append(f"<img src='data:image/png;base64,{figure_png(figs['mechanism'], dpi=90)}'>")
-    parts.append("</body></html>")
-    write_text(out / "index.html", "\n".join(parts))
+        rep.add_html(table_html(table) + f"\n<p>{esc(_findings(s, rs))}</p>\n" + figure_html(figs[s], s, dpi=90),
+                     f"{s} ({STUDIES[s][2]}; paper: {STUDIES[s][3]})")
+    rep.add_figure(figs["mechanism"], "Mechanism", dpi=90)
+    rep.save(out / "index.html")

@@ -8,9 +8,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import BearingLabError, SceneError
-from .io.export import checksum_path, to_netcdf
-from .schema import DEFAULT_CHANNEL
+from ..errors import BearingLabError, SceneError
+from ..io.export import checksum_path, to_netcdf
+from ..schema import DEFAULT_CHANNEL
 
 SWEEP_METRICS = ("rms", "peak", "crest_factor", "kurtosis")   # the analysis METRICS stored per scene
 METRIC_SIGNAL = DEFAULT_CHANNEL  # the simulator's accelerometer signal
@@ -59,7 +59,7 @@ def _read_cache(path: Path, digest: str, expect: dict):
     (a damaged file never reaches the C library), then the content is validated.
     """
     import xarray as xr
-    from .utils._files import sha256_file
+    from ..utils._files import sha256_file
     if not path.is_file():
         return None, None
     sums = checksum_path(path)
@@ -116,7 +116,7 @@ def from_cache(cdir, scenes, digests, acc):
 
 def _metrics(x: np.ndarray) -> dict:
     """The sweep's metrics (the analysis table's functions; NaN where undefined)."""
-    from .analysis._metrics import METRICS
+    from ..analysis._metrics import METRICS
     out = {}
     for name in SWEEP_METRICS:
         try:

@@ -1,8 +1,16 @@
-"""The parts of a recording case around its main comparison: the ratio companion, the healthy
-reference, and the assembly of rows, signals and figures into a :class:`CaseResult`.
+"""A recording case run end to end: the recording and declared scene (:mod:`.recording_case`), the
+rig's path and background (:mod:`.rig`), the rows (:mod:`.evaluate`), the ratio companion, the
+healthy reference, and the assembly of rows, signals and figures into a
+:class:`~bearing_lab.validation.evaluate.CaseResult`.
 
 The result lists its report sections as plain data ``(kind, title, payload)``; the page
 is rendered by :mod:`bearing_lab.validation.pages`.
+
+Public API
+----------
+run_recording_case(case, *, steps, mirror=None) -> CaseResult
+ratio_companion(case, prep, path, *, mirror=None), healthy_reference(case, prep, path, background, reference)
+assemble(case, prep, path, background, signals, rows, err, healthy, ctx) -> CaseResult
 """
 from __future__ import annotations
 
@@ -12,29 +20,13 @@ from ..analysis.measurement import measure
 from ..compare import align_by_impulse_phase, compare, shift
 from ..units import G
 from . import figures, simulation
+from .evaluate import CaseResult, context, evaluate_rows
 from .recording import open_spec
+from .recording_case import comparison_band, measure_signals, prepare, simulate_signals
+from .rig import background_for, path_for
 from .speed import resolve_speed
 
-__all__ = ["context", "ratio_companion", "healthy_reference", "assemble", "model_details"]
-
-
-def model_details(ds) -> dict:
-    """What the simulation that ran assumed (fidelity, contact and cage models, load path, solver)."""
-    keys = ("bearing", "fidelity", "defect_contact_models", "cage_model", "load_path", "solver_method",
-            "solver_rtol", "sensor_resonator", "anti_alias")
-    return {k: ds.attrs.get(k) for k in keys if k in ds.attrs}
-
-
-def context(case, prep, path, background=None) -> dict:
-    sp = case.section("structural_path")
-    fitted_here = sp.get("method", "fit") == "fit" and not sp.get("from_case") and not sp.get("file")
-    rec = prep.recording
-    t0 = rec.spec.start_s
-    from_rec = background is not None and background.source.startswith("the recording")
-    return {"path": path, "path_fitted_here": fitted_here, "speed_estimated": case.speed == "estimate",
-            "background_from_recording": from_rec,
-            "span_text": {"record": f"recording: whole record ({rec.x.size / rec.fs:.3g} s)",
-                          "segment": f"recording: {t0:g}-{t0 + prep.n / rec.fs:g} s"}}
+__all__ = ["run_recording_case", "ratio_companion", "healthy_reference", "assemble"]
 
 
 def ratio_companion(case, prep, path, *, mirror=None) -> dict:
@@ -73,7 +65,6 @@ def _decomposition(parts: dict) -> list:
 
 def healthy_reference(case, prep, path, background, reference) -> dict:
     """The healthy bearing simulated against the healthy reference recording of the same rig."""
-    from .recording_case import evaluate_rows
     spec_speed = reference.spec.speed if reference.spec.speed is not None else case.speed
     speed = resolve_speed(spec_speed, reference.dataset, reference.x, bearing=prep.bearing, case_name=case.name,
                           where="reference.speed")
@@ -176,7 +167,6 @@ def _sections(case, prep, path, background, aligned, shift_k, result, healthy):
 
 
 def assemble(case, prep, path, background, signals, rows, err, healthy, ctx):
-    from .recording_case import CaseResult
     aligned, k = _aligned(prep, signals)
     m = prep.measured["record"]
     ff = m["extras"]["analysis"]["fault_frequencies"]
@@ -186,7 +176,7 @@ def assemble(case, prep, path, background, signals, rows, err, healthy, ctx):
                             "shaft_hz": prep.speed.rpm / 60.0, "speed_source": prep.speed.source,
                             "structural_path": path.to_dict()})
     ds = prep.dataset
-    extra = {"speed": {"rpm": prep.speed.rpm, "source": prep.speed.source}, "model": model_details(ds),
+    extra = {"speed": {"rpm": prep.speed.rpm, "source": prep.speed.source}, "model": simulation.model_details(ds),
              "structural_path": path.to_dict(), "background": background.to_dict() if background else None,
              "numerical_error": err, "ratio": {k_: v for k_, v in (ctx.get("ratio") or {}).items()},
              "healthy": {"decomposition": healthy["decomposition"], "speed": healthy["speed"]} if healthy else None,
@@ -204,3 +194,30 @@ def assemble(case, prep, path, background, signals, rows, err, healthy, ctx):
         prov["ratio companion"] = f"{ctx['ratio']['recording']} (sha256 {ctx['ratio']['sha256']})"
     sections = _sections(case, prep, path, background, aligned, k, result, healthy)
     return CaseResult(rows, result, extra, prov, sections, path)
+
+
+def run_recording_case(case, *, steps, mirror=None) -> CaseResult:
+    """Run a recording case (see the module docstring); the report is assembled by the caller."""
+    prep = prepare(case, mirror=mirror)
+    steps.step("recording and declared scene")
+    path = path_for(case, prep.recording, prep.measured["record"], prep.simulated["model"], mirror=mirror)
+    reference = open_spec(case.reference, case.name, mirror) if case.reference is not None else None
+    model = path.apply(prep.simulated["model"], prep.fs) if path.status in ("ok", "given") else None
+    background = background_for(case, prep.recording, prep.measured["record"], reference, model=model,
+                                band=comparison_band(prep.fs))
+    steps.step("structural path and background")
+    signals = simulate_signals(prep, path, background)
+    sim_m = measure_signals(prep, signals)
+    ctx = context(case, prep, path, background)
+    if "ratio" in case.data:
+        ctx["ratio"] = ratio_companion(case, prep, path, mirror=mirror)
+    rows = evaluate_rows(case.tolerances, prep.measured, sim_m, context=ctx)
+    steps.step("measure and compare")
+    healthy = healthy_reference(case, prep, path, background, reference) if reference is not None else None
+    if healthy:
+        rows += healthy["rows"]
+    err = (simulation.numerical_error(prep.scene, prep.dataset,
+                                      duration=float(case.section("numerical_error").get("duration_s", 0.25)))
+           if case.section("numerical_error").get("enabled", True) else {})
+    steps.step("numerical error")
+    return assemble(case, prep, path, background, signals, rows, err, healthy, ctx)
