@@ -139,7 +139,7 @@ class HalfSpace:
     """DC-FFT influence operator on an (nx, ny) grid of cells dx x dy, and its solver."""
 
     def __init__(self, nx: int, ny: int, dx: float, dy: float, e_star: float,
-                 kern: np.ndarray | None = None):
+                 kern: np.ndarray | None = None, stencil: np.ndarray | None = None):
         self.nx, self.ny, self.dx, self.dy, self.e_star = nx, ny, dx, dy, e_star
         k = love_influence(nx, ny, dx, dy, e_star) if kern is None else kern[:nx, :ny]
         self._crops: dict[tuple[int, int], HalfSpace] = {}
@@ -158,7 +158,7 @@ class HalfSpace:
         # order one so that no product falls into float32's subnormal range (~1e-38),
         # where the arithmetic is a hundred times slower
         self.kf = (sfft.rfft2(full, workers=1) / self.k00).astype(np.complex64)
-        self.stencil = preconditioner_stencil(k)
+        self.stencil = preconditioner_stencil(k) if stencil is None else stencil
 
     def displacement(self, p: np.ndarray) -> np.ndarray:
         """Surface displacement (m) at the cell centres for cell pressures ``p`` (Pa),
@@ -220,7 +220,8 @@ class HalfSpace:
         if shape == (self.nx, self.ny):
             return self._iterate(h, approach, tol, maxiter, p0, precondition)
         if shape not in self._crops:
-            self._crops[shape] = HalfSpace(*shape, self.dx, self.dy, self.e_star, kern=self.kern)
+            self._crops[shape] = HalfSpace(*shape, self.dx, self.dy, self.e_star, kern=self.kern,
+                                           stencil=self.stencil)
         p, its = self._crops[shape]._iterate(h[box], approach, tol, maxiter,
                                              None if p0 is None else np.asarray(p0)[box], precondition)
         out = np.zeros_like(h)
