@@ -254,7 +254,7 @@ class HalfSpace:
         u = np.ascontiguousarray(self.displacement(p))
         g, z, fresh = np.empty_like(p), np.empty_like(p), np.zeros_like(done)
         gc = np.zeros((p.shape[0], self.nx + 2, self.ny + 2))
-        escale = (ENTER_SCALE * float(stencil[1, 1]) if precondition else 1.0) / self.k00
+        escale = (ENTER_SCALE * float(stencil[1, 1]) if stencil is not PLAIN else 1.0) / self.k00
         for it in range(1, maxiter + 1):
             cg_direction(p, u, g, hd, t, allowed, restart, g_old, floor, self.k00, stalled, exact,
                          stencil, gc, z)
