@@ -107,3 +107,19 @@ def test_solve_on_the_box_of_touching_cells_matches_the_whole_window():
     p_all, _ = hs._iterate(gaps, 4.04e-6, 1e-8, 3000, None, True)
     assert np.abs(p_box - p_all).max() < 1e-5 * p_all.max()
     assert np.all(p_box[~allowed] == 0)
+
+
+@pytest.mark.parametrize("race", ["outer", "inner"])
+@pytest.mark.parametrize("depth", [0.0, 0.5e-3])
+def test_compiled_window_gap_is_the_geometry_gap(race, depth):
+    """The skewed windows' compiled gap against RaceGeometry.approach (numpy) at random points,
+    a third of them out of the ball's reach (there 1.0, where approach gives +inf): equal to
+    the last bits."""
+    geom = RaceGeometry.from_bearing(B6308, race)
+    rng = np.random.default_rng(3)
+    S, Z = rng.uniform(-8e-3, 8e-3, (3, 40, 30)), rng.uniform(-9e-3, 9e-3, (3, 40, 30))
+    ref = geom.approach(S / geom.track_radius, Z, depth=depth)
+    assert 0.2 < np.mean(~np.isfinite(ref)) < 0.6
+    got = hsk._gap(geom, S, Z, depth)
+    assert got.shape == S.shape
+    np.testing.assert_allclose(got, np.where(np.isfinite(ref), ref, 1.0), rtol=1e-13, atol=1e-18)

@@ -1,5 +1,6 @@
 """numba kernels of the half-space solver: the element-wise steps of one conjugate-gradient
-iteration (Polonsky & Keer, Wear 231, 1999) for a batch of problems.
+iteration (Polonsky & Keer, Wear 231, 1999) for a batch of problems, and the groove's gap over
+a skewed table's windows (:func:`torus_gap`).
 
 Why numba: on the tables' small grids (about 34 x 26 cells) the two FFT convolutions of
 an iteration cost ~25 µs per problem in single precision, while the dozen numpy
@@ -17,6 +18,8 @@ Arrays are (K, nx, ny), float64: K independent problems, each with its own scala
 approach).
 """
 from __future__ import annotations
+
+import math
 
 import numpy as np
 from numba import njit
@@ -160,6 +163,28 @@ def update_displacement(u, r, tau, extra, n_extra, kern, stalled, max_cells, ref
     return any_fresh
 
 
+@njit(cache=True)
+def torus_gap(S, Z, depth, R, rb, rg, centre, sign, rho0, outer, out):
+    """:meth:`.geometry.RaceGeometry.approach` in one compiled pass over flat arrays of track
+    positions ``S`` (m along the track from the ball) and ``Z`` (m across), the surface moved
+    ``depth`` into the ring; 1.0 (m: never touches) where the ball cannot reach, written to
+    ``out``.  The windows of a skewed table ask for this gap at about 10^5 cells per round,
+    where numpy's two dozen passes cost about 13 % of the table.  Tested against ``approach``."""
+    for n in range(S.size):
+        z = Z[n]
+        dphi = S[n] / R
+        r = centre + sign * (math.sqrt(max(rg * rg - z * z, 0.0)) + depth)
+        sn = math.sin(dphi)
+        cs = math.cos(dphi)
+        arg = rb * rb - z * z - (r * sn) ** 2
+        if arg >= 0.0 and abs(z) < rg and cs > 0.0:
+            rc = r * cs
+            out[n] = (rc - rho0 if outer else rho0 - rc) - math.sqrt(arg)
+        else:
+            out[n] = 1.0
+    return out
+
+
 def warm_up():
     """Compile (or load from numba's cache) the kernels on a tiny problem."""
     p = np.ones((1, 2, 2))
@@ -175,3 +200,4 @@ def warm_up():
             f.copy(), g.copy(), n, 1.0)
     update_displacement(g, g.copy(), f.copy(), g.copy(), n, np.ones((2, 2)), flags.copy(), 32,
                         False, flags.copy())
+    torus_gap(f.copy(), f.copy(), 0.0, 1.0, 1.0, 1.1, 0.0, 1.0, 0.0, True, f.copy())

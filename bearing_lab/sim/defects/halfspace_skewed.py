@@ -107,8 +107,15 @@ def _track_coords(skew: float, g: SkewedGrid, fu: float, fv: float):
 
 
 def _gap(geom: RaceGeometry, S, Z, depth=0.0):
-    g = geom.approach(S / geom.track_radius, Z, depth=depth)
-    return np.where(np.isfinite(g), g, 1.0)
+    """The intact (or, ``depth`` into the ring, the floor's) gap (m) at track positions S, Z
+    relative to the ball; 1.0 where the ball cannot reach (compiled ``geom.approach``)."""
+    from ._halfspace_kernels import torus_gap
+    S, Z = np.broadcast_arrays(np.asarray(S, dtype=float), np.asarray(Z, dtype=float))
+    out = np.empty(S.shape)
+    torus_gap(np.ascontiguousarray(S).ravel(), np.ascontiguousarray(Z).ravel(), float(depth),
+              geom.track_radius, geom.ball_radius, geom.groove_radius, geom.centre_radius, geom.sign,
+              geom.rho0, geom.race == "outer", out.reshape(-1))
+    return out
 
 
 def window(defect: Defect, geom: RaceGeometry, g: SkewedGrid, s_ball: float):
