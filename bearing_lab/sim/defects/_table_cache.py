@@ -68,14 +68,15 @@ def table_key(defect, bearing, **args) -> str:
     ``defect`` must have angle 0: where the defect sits around the ring does not enter
     the table."""
     from .contact import ABOVE_NODE_STEP, HALFSPACE_NODES
-    from .halfspace import (COARSE_STEP, DIRECT_UPDATE_CELLS, REFINE_TOL, REFRESH_EVERY, SOLVE_TOL,
-                            TABLE_CELLS)
+    from .halfspace import (COARSE_STEP, DIRECT_UPDATE_CELLS, ENTER_SCALE, REFINE_TOL, REFRESH_EVERY,
+                            SOLVE_TOL, TABLE_CELLS)
     from .halfspace_skewed import INTACT_LATTICE
     payload = {"format": FORMAT, "code": code_fingerprint(), "defect": _plain(defect),
                "bearing": {f: _plain(getattr(bearing, f)) for f in BEARING_FIELDS},
                "args": _plain(args),
                "halfspace": _plain([HALFSPACE_NODES, ABOVE_NODE_STEP, TABLE_CELLS, SOLVE_TOL, REFINE_TOL,
-                                    COARSE_STEP, INTACT_LATTICE, DIRECT_UPDATE_CELLS, REFRESH_EVERY])}
+                                    COARSE_STEP, INTACT_LATTICE, DIRECT_UPDATE_CELLS, REFRESH_EVERY,
+                                    ENTER_SCALE])}
     return hashlib.sha256(json.dumps(payload, sort_keys=True).encode()).hexdigest()
 
 
