@@ -24,16 +24,16 @@ import numpy as np
 
 #: CPU s of one contact table built cold, as the simulation builds it (half-space; 6308 stand-in rig):
 #: an outline with sides along and across the track, and a skewed one (rotated cells).  Measured with
-#: benchmarks/identify_cost.py: 0.31 s and 1.3-3.2 s on the shared 2-core machine; bracketed with its spread
-TABLE_CPU_S = {"aligned": (0.15, 1.0), "skewed": (0.8, 5.0)}
+#: benchmarks/identify_cost.py: 0.17 s and 0.47-1.14 s on the shared 2-core machine; bracketed with its spread
+TABLE_CPU_S = {"aligned": (0.08, 1.0), "skewed": (0.3, 3.0)}
 #: CPU s per second of record of one scene with its table cached, its signature and score included
 #: (0.08-0.10 s for the time loop at rtol 1e-6, 20 kHz; the sweep, the Dataset and the scoring add to it)
 SCENE_CPU_S_PER_S = (0.08, 0.8)
 #: fewest scenes the refinement adds in the runs measured (210-244 on the stand-ins); its most is its budget
 REFINE_FEWEST = 100
-#: the likely figures inside those brackets: the middle of the measured tables (0.3 s aligned, 1.3-3.2 s
+#: the likely figures inside those brackets: the middle of the measured tables (0.17 s aligned, 0.47-1.14 s
 #: skewed), a scene with its scoring, and the refinement's scenes in the runs measured
-TABLE_CPU_LIKELY_S = {"aligned": 0.3, "skewed": 2.0}
+TABLE_CPU_LIKELY_S = {"aligned": 0.17, "skewed": 0.9}
 SCENE_CPU_LIKELY_S_PER_S = 0.15
 REFINE_LIKELY = 230
 
