@@ -80,7 +80,8 @@ def run_routes(x, fs, geometry, shaft_hz, *, tolerance=0.02, n_harmonics=5, prew
         The cepstrum-pre-whitened signal, if already computed.
     ses : dict, optional
         Squared envelope spectra already computed (of ``xw``: key "cpw"; of ``x`` in a band:
-        ("x", band)), as ``(f, spectrum, fmax)``.
+        ("x", band)), as ``(f, spectrum, fmax)``; key "kurtogram": a ``KurtogramTree`` of ``x``
+        (its levels already computed are not computed again).
 
     Returns
     -------
@@ -100,7 +101,9 @@ def run_routes(x, fs, geometry, shaft_hz, *, tolerance=0.02, n_harmonics=5, prew
     ses = ses or {}
     xk = xw if prewhiten else x
     try:
-        kg = fast_kurtogram(xk, fs, min_bandwidth=line_top)
+        tree = ses.get("kurtogram") if not prewhiten else None
+        kg = (tree.kurtogram(min_bandwidth=line_top) if tree is not None
+              else fast_kurtogram(xk, fs, min_bandwidth=line_top))
         band, sk = kg.band, float(kg.kurtosis_max)
     except AnalysisError:
         band, sk = None, 0.0  # too short for a kurtogram: demodulate the whole band
