@@ -36,7 +36,7 @@ from __future__ import annotations
 from ..errors import AnalysisError
 from ._cyclo import enhanced_envelope_spectrum
 from ._families import LABELS, SK_MIN, CyclicSpectrum, route_verdict, search_families
-from ._spectral import cepstral_prewhitening, fast_kurtogram, squared_envelope_spectrum
+from ._spectral import fast_kurtogram, prewhitened, record_ses
 from ._shaft import discrete_comb
 
 __all__ = ["run_routes", "combine", "coincidences", "ROUTES", "VERDICTS"]
@@ -55,13 +55,14 @@ def spectrum_top(fault_hz, shaft_hz, *, tolerance, n_harmonics):
     return n_harmonics * DECOY_SPAN * big * (1 + tolerance) + shaft_hz + 5.0
 
 
-def _ses(sig, fs, *, band, fmax, known):
+def _ses(sig, fs, *, band, fmax, known, spectrum=None):
     """Squared envelope spectrum of ``sig`` up to ``fmax``: cropped from ``known`` = (f, spectrum,
-    its fmax) when that reaches as far (the same numbers: the spectrum is cropped after the DFT)."""
+    its fmax) when that reaches as far (the same numbers: the spectrum is cropped after the DFT);
+    else demodulated from ``spectrum``, the rfft of ``sig``, when given."""
     if known is not None and fmax <= known[2]:
         keep = known[0] <= fmax
         return known[0][keep], known[1][keep]
-    return squared_envelope_spectrum(sig, fs, window="hann", band=band, fmax=fmax)
+    return record_ses(sig, fs, window="hann", band=band, fmax=fmax, spectrum=spectrum)
 
 
 def run_routes(x, fs, geometry, shaft_hz, *, tolerance=0.02, n_harmonics=5, prewhiten=False, xw=None, ses=None):
@@ -81,7 +82,8 @@ def run_routes(x, fs, geometry, shaft_hz, *, tolerance=0.02, n_harmonics=5, prew
     ses : dict, optional
         Squared envelope spectra already computed (of ``xw``: key "cpw"; of ``x`` in a band:
         ("x", band)), as ``(f, spectrum, fmax)``; key "kurtogram": a ``KurtogramTree`` of ``x``
-        (its levels already computed are not computed again).
+        (its levels already computed are not computed again); keys "rfft" and "whitened": the DFT
+        of ``x - mean`` and of ``xw`` (given with ``xw``).
 
     Returns
     -------
@@ -97,7 +99,8 @@ def run_routes(x, fs, geometry, shaft_hz, *, tolerance=0.02, n_harmonics=5, prew
                             f"fault frequencies (up to {line_top:.0f} Hz) of bearing {geometry.name!r}")
     fmax = min(spectrum_top(ff, shaft_hz, tolerance=tolerance, n_harmonics=n_harmonics), 0.49 * fs)
     if xw is None:
-        xw, ses = cepstral_prewhitening(x), {}
+        X, W, xw = prewhitened(x)
+        ses = {"rfft": X, "whitened": W}
     ses = ses or {}
     xk = xw if prewhiten else x
     try:
@@ -108,8 +111,9 @@ def run_routes(x, fs, geometry, shaft_hz, *, tolerance=0.02, n_harmonics=5, prew
     except AnalysisError:
         band, sk = None, 0.0  # too short for a kurtogram: demodulate the whole band
     spectra = {
-        "kurtogram_ses": _ses(xk, fs, band=band, fmax=fmax, known=None if prewhiten else ses.get(("x", band))),
-        "cpw_ses": _ses(xw, fs, band=None, fmax=fmax, known=ses.get("cpw")),
+        "kurtogram_ses": _ses(xk, fs, band=band, fmax=fmax, known=None if prewhiten else ses.get(("x", band)),
+                              spectrum=ses.get("whitened" if prewhiten else "rfft")),
+        "cpw_ses": _ses(xw, fs, band=None, fmax=fmax, known=ses.get("cpw"), spectrum=ses.get("whitened")),
         # the EES costs grow with alpha_max squared: it reaches the fault lines (decoys below them)
         "ees": enhanced_envelope_spectrum(x, fs, alpha_max=min(line_top + 20.0, 0.24 * fs)),
     }
@@ -124,12 +128,12 @@ def run_routes(x, fs, geometry, shaft_hz, *, tolerance=0.02, n_harmonics=5, prew
         if routes[name]["abstained"]:
             routes[name]["abstain_reason"] = (f"the band's spectral kurtosis {sk:.2f} is below {SK_MIN:g}: "
                                               "no impulsiveness to demodulate")
-    note = _check_discrete(x, fs, routes, ff)
+    note = _check_discrete(x, fs, routes, ff, ses.get("rfft"))
     return {"band": band, "spectral_kurtosis": sk, "impulsive": sk >= SK_MIN, "fault_hz": ff,
             "routes": routes, "xw": xw, "notes": [note] if note else []}
 
 
-def _check_discrete(x, fs, routes, fault_hz):
+def _check_discrete(x, fs, routes, fault_hz, spectrum=None):
     """The pre-whitened route abstains for a slip-free fault comb of discrete lines.
 
     A comb of discrete lines is deterministic.  A bearing fault's impacts slip,
@@ -147,7 +151,7 @@ def _check_discrete(x, fs, routes, fault_hz):
         if routes[name]["abstained"] or key not in LABELS or not routes[name]["families"][key]["detected"]:
             continue
         f1 = routes[name]["families"][key]["measured_hz"]
-        discrete, frac, count = discrete_comb(x, fs, f1)
+        discrete, frac, count = discrete_comb(x, fs, f1, spectrum=spectrum)
         if not discrete:
             continue
         kin = 2 * fault_hz["bsf"] if key == "bsf" else fault_hz[key]

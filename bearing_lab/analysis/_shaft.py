@@ -95,14 +95,17 @@ class RawLines:
         Highest frequency needed.
     mains_hz : sequence of float
         Mains frequencies whose harmonics are masked (within 1.5 bins).
+    spectrum : ndarray, optional
+        ``rfft(x - x.mean())``, when the caller has it.
     """
 
-    def __init__(self, x, fs, *, top_hz, mains_hz=(50.0, 60.0)):
+    def __init__(self, x, fs, *, top_hz, mains_hz=(50.0, 60.0), spectrum=None):
         n = x.size
         self.fs, self.n, self.df = float(fs), n, fs / n
         self.x = x
         top = min(int(np.ceil(top_hz / self.df)) + 64, n // 2)
-        self.X_full = _fft.rfft(x - x.mean())  # the whole spectrum, for discrete_comb
+        # the whole spectrum, for discrete_comb (``spectrum``: the caller's rfft(x - x.mean()))
+        self.X_full = _fft.rfft(x - x.mean()) if spectrum is None else spectrum
         self.X = self.X_full[: top + 2]
         amp = np.abs(self.X)
         self.amp = amp
@@ -469,7 +472,7 @@ def _own_comb(geometry, prior_hz, f_hz, tolerance):
 
 
 def resolve_speed(x, fs, geometry, *, rpm=None, rpm_source="given", cs=None, tolerance=0.02,
-                  blind_range_hz=BLIND_RANGE_HZ, min_family_rms=None):
+                  blind_range_hz=BLIND_RANGE_HZ, min_family_rms=None, spectrum=None):
     """Shaft frequency from a prior speed or the signal alone (module docstring).
 
     Parameters
@@ -493,6 +496,8 @@ def resolve_speed(x, fs, geometry, *, rpm=None, rpm_source="given", cs=None, tol
     min_family_rms : float, optional
         Measurability floor (signal units, rms) a plain 1x family must reach to name a
         blind speed without a fault family to confirm it.
+    spectrum : ndarray, optional
+        ``rfft(x - x.mean())``, when the caller has it.
 
     Returns
     -------
@@ -513,7 +518,7 @@ def resolve_speed(x, fs, geometry, *, rpm=None, rpm_source="given", cs=None, tol
                             f"record sampled at {fs:.6g} Hz (its lines must lie below {0.5 * fs:.6g} Hz): "
                             "the stored or given speed is wrong; give the speed with --rpm, or --rpm none")
     hi_all = max(hi_b, prior * (1 + PRIOR_TOLERANCE) if prior else 0.0)
-    raw = RawLines(x, fs, top_hz=min(0.45 * fs, N_SHAFT_HARMONICS * hi_all * 1.03))
+    raw = RawLines(x, fs, top_hz=min(0.45 * fs, N_SHAFT_HARMONICS * hi_all * 1.03), spectrum=spectrum)
     raw.min_rms = min_family_rms
     lowest = prior * (1 - PRIOR_TOLERANCE) if prior else lo_b
     if 4 * raw.df > lowest:

@@ -179,18 +179,44 @@ def cepstral_prewhitening(x, *, axis=-1):
     """
     x = check_signal(x, func="cepstral_prewhitening", min_samples=4, axis=axis)
     n = x.shape[axis]
-    X = _fft.fft(x - x.mean(axis=axis, keepdims=True), axis=axis)
+    # x is real: the half spectrum (rfft) and its inverse give what the whole one gives
+    return _fft.irfft(whitened_spectrum(_fft.rfft(x - x.mean(axis=axis, keepdims=True), axis=axis), axis=axis),
+                      n=n, axis=axis)
+
+
+def whitened_spectrum(X, *, axis=-1):
+    """``X / |X|`` (0 where ``|X|`` is below 1e-12 of its largest value): the DFT of the cepstrum-
+    pre-whitened signal, given the DFT ``X`` of the zero-mean signal (full or half spectrum)."""
     mag = np.abs(X)
     floor = 1e-12 * np.max(mag, axis=axis, keepdims=True)
     if np.all(floor == 0):
         raise AnalysisError("cepstral_prewhitening: x is constant; nothing to whiten")
-    X = np.where(mag > floor, X / np.maximum(mag, floor), 0.0)
-    return _fft.ifft(X, n=n, axis=axis).real
+    return np.where(mag > floor, X / np.maximum(mag, floor), 0.0)
 
 
-def _analytic_band(x, fs, band, nfft):
-    """Analytic signal of ``x`` band-passed to ``band`` (ideal filter), last axis."""
-    X = _fft.rfft(x, n=nfft, axis=-1)
+def prewhitened(x):
+    """(``rfft(x - mean)``, its whitened spectrum, the pre-whitened signal) of a 1-D record: what
+    :func:`cepstral_prewhitening` computes, with the two spectra kept for the record's other uses."""
+    X = _fft.rfft(x - x.mean())
+    W = whitened_spectrum(X)
+    return X, W, _fft.irfft(W, n=x.size)
+
+
+def record_ses(x, fs, *, window, band=None, fmax=None, spectrum=None):
+    """:func:`squared_envelope_spectrum` of a checked 1-D record, demodulated from ``spectrum``, the
+    record's ``rfft`` (its zero-frequency bin is not used), when given and the envelope's transform
+    has the record's length (else from x)."""
+    if spectrum is None or _fft.next_fast_len(x.size, real=True) != x.size:
+        return squared_envelope_spectrum(x, fs, window=window, band=band, fmax=fmax)
+    return _ses_of(_analytic_band(x, fs, check_band(band, fs, func="squared_envelope"), x.size, X=spectrum),
+                   fs, window, fmax)
+
+
+def _analytic_band(x, fs, band, nfft, X=None):
+    """Analytic signal of ``x`` band-passed to ``band`` (ideal filter), last axis; ``X``: its rfft
+    of length ``nfft`` when known."""
+    if X is None:
+        X = _fft.rfft(x, n=nfft, axis=-1)
     f = np.fft.rfftfreq(nfft, 1.0 / fs)
     keep = np.ones(f.shape, bool) if band is None else (f >= band[0]) & (f <= band[1])
     keep[0] = False  # the analytic signal of the zero-mean part
@@ -336,8 +362,19 @@ def squared_envelope_spectrum(x, fs, *, window, band=None, prewhiten=False, fmax
     fs = check_fs(fs, func="squared_envelope_spectrum")
     x = check_signal(x, func="squared_envelope_spectrum", min_samples=16, axis=axis)
     se = np.moveaxis(squared_envelope(x, fs, band=band, prewhiten=prewhiten, axis=axis), axis, -1)
+    w = get_window(window, se.shape[-1], func="squared_envelope_spectrum")
+    f, spec = _ses_spectrum(se, fs, w, fmax)
+    return f, np.moveaxis(spec, -1, axis)
+
+
+def _ses_of(z, fs, window, fmax):
+    """SES of the analytic signal ``z`` (1-D), as :func:`squared_envelope_spectrum`."""
+    se = z.real ** 2 + z.imag ** 2
+    return _ses_spectrum(se, fs, get_window(window, se.size, func="squared_envelope_spectrum"), fmax)
+
+
+def _ses_spectrum(se, fs, w, fmax):
     n = se.shape[-1]
-    w = get_window(window, n, func="squared_envelope_spectrum")
     mean = se.mean(axis=-1, keepdims=True)
     spec = np.abs(_fft.rfft((se - mean) * w, axis=-1)) * (2.0 / w.sum())
     spec[..., 0] = mean[..., 0]
@@ -345,7 +382,7 @@ def squared_envelope_spectrum(x, fs, *, window, band=None, prewhiten=False, fmax
     if fmax is not None:
         keep = f <= float(fmax)
         f, spec = f[keep], spec[..., keep]
-    return f, np.moveaxis(spec, -1, axis)
+    return f, spec
 
 
 Kurtogram = namedtuple("Kurtogram", ["kurtosis", "levels", "frequency", "band", "level", "kurtosis_max"])

@@ -48,7 +48,7 @@ from ._hump import apply as apply_humps
 from ._impulse import excitation_period
 from ._metrics import METRIC_NAMES, metrics
 from ._shaft import BLIND_RANGE_HZ, resolve_speed
-from ._spectral import KurtogramTree, amplitude_spectrum, cepstral_prewhitening, squared_envelope_spectrum
+from ._spectral import KurtogramTree, amplitude_spectrum, prewhitened, record_ses
 from ._speed import shaft_frequency
 from ._tacho import ORDER_TRACK_VARIATION, order_track, tacho_pulses, tacho_speed
 from ._util import check_fs, check_signal
@@ -97,8 +97,9 @@ def _tacho_speed(x, fs, tacho, pulses_per_rev):
 def _speed(x, fs, geom, *, rpm, rpm_source, shaft_hz, tacho, pulses_per_rev, tolerance, n_harmonics,
            fallback=True, units="m s-2"):
     """(signal to analyse, speed dict, pre-whitened signal or None, the envelope spectra computed:
-    ``{key: (f, spectrum, fmax)}``, key "cpw" or ("x", band), and "kurtogram": the record's
-    :class:`KurtogramTree` once a kurtogram was asked for, for :func:`run_routes` to reuse)."""
+    ``{key: (f, spectrum, fmax)}``, key "cpw" or ("x", band), "rfft" and "whitened": the record's
+    DFT and its whitened one, and "kurtogram": the record's :class:`KurtogramTree` once a kurtogram
+    was asked for, for :func:`run_routes` to reuse)."""
     if shaft_hz is not None:
         fr = float(shaft_hz)
         if not (math.isfinite(fr) and fr > 0):
@@ -110,8 +111,8 @@ def _speed(x, fs, geom, *, rpm, rpm_source, shaft_hz, tacho, pulses_per_rev, tol
     if rpm is not None and not (math.isfinite(rpm) and rpm > 0):
         raise AnalysisError(f"analyze: rpm={rpm!r} must be a positive speed in r/min")
     check_choice(rpm_source, ("given", "file"), "analyze: rpm_source", AnalysisError)
-    xw = cepstral_prewhitening(x)
-    cache, ses = {}, {}
+    X, W, xw = prewhitened(x)  # the record's DFT and its whitened one, for every spectrum below
+    cache, ses = {}, {"rfft": X, "whitened": W}
 
     def spectra(f0):
         """Pre-whitened SES (once, reaching the fastest blind candidate's decoys) and the SES of
@@ -120,7 +121,7 @@ def _speed(x, fs, geom, *, rpm, rpm_source, shaft_hz, tacho, pulses_per_rev, tol
         if "cpw" not in cache:
             fmax = min(0.49 * fs, spectrum_top(geom.fault_frequencies(BLIND_RANGE_HZ[1]), BLIND_RANGE_HZ[1],
                                                tolerance=tolerance, n_harmonics=n_harmonics))
-            ses["cpw"] = (*squared_envelope_spectrum(xw, fs, window="hann", fmax=fmax), fmax)
+            ses["cpw"] = (*record_ses(xw, fs, window="hann", fmax=fmax, spectrum=W), fmax)
             cache["cpw"] = CyclicSpectrum(*ses["cpw"][:2])
         line_top = n_harmonics * max(ff["bpfi"], 2 * ff["bsf"], ff["bpfo"]) * (1 + tolerance) + f0
         nb = int(2 ** np.floor(np.log2(max(1.0, fs / 2 / line_top))))
@@ -136,7 +137,7 @@ def _speed(x, fs, geom, *, rpm, rpm_source, shaft_hz, tacho, pulses_per_rev, tol
         return [cache["cpw"], cache[nb]]
 
     sp = resolve_speed(x, fs, geom, rpm=rpm, rpm_source=rpm_source, cs=spectra, tolerance=tolerance,
-                       min_family_rms=floor_in_units(units))
+                       min_family_rms=floor_in_units(units), spectrum=X)
     if sp["shaft_hz"] is None and fallback:
         # nothing to go by: the strongest harmonic family, for the fault-frequency table only
         sp["shaft_hz"] = float(shaft_frequency(x, fs, window="boxcar")[0])
@@ -152,7 +153,7 @@ def _band_spectrum(x, fs, kg, geom, tolerance, n_harmonics, ses):
         return SimpleNamespace(band=kg.band, kurtosis=float(kg.kurtosis_max))
     top = min(0.49 * fs, spectrum_top(geom.fault_frequencies(BLIND_RANGE_HZ[1]), BLIND_RANGE_HZ[1],
                                       tolerance=tolerance, n_harmonics=n_harmonics))
-    ses[("x", kg.band)] = (*squared_envelope_spectrum(x, fs, window="hann", band=kg.band, fmax=top), top)
+    ses[("x", kg.band)] = (*record_ses(x, fs, window="hann", band=kg.band, fmax=top, spectrum=ses["rfft"]), top)
     cs = CyclicSpectrum(*ses[("x", kg.band)][:2])
     cs.band, cs.kurtosis = kg.band, float(kg.kurtosis_max)
     return cs
