@@ -46,9 +46,10 @@ from ._families import LABELS, SK_MIN, CyclicSpectrum
 from ._floor import band_rms, floor_in_units
 from ._hump import apply as apply_humps
 from ._impulse import excitation_period
+from ._kurtogram import KurtogramTree
 from ._metrics import METRIC_NAMES, metrics
 from ._shaft import BLIND_RANGE_HZ, resolve_speed
-from ._spectral import KurtogramTree, amplitude_spectrum, prewhitened, record_ses
+from ._spectral import amplitude_spectrum, prewhitened, record_ses
 from ._speed import shaft_frequency
 from ._tacho import ORDER_TRACK_VARIATION, order_track, tacho_pulses, tacho_speed
 from ._util import check_fs, check_signal
