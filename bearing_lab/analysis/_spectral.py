@@ -207,8 +207,47 @@ def record_ses(x, fs, *, window, band=None, fmax=None, spectrum=None):
     has the record's length (else from x)."""
     if spectrum is None or _fft.next_fast_len(x.size, real=True) != x.size:
         return squared_envelope_spectrum(x, fs, window=window, band=band, fmax=fmax)
-    return _ses_of(_analytic_band(x, fs, check_band(band, fs, func="squared_envelope"), x.size, X=spectrum),
-                   fs, window, fmax)
+    band = check_band(band, fs, func="squared_envelope")
+    if window == "hann" and fmax is not None:
+        out = _hann_ses_low(spectrum, x.size, fs, band, float(fmax))
+        if out is not None:
+            return out
+    return _ses_of(_analytic_band(x, fs, band, x.size, X=spectrum), fs, window, fmax)
+
+
+def _hann_ses_low(X, n, fs, band, fmax):
+    """The Hann-windowed SES up to ``fmax`` from a shorter transform (None when it would not be).
+
+    The squared envelope's DFT at lag k is the autocorrelation of the band's bins,
+    ``SE[k] = sum_i Z[i + k] conj(Z[i]) / n``: it vanishes beyond the band's ``m`` bins, so the
+    DFT of the squared magnitude of the band's complex envelope sampled ``L >= K + m`` times (K the
+    highest lag read), times ``L / n``, is ``SE[0..K]`` without aliasing; the periodic Hann window
+    is the 3-tap kernel (-1/4, 1/2, -1/4) on that DFT.  A minute at 20 kHz demodulated in a band
+    of 833 Hz and read up to 1 kHz: transforms of 120 000 points instead of 1.2 M."""
+    f = np.fft.rfftfreq(n, 1.0 / fs)
+    keep = np.ones(f.shape, bool) if band is None else (f >= band[0]) & (f <= band[1])
+    keep[0] = False
+    idx = np.flatnonzero(keep)
+    f = f[f <= fmax]
+    K = f.size  # lags 0 .. K read (K for the window's kernel at the top bin)
+    m = idx.size
+    if m == 0 or K < 2:
+        return None
+    L = _fft.next_fast_len(max(K + m + 1, 2 * K + 2), real=True)
+    if L >= n:
+        return None
+    Zb = np.zeros(L, complex)
+    Zb[:m] = 2.0 * X[idx[0]: idx[-1] + 1]
+    if n % 2 == 0 and idx[-1] == n // 2:
+        Zb[m - 1] /= 2.0
+    c = _fft.ifft(Zb, workers=1)
+    SE = _fft.rfft(c.real ** 2 + c.imag ** 2)[: K + 1] * (L / n)
+    mean = SE[0].real / n
+    SE[0] = 0.0  # the mean removed
+    low = np.concatenate([[np.conj(SE[1])], SE[:-2]])  # SE[k - 1], SE[-1] = conj(SE[1])
+    spec = np.abs(0.5 * SE[:-1] - 0.25 * (low + SE[1:])) * (4.0 / n)
+    spec[0] = mean
+    return f, spec
 
 
 def _analytic_band(x, fs, band, nfft, X=None):
