@@ -90,7 +90,8 @@ def run_routes(x, fs, geometry, shaft_hz, *, tolerance=0.02, n_harmonics=5, prew
     dict
         ``band`` (low, high) Hz or None, ``spectral_kurtosis``, ``impulsive``,
         ``fault_hz``, ``routes``: per route ``verdict`` (route_verdict result),
-        ``families``, ``f``, ``spectrum``, ``abstained`` (bool).
+        ``families``, ``f``, ``spectrum``, ``abstained`` (bool); ``xw`` and ``rfft``, the DFT of
+        ``x - mean`` (None when ``xw`` was given without it).
     """
     ff = geometry.fault_frequencies(shaft_hz)
     line_top = n_harmonics * max(ff["bpfi"], 2 * ff["bsf"], ff["bpfo"]) * (1 + tolerance) + shaft_hz
@@ -130,7 +131,7 @@ def run_routes(x, fs, geometry, shaft_hz, *, tolerance=0.02, n_harmonics=5, prew
                                               "no impulsiveness to demodulate")
     note = _check_discrete(x, fs, routes, ff, ses.get("rfft"))
     return {"band": band, "spectral_kurtosis": sk, "impulsive": sk >= SK_MIN, "fault_hz": ff,
-            "routes": routes, "xw": xw, "notes": [note] if note else []}
+            "routes": routes, "xw": xw, "rfft": ses.get("rfft"), "notes": [note] if note else []}
 
 
 def _check_discrete(x, fs, routes, fault_hz, spectrum=None):

@@ -90,14 +90,19 @@ class KurtogramTree:
             if m < 8:
                 self._rows[nb] = None
                 return None
-            starts = 1 + (np.arange(nb) * nb_total) // nb
-            idx = starts[:, None] + np.arange(m)[None, :]
-            c = _fft.ifft(X[idx], axis=-1)
+            if nb_total % nb == 0:  # the bands tile the bins: a view, no gather
+                bands = X[1:].reshape(nb, m)
+            else:
+                starts = 1 + (np.arange(nb) * nb_total) // nb
+                bands = X[starts[:, None] + np.arange(m)[None, :]]
+            c = _fft.ifft(bands, axis=-1, workers=1)
             c = c[:, int(0.1 * m): m - int(0.1 * m)]
-            p = c.real ** 2 + c.imag ** 2
+            p = np.multiply(c.real, c.real)  # |c|^2, then |c|^4 in place: no temporaries
+            p += c.imag * c.imag
             m2 = p.mean(axis=-1)
+            p *= p
             with np.errstate(invalid="ignore", divide="ignore"):
-                k = np.where(m2 > 0, (p * p).mean(axis=-1) / np.where(m2 > 0, m2, 1) ** 2 - 2.0, -2.0)
+                k = np.where(m2 > 0, p.mean(axis=-1) / np.where(m2 > 0, m2, 1) ** 2 - 2.0, -2.0)
             self._rows[nb] = k
         return self._rows[nb]
 

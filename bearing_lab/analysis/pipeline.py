@@ -204,7 +204,8 @@ def _run(x, fs, *, bearing, rpm=None, shaft_hz=None, tolerance=0.02, n_harmonics
     fr = float(speed["shaft_hz"])
     if speed["status"] == "unresolved":
         out = _unresolved(speed, geom, fs, xa.size, m, tolerance, n_harmonics)
-        return _below_floor_unresolved(out, band_rms(xa, fs, None), floor_in_units(units, fs / 2), units)
+        rms = band_rms(xa, fs, None, spectrum=ses.get("rfft") if xa is x else None)
+        return _below_floor_unresolved(out, rms, floor_in_units(units, fs / 2), units)
     res = run_routes(xa, fs, geom, fr, tolerance=tolerance, n_harmonics=n_harmonics, prewhiten=prewhiten,
                      xw=xw if xa is x else None, ses=ses if xa is x else None)
     routes = res["routes"]
@@ -212,7 +213,8 @@ def _run(x, fs, *, bearing, rpm=None, shaft_hz=None, tolerance=0.02, n_harmonics
                                  factors=geom.frequency_factors(), speed_status=speed["status"], tolerance=tolerance)
     width = fs / 2 if res["band"] is None else res["band"][1] - res["band"][0]
     floor = floor_in_units(units, width)
-    verdict = _floor_verdict(verdict, band_rms(xa, fs, res["band"]), floor, units)
+    rms = band_rms(xa, fs, res["band"], spectrum=res["rfft"] if xa is x else None)
+    verdict = _floor_verdict(verdict, rms, floor, units)
     decided = deciding_route(routes)
     key = {v: k for k, v in LABELS.items()}.get(verdict["diagnosis"]) if verdict["verdict"] == "diagnosed" else None
     period = None
