@@ -83,7 +83,8 @@ def run_routes(x, fs, geometry, shaft_hz, *, tolerance=0.02, n_harmonics=5, prew
         Squared envelope spectra already computed (of ``xw``: key "cpw"; of ``x`` in a band:
         ("x", band)), as ``(f, spectrum, fmax)``; key "kurtogram": a ``KurtogramTree`` of ``x``
         (its levels already computed are not computed again); keys "rfft" and "whitened": the DFT
-        of ``x - mean`` and of ``xw`` (given with ``xw``).
+        of ``x - mean`` and of ``xw`` (given with ``xw``); "floors": a ``SpectrumFloors`` of the
+        former.
 
     Returns
     -------
@@ -129,12 +130,12 @@ def run_routes(x, fs, geometry, shaft_hz, *, tolerance=0.02, n_harmonics=5, prew
         if routes[name]["abstained"]:
             routes[name]["abstain_reason"] = (f"the band's spectral kurtosis {sk:.2f} is below {SK_MIN:g}: "
                                               "no impulsiveness to demodulate")
-    note = _check_discrete(x, fs, routes, ff, ses.get("rfft"))
+    note = _check_discrete(x, fs, routes, ff, ses.get("rfft"), ses.get("floors"))
     return {"band": band, "spectral_kurtosis": sk, "impulsive": sk >= SK_MIN, "fault_hz": ff,
             "routes": routes, "xw": xw, "rfft": ses.get("rfft"), "notes": [note] if note else []}
 
 
-def _check_discrete(x, fs, routes, fault_hz, spectrum=None):
+def _check_discrete(x, fs, routes, fault_hz, spectrum=None, floors=None):
     """The pre-whitened route abstains for a slip-free fault comb of discrete lines.
 
     A comb of discrete lines is deterministic.  A bearing fault's impacts slip,
@@ -152,7 +153,7 @@ def _check_discrete(x, fs, routes, fault_hz, spectrum=None):
         if routes[name]["abstained"] or key not in LABELS or not routes[name]["families"][key]["detected"]:
             continue
         f1 = routes[name]["families"][key]["measured_hz"]
-        discrete, frac, count = discrete_comb(x, fs, f1, spectrum=spectrum)
+        discrete, frac, count = discrete_comb(x, fs, f1, spectrum=spectrum, floors=floors)
         if not discrete:
             continue
         kin = 2 * fault_hz["bsf"] if key == "bsf" else fault_hz[key]

@@ -50,7 +50,7 @@ from ._kurtogram import KurtogramTree
 from ._metrics import METRIC_NAMES, metrics
 from ._shaft import BLIND_RANGE_HZ, resolve_speed
 from ._spectral import amplitude_spectrum, prewhitened, record_ses
-from ._speed import shaft_frequency
+from ._speed import SpectrumFloors, shaft_frequency
 from ._tacho import ORDER_TRACK_VARIATION, order_track, tacho_pulses, tacho_speed
 from ._util import check_fs, check_signal
 
@@ -99,7 +99,7 @@ def _speed(x, fs, geom, *, rpm, rpm_source, shaft_hz, tacho, pulses_per_rev, tol
            fallback=True, units="m s-2"):
     """(signal to analyse, speed dict, pre-whitened signal or None, the envelope spectra computed:
     ``{key: (f, spectrum, fmax)}``, key "cpw" or ("x", band), "rfft" and "whitened": the record's
-    DFT and its whitened one, and "kurtogram": the record's :class:`KurtogramTree` once a kurtogram
+    DFT and its whitened one, "floors": a SpectrumFloors of the record's DFT, and "kurtogram": the record's :class:`KurtogramTree` once a kurtogram
     was asked for, for :func:`run_routes` to reuse)."""
     if shaft_hz is not None:
         fr = float(shaft_hz)
@@ -113,7 +113,7 @@ def _speed(x, fs, geom, *, rpm, rpm_source, shaft_hz, tacho, pulses_per_rev, tol
         raise AnalysisError(f"analyze: rpm={rpm!r} must be a positive speed in r/min")
     check_choice(rpm_source, ("given", "file"), "analyze: rpm_source", AnalysisError)
     X, W, xw = prewhitened(x)  # the record's DFT and its whitened one, for every spectrum below
-    cache, ses = {}, {"rfft": X, "whitened": W}
+    cache, ses = {}, {"rfft": X, "whitened": W, "floors": SpectrumFloors(X)}
 
     def spectra(f0):
         """Pre-whitened SES (once, reaching the fastest blind candidate's decoys) and the SES of
@@ -138,7 +138,8 @@ def _speed(x, fs, geom, *, rpm, rpm_source, shaft_hz, tacho, pulses_per_rev, tol
         return [cache["cpw"], cache[nb]]
 
     sp = resolve_speed(x, fs, geom, rpm=rpm, rpm_source=rpm_source, cs=spectra, tolerance=tolerance,
-                       min_family_rms=floor_in_units(units), spectrum=X)
+                       min_family_rms=floor_in_units(units), spectrum=X,
+                       floors=ses["floors"])
     if sp["shaft_hz"] is None and fallback:
         # nothing to go by: the strongest harmonic family, for the fault-frequency table only
         sp["shaft_hz"] = float(shaft_frequency(x, fs, window="boxcar")[0])

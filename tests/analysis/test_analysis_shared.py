@@ -67,3 +67,12 @@ def test_kurtogram_tree_read_twice_equals_two_kurtograms():
         np.testing.assert_array_equal(a.kurtosis, b.kurtosis)
         assert (a.band, a.level, a.kurtosis_max) == (b.band, b.level, b.kurtosis_max)
     assert tree.kurtogram(min_bandwidth=800.0, fmin=4000.0).band[1] > 4000.0
+
+
+def test_spectrum_floors_of_slices_equal_the_slices_own_floors():
+    from bearing_lab.analysis._speed import SpectrumFloors, line_floor_db
+    X = fft.rfft(_impacts(200000, 20000.0, seed=3))
+    floors = SpectrumFloors(X)
+    n = X.size
+    for a, b, w in ((1, n, 601), (200, n - 150, 600), (0, n // 2 + 10, 31), (5000, n - 1, 600), (10, 3000, 601)):
+        np.testing.assert_array_equal(floors.snr(a, b, width=w), line_floor_db(np.abs(X[a:b]), width=w))
