@@ -147,9 +147,17 @@ class RawLines:
         step = 0.5 * self.df / nh
         cand = np.arange(lo, hi + step, step)
         h = np.arange(1, nh + 1)
-        pos = np.clip(np.rint(cand[:, None] * h / self.df).astype(int), 1, self.clear.size - 2)
-        vals = self.clear3[pos]
-        return cand, (vals * 0.9 ** (h - 1)).sum(axis=1)
+        wts = 0.9 ** (h - 1)
+        score = np.empty(cand.size)
+        for i in range(0, cand.size, 8192):  # blocks that stay in cache, operations in place
+            c = cand[i:i + 8192, None] * h
+            c /= self.df
+            pos = np.rint(c, out=c).astype(np.intp)
+            np.clip(pos, 1, self.clear.size - 2, out=pos)
+            vals = self.clear3[pos]
+            vals *= wts
+            score[i:i + 8192] = vals.sum(axis=1)
+        return cand, score
 
     def candidates(self, lo, hi, count=6):
         """Up to ``count`` distinct local maxima of the family score in [lo, hi], best first."""
