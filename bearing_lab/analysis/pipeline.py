@@ -99,8 +99,8 @@ def _speed(x, fs, geom, *, rpm, rpm_source, shaft_hz, tacho, pulses_per_rev, tol
            fallback=True, units="m s-2"):
     """(signal to analyse, speed dict, pre-whitened signal or None, the envelope spectra computed:
     ``{key: (f, spectrum, fmax)}``, key "cpw" or ("x", band), "rfft" and "whitened": the record's
-    DFT and its whitened one, "floors": a SpectrumFloors of the record's DFT, and "kurtogram": the record's :class:`KurtogramTree` once a kurtogram
-    was asked for, for :func:`run_routes` to reuse)."""
+    DFT and its whitened one, "floors": a SpectrumFloors of the record's DFT, and "kurtogram": the
+    record's :class:`KurtogramTree` once a kurtogram was asked for, for :func:`run_routes` to reuse)."""
     if shaft_hz is not None:
         fr = float(shaft_hz)
         if not (math.isfinite(fr) and fr > 0):
