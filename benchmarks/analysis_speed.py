@@ -21,6 +21,8 @@ A second table gives ``analyze`` alone in its three speed modes: a stored or giv
 speed as a prior (``rpm``, as above), the shaft frequency given (``shaft_hz``), and
 no speed at all (blind).
 Threads are limited to one (OMP/MKL/OpenBLAS) before numpy is imported.
+That a faster tree gives the same results: ``benchmarks/analysis_fingerprint.py`` (``dump`` with
+each tree, then ``compare``).
 """
 from __future__ import annotations
 

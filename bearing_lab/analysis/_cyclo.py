@@ -106,15 +106,21 @@ def enhanced_envelope_spectrum(x, fs, *, alpha_max, nw=None):
     hop = max(1, min(int(fs / (2 * alpha_max)), nw // 4))
     n_frames = (x.size - nw) // hop + 1
     frames = np.lib.stride_tricks.sliding_window_view(x - x.mean(), nw)[::hop][:n_frames]
-    X = _fft.rfft(frames * np.hanning(nw + 1)[:-1], axis=1)
-    power = np.mean(X.real ** 2 + X.imag ** 2, axis=0)
+    # frames as columns: the STFT's bins come out as contiguous rows (no transposed copy of them)
+    X = _fft.rfft(frames.T * np.hanning(nw + 1)[:-1, None], axis=0)
+    S = np.multiply(X.real, X.real)  # |X|^2: the bins' power, and the zero shift's products below
+    S += X.imag * X.imag
+    power = np.mean(S, axis=1)
     n_fft = _fft.next_fast_len(n_frames)
-    nb = X.shape[1]
+    nb = X.shape[0]
     # whitened bins 1 .. nb-2 (DC and Nyquist excluded) as rows, zero-padded to n_fft frames: each
     # shift's products are then contiguous rows, transformed along the last axis
     Xt = np.zeros((nb - 2, n_fft), complex)
-    np.divide(X[:, 1:-1].T, np.sqrt(np.maximum(power, power.max() * 1e-12))[1:-1, None], out=Xt[:, :n_frames])
+    scale = np.maximum(power, power.max() * 1e-12)[1:-1, None]
+    np.divide(X[1:-1], np.sqrt(scale), out=Xt[:, :n_frames])
     del X
+    Xc = np.conj(Xt)  # once for every shift; one product buffer, transformed in place
+    buf = np.empty((max(nb - 3, 1), n_fft), complex)
     frame_rate = fs / hop
     alpha = np.arange(n_fft) * frame_rate / n_fft
     keep = int(np.searchsorted(alpha, alpha_max, side="right"))
@@ -129,9 +135,12 @@ def enhanced_envelope_spectrum(x, fs, *, alpha_max, nw=None):
         if sel.size == 0 or p >= nb - 2:
             continue
         if p == 0:  # |X|^2 is real: half the transform
-            Q = _fft.rfft(Xt.real ** 2 + Xt.imag ** 2, axis=1, workers=1)
+            P = np.zeros((nb - 2, n_fft))
+            np.divide(S[1:-1], scale, out=P[:, :n_frames])  # |X|^2 whitened: |Xt|^2
+            Q = _fft.rfft(P, axis=1, workers=1)
         else:
-            Q = _fft.fft(Xt[p:] * np.conj(Xt[: nb - 2 - p]), axis=1, overwrite_x=True, workers=1)
+            Q = _fft.fft(np.multiply(Xt[p:], Xc[: nb - 2 - p], out=buf[: nb - 2 - p]), axis=1, overwrite_x=True,
+                         workers=1)
         rows = np.abs(Q[:, sel[0]: sel[-1] + 1])
         delta = np.abs(alpha[sel] - p * bin_hz)
         gain = g[np.rint(delta / grid_hz).astype(int) % g.size]

@@ -36,7 +36,7 @@ from __future__ import annotations
 from ..errors import AnalysisError
 from ._cyclo import enhanced_envelope_spectrum
 from ._families import LABELS, SK_MIN, CyclicSpectrum, route_verdict, search_families
-from ._spectral import cepstral_prewhitening, fast_kurtogram, squared_envelope_spectrum
+from ._spectral import fast_kurtogram, prewhitened, record_ses
 from ._shaft import discrete_comb
 
 __all__ = ["run_routes", "combine", "coincidences", "ROUTES", "VERDICTS"]
@@ -55,13 +55,14 @@ def spectrum_top(fault_hz, shaft_hz, *, tolerance, n_harmonics):
     return n_harmonics * DECOY_SPAN * big * (1 + tolerance) + shaft_hz + 5.0
 
 
-def _ses(sig, fs, *, band, fmax, known):
+def _ses(sig, fs, *, band, fmax, known, spectrum=None):
     """Squared envelope spectrum of ``sig`` up to ``fmax``: cropped from ``known`` = (f, spectrum,
-    its fmax) when that reaches as far (the same numbers: the spectrum is cropped after the DFT)."""
+    its fmax) when that reaches as far (the same numbers: the spectrum is cropped after the DFT);
+    else demodulated from ``spectrum``, the rfft of ``sig``, when given."""
     if known is not None and fmax <= known[2]:
         keep = known[0] <= fmax
         return known[0][keep], known[1][keep]
-    return squared_envelope_spectrum(sig, fs, window="hann", band=band, fmax=fmax)
+    return record_ses(sig, fs, window="hann", band=band, fmax=fmax, spectrum=spectrum)
 
 
 def run_routes(x, fs, geometry, shaft_hz, *, tolerance=0.02, n_harmonics=5, prewhiten=False, xw=None, ses=None):
@@ -80,14 +81,18 @@ def run_routes(x, fs, geometry, shaft_hz, *, tolerance=0.02, n_harmonics=5, prew
         The cepstrum-pre-whitened signal, if already computed.
     ses : dict, optional
         Squared envelope spectra already computed (of ``xw``: key "cpw"; of ``x`` in a band:
-        ("x", band)), as ``(f, spectrum, fmax)``.
+        ("x", band)), as ``(f, spectrum, fmax)``; key "kurtogram": a ``KurtogramTree`` of ``x``
+        (its levels already computed are not computed again); keys "rfft" and "whitened": the DFT
+        of ``x - mean`` and of ``xw`` (given with ``xw``); "floors": a ``SpectrumFloors`` of the
+        former.
 
     Returns
     -------
     dict
         ``band`` (low, high) Hz or None, ``spectral_kurtosis``, ``impulsive``,
         ``fault_hz``, ``routes``: per route ``verdict`` (route_verdict result),
-        ``families``, ``f``, ``spectrum``, ``abstained`` (bool).
+        ``families``, ``f``, ``spectrum``, ``abstained`` (bool); ``xw`` and ``rfft``, the DFT of
+        ``x - mean`` (None when ``xw`` was given without it).
     """
     ff = geometry.fault_frequencies(shaft_hz)
     line_top = n_harmonics * max(ff["bpfi"], 2 * ff["bsf"], ff["bpfo"]) * (1 + tolerance) + shaft_hz
@@ -96,17 +101,21 @@ def run_routes(x, fs, geometry, shaft_hz, *, tolerance=0.02, n_harmonics=5, prew
                             f"fault frequencies (up to {line_top:.0f} Hz) of bearing {geometry.name!r}")
     fmax = min(spectrum_top(ff, shaft_hz, tolerance=tolerance, n_harmonics=n_harmonics), 0.49 * fs)
     if xw is None:
-        xw, ses = cepstral_prewhitening(x), {}
+        X, W, xw = prewhitened(x)
+        ses = {"rfft": X, "whitened": W}
     ses = ses or {}
     xk = xw if prewhiten else x
     try:
-        kg = fast_kurtogram(xk, fs, min_bandwidth=line_top)
+        tree = ses.get("kurtogram") if not prewhiten else None
+        kg = (tree.kurtogram(min_bandwidth=line_top) if tree is not None
+              else fast_kurtogram(xk, fs, min_bandwidth=line_top))
         band, sk = kg.band, float(kg.kurtosis_max)
     except AnalysisError:
         band, sk = None, 0.0  # too short for a kurtogram: demodulate the whole band
     spectra = {
-        "kurtogram_ses": _ses(xk, fs, band=band, fmax=fmax, known=None if prewhiten else ses.get(("x", band))),
-        "cpw_ses": _ses(xw, fs, band=None, fmax=fmax, known=ses.get("cpw")),
+        "kurtogram_ses": _ses(xk, fs, band=band, fmax=fmax, known=None if prewhiten else ses.get(("x", band)),
+                              spectrum=ses.get("whitened" if prewhiten else "rfft")),
+        "cpw_ses": _ses(xw, fs, band=None, fmax=fmax, known=ses.get("cpw"), spectrum=ses.get("whitened")),
         # the EES costs grow with alpha_max squared: it reaches the fault lines (decoys below them)
         "ees": enhanced_envelope_spectrum(x, fs, alpha_max=min(line_top + 20.0, 0.24 * fs)),
     }
@@ -121,12 +130,12 @@ def run_routes(x, fs, geometry, shaft_hz, *, tolerance=0.02, n_harmonics=5, prew
         if routes[name]["abstained"]:
             routes[name]["abstain_reason"] = (f"the band's spectral kurtosis {sk:.2f} is below {SK_MIN:g}: "
                                               "no impulsiveness to demodulate")
-    note = _check_discrete(x, fs, routes, ff)
+    note = _check_discrete(x, fs, routes, ff, ses.get("rfft"), ses.get("floors"))
     return {"band": band, "spectral_kurtosis": sk, "impulsive": sk >= SK_MIN, "fault_hz": ff,
-            "routes": routes, "xw": xw, "notes": [note] if note else []}
+            "routes": routes, "xw": xw, "rfft": ses.get("rfft"), "notes": [note] if note else []}
 
 
-def _check_discrete(x, fs, routes, fault_hz):
+def _check_discrete(x, fs, routes, fault_hz, spectrum=None, floors=None):
     """The pre-whitened route abstains for a slip-free fault comb of discrete lines.
 
     A comb of discrete lines is deterministic.  A bearing fault's impacts slip,
@@ -144,7 +153,7 @@ def _check_discrete(x, fs, routes, fault_hz):
         if routes[name]["abstained"] or key not in LABELS or not routes[name]["families"][key]["detected"]:
             continue
         f1 = routes[name]["families"][key]["measured_hz"]
-        discrete, frac, count = discrete_comb(x, fs, f1)
+        discrete, frac, count = discrete_comb(x, fs, f1, spectrum=spectrum, floors=floors)
         if not discrete:
             continue
         kin = 2 * fault_hz["bsf"] if key == "bsf" else fault_hz[key]

@@ -48,11 +48,11 @@ def floor_in_units(units, bandwidth_hz=REFERENCE_BAND_HZ):
     return FLOOR_MS2 * float(np.sqrt(bandwidth_hz / REFERENCE_BAND_HZ)) / float(u.factor)
 
 
-def band_rms(x, fs, band):
+def band_rms(x, fs, band, *, spectrum=None):
     """rms of x in the band (low, high) Hz (Parseval on the one-sided DFT); whole signal
-    (mean removed) when band is None."""
+    (mean removed) when band is None.  ``spectrum``: ``rfft(x - x.mean())`` when known."""
     x = np.asarray(x, float)
-    X = np.fft.rfft(x - x.mean())
+    X = np.fft.rfft(x - x.mean()) if spectrum is None else spectrum
     f = np.fft.rfftfreq(x.size, 1.0 / fs)
     w = np.ones(f.size) * 2.0
     w[0] = 1.0

@@ -49,8 +49,6 @@ def hump_score(f, s, carrier_hz, *, shaft_hz, ftf_hz, n_harmonics=HUMP_HARMONICS
     does not reach the last ring."""
     df = float(f[1] - f[0])
     top = f[-1]
-    m = np.rint(f / shaft_hz)
-    keep = ~((m >= 1) & (np.abs(f - m * shaft_hz) <= 1.5 * df))
     total = 0.0
     for k in range(1, n_harmonics + 1):
         c = k * carrier_hz
@@ -58,7 +56,9 @@ def hump_score(f, s, carrier_hz, *, shaft_hz, ftf_hz, n_harmonics=HUMP_HARMONICS
         if c + 4 * h >= top or c - 4 * h <= 0:
             return float("nan")
         a, b = int(np.floor((c - 4 * h) / df)), int(np.ceil((c + 4 * h) / df)) + 1
-        ff, ss, kk = f[a:b], s[a:b], keep[a:b]
+        ff, ss = f[a:b], s[a:b]
+        m = np.rint(ff / shaft_hz)  # shaft harmonics are left out (only this window's bins)
+        kk = ~((m >= 1) & (np.abs(ff - m * shaft_hz) <= 1.5 * df))
         d = np.abs(ff - c)
         win, ring = kk & (d <= h), kk & (d > h)
         if np.count_nonzero(win) < 3 or np.count_nonzero(ring) < 6:

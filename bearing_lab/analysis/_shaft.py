@@ -95,14 +95,20 @@ class RawLines:
         Highest frequency needed.
     mains_hz : sequence of float
         Mains frequencies whose harmonics are masked (within 1.5 bins).
+    spectrum : ndarray, optional
+        ``rfft(x - x.mean())``, when the caller has it.
+    floors : SpectrumFloors, optional
+        Of ``spectrum``, for the discrete-comb tests.
     """
 
-    def __init__(self, x, fs, *, top_hz, mains_hz=(50.0, 60.0)):
+    def __init__(self, x, fs, *, top_hz, mains_hz=(50.0, 60.0), spectrum=None, floors=None):
         n = x.size
         self.fs, self.n, self.df = float(fs), n, fs / n
         self.x = x
         top = min(int(np.ceil(top_hz / self.df)) + 64, n // 2)
-        self.X_full = _fft.rfft(x - x.mean())  # the whole spectrum, for discrete_comb
+        # the whole spectrum, for discrete_comb (``spectrum``: the caller's rfft(x - x.mean()))
+        self.X_full = _fft.rfft(x - x.mean()) if spectrum is None else spectrum
+        self.floors = floors  # a SpectrumFloors of X_full, or None
         self.X = self.X_full[: top + 2]
         amp = np.abs(self.X)
         self.amp = amp
@@ -141,9 +147,17 @@ class RawLines:
         step = 0.5 * self.df / nh
         cand = np.arange(lo, hi + step, step)
         h = np.arange(1, nh + 1)
-        pos = np.clip(np.rint(cand[:, None] * h / self.df).astype(int), 1, self.clear.size - 2)
-        vals = self.clear3[pos]
-        return cand, (vals * 0.9 ** (h - 1)).sum(axis=1)
+        wts = 0.9 ** (h - 1)
+        score = np.empty(cand.size)
+        for i in range(0, cand.size, 8192):  # blocks that stay in cache, operations in place
+            c = cand[i:i + 8192, None] * h
+            c /= self.df
+            pos = np.rint(c, out=c).astype(np.intp)
+            np.clip(pos, 1, self.clear.size - 2, out=pos)
+            vals = self.clear3[pos]
+            vals *= wts
+            score[i:i + 8192] = vals.sum(axis=1)
+        return cand, score
 
     def candidates(self, lo, hi, count=6):
         """Up to ``count`` distinct local maxima of the family score in [lo, hi], best first."""
@@ -254,7 +268,7 @@ def _primitive(hs):
     return True
 
 
-def discrete_comb(x, fs, f1, *, max_lines=300, spectrum=None):
+def discrete_comb(x, fs, f1, *, max_lines=300, spectrum=None, floors=None):
     """Is the comb ``k f1`` a set of discrete lines of x (a fault without slip)?
 
     A fault comb without slip (a simulation with a kinematic cage) is a set of
@@ -265,7 +279,8 @@ def discrete_comb(x, fs, f1, *, max_lines=300, spectrum=None):
     them count and that many hits are unlikely by chance (binomial, hit rate
     three times the density of clear lines among the bins examined, p < 1e-3).
 
-    ``spectrum``: ``rfft(x - x.mean())`` when the caller has it already.
+    ``spectrum``: ``rfft(x - x.mean())`` when the caller has it already; ``floors``: a
+    :class:`SpectrumFloors` of it, shared by the tests of several combs.
 
     Returns
     -------
@@ -277,8 +292,11 @@ def discrete_comb(x, fs, f1, *, max_lines=300, spectrum=None):
     if k.size < 10:
         return False, 0.0, int(k.size)
     a, b = max(1, int(k[0] * f1 / df) - 200), min(n // 2, int(k[-1] * f1 / df) + 200)
-    amp = np.abs((_fft.rfft(x - x.mean()) if spectrum is None else spectrum)[a:b])
-    snr = line_floor_db(amp, width=max(31, int(round(10.0 / df))))
+    if floors is not None:
+        amp, snr = floors.amp[a:b], floors.snr(a, b, width=max(31, int(round(10.0 / df))))
+    else:
+        amp = np.abs((_fft.rfft(x - x.mean()) if spectrum is None else spectrum)[a:b])
+        snr = line_floor_db(amp, width=max(31, int(round(10.0 / df))))
     local = np.zeros(amp.size, bool)
     local[1:-1] = (amp[1:-1] >= amp[:-2]) & (amp[1:-1] >= amp[2:])
     clear = local & (snr >= LINE_SNR_DB)
@@ -434,7 +452,7 @@ def _fault_comb(raw, cs, f0, lines_h=()):
         if snr[0] >= FUNDAMENTAL_SNR_DB and np.count_nonzero(snr > 0) >= MIN_HARMONICS:
             return f"a comb of {np.count_nonzero(snr > 0)} lines in the {name} envelope spectrum"
     if raw.x is not None:
-        discrete, frac, count = discrete_comb(raw.x, raw.fs, f0, spectrum=raw.X_full)
+        discrete, frac, count = discrete_comb(raw.x, raw.fs, f0, spectrum=raw.X_full, floors=raw.floors)
         if discrete:
             return f"a comb of discrete lines up to 0.45 fs ({100 * frac:.0f} % of {count} harmonics)"
     if cs is None:
@@ -469,7 +487,7 @@ def _own_comb(geometry, prior_hz, f_hz, tolerance):
 
 
 def resolve_speed(x, fs, geometry, *, rpm=None, rpm_source="given", cs=None, tolerance=0.02,
-                  blind_range_hz=BLIND_RANGE_HZ, min_family_rms=None):
+                  blind_range_hz=BLIND_RANGE_HZ, min_family_rms=None, spectrum=None, floors=None):
     """Shaft frequency from a prior speed or the signal alone (module docstring).
 
     Parameters
@@ -493,6 +511,10 @@ def resolve_speed(x, fs, geometry, *, rpm=None, rpm_source="given", cs=None, tol
     min_family_rms : float, optional
         Measurability floor (signal units, rms) a plain 1x family must reach to name a
         blind speed without a fault family to confirm it.
+    spectrum : ndarray, optional
+        ``rfft(x - x.mean())``, when the caller has it.
+    floors : SpectrumFloors, optional
+        Of ``spectrum``, shared with the caller's discrete-comb tests.
 
     Returns
     -------
@@ -513,7 +535,8 @@ def resolve_speed(x, fs, geometry, *, rpm=None, rpm_source="given", cs=None, tol
                             f"record sampled at {fs:.6g} Hz (its lines must lie below {0.5 * fs:.6g} Hz): "
                             "the stored or given speed is wrong; give the speed with --rpm, or --rpm none")
     hi_all = max(hi_b, prior * (1 + PRIOR_TOLERANCE) if prior else 0.0)
-    raw = RawLines(x, fs, top_hz=min(0.45 * fs, N_SHAFT_HARMONICS * hi_all * 1.03))
+    raw = RawLines(x, fs, top_hz=min(0.45 * fs, N_SHAFT_HARMONICS * hi_all * 1.03), spectrum=spectrum,
+                   floors=floors)
     raw.min_rms = min_family_rms
     lowest = prior * (1 - PRIOR_TOLERANCE) if prior else lo_b
     if 4 * raw.df > lowest:

@@ -115,6 +115,34 @@ def line_floor_db(amp, *, width):
     return 20 * np.log10(np.maximum(amp, 1e-300) / floor)
 
 
+class SpectrumFloors:
+    """:func:`line_floor_db` of slices of one amplitude spectrum ``|spectrum|``, the running median
+    of the whole spectrum computed once for the wide slices (the discrete-comb tests of several
+    combs read nearly the same half million bins).  Inside a slice the median's window lies in
+    the slice, so the whole spectrum's median is the slice's; the ``width // 2`` bins at each end,
+    where the slice's own median repeats its end values, are filtered from the slice's ends
+    alone: the same numbers as ``line_floor_db(abs(spectrum[a:b]), width=width)``."""
+
+    def __init__(self, spectrum):
+        self.spectrum = spectrum
+        self.amp = np.abs(spectrum)
+        self._median = {}
+
+    def snr(self, a, b, *, width):
+        amp = self.amp[a:b]
+        w = max(3, int(width) | 1)
+        h = w // 2
+        if 2 * amp.size < self.amp.size or amp.size < 3 * h + 1:  # narrow: filtered on its own
+            return line_floor_db(amp, width=width)
+        if w not in self._median:
+            self._median[w] = median_filter(self.amp, size=w, mode="nearest")
+        floor = self._median[w][a:b].copy()
+        floor[:h] = median_filter(amp[: 3 * h + 1], size=w, mode="nearest")[:h]
+        floor[-h:] = median_filter(amp[-(3 * h + 1):], size=w, mode="nearest")[-h:]
+        floor = np.maximum(floor, np.max(amp) * 1e-12 + 1e-300)
+        return 20 * np.log10(np.maximum(amp, 1e-300) / floor)
+
+
 def _method_for(window):
     if window == "boxcar" or window == "rectangular":
         return "quinn"

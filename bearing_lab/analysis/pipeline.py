@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import math
 import warnings
+from types import SimpleNamespace
 
 import numpy as np
 
@@ -41,14 +42,15 @@ from ..bearings import BearingGeometry, get_bearing
 from ..errors import AnalysisError, BearingLabError, check_choice
 from ._diagnosis import (coincidences, combine, deciding_route, interpretations, line_stats, route_summary,
                          run_routes, runner_up, spectrum_top)
-from ._families import LABELS, CyclicSpectrum
+from ._families import LABELS, SK_MIN, CyclicSpectrum
 from ._floor import band_rms, floor_in_units
 from ._hump import apply as apply_humps
 from ._impulse import excitation_period
+from ._kurtogram import KurtogramTree
 from ._metrics import METRIC_NAMES, metrics
 from ._shaft import BLIND_RANGE_HZ, resolve_speed
-from ._spectral import amplitude_spectrum, cepstral_prewhitening, fast_kurtogram, squared_envelope_spectrum
-from ._speed import shaft_frequency
+from ._spectral import amplitude_spectrum, prewhitened, record_ses
+from ._speed import SpectrumFloors, shaft_frequency
 from ._tacho import ORDER_TRACK_VARIATION, order_track, tacho_pulses, tacho_speed
 from ._util import check_fs, check_signal
 
@@ -96,7 +98,9 @@ def _tacho_speed(x, fs, tacho, pulses_per_rev):
 def _speed(x, fs, geom, *, rpm, rpm_source, shaft_hz, tacho, pulses_per_rev, tolerance, n_harmonics,
            fallback=True, units="m s-2"):
     """(signal to analyse, speed dict, pre-whitened signal or None, the envelope spectra computed:
-    ``{key: (f, spectrum, fmax)}``, key "cpw" or ("x", band), for :func:`run_routes` to reuse)."""
+    ``{key: (f, spectrum, fmax)}``, key "cpw" or ("x", band), "rfft" and "whitened": the record's
+    DFT and its whitened one, "floors": a SpectrumFloors of the record's DFT, and "kurtogram": the
+    record's :class:`KurtogramTree` once a kurtogram was asked for, for :func:`run_routes` to reuse)."""
     if shaft_hz is not None:
         fr = float(shaft_hz)
         if not (math.isfinite(fr) and fr > 0):
@@ -108,8 +112,8 @@ def _speed(x, fs, geom, *, rpm, rpm_source, shaft_hz, tacho, pulses_per_rev, tol
     if rpm is not None and not (math.isfinite(rpm) and rpm > 0):
         raise AnalysisError(f"analyze: rpm={rpm!r} must be a positive speed in r/min")
     check_choice(rpm_source, ("given", "file"), "analyze: rpm_source", AnalysisError)
-    xw = cepstral_prewhitening(x)
-    cache, ses = {}, {}
+    X, W, xw = prewhitened(x)  # the record's DFT and its whitened one, for every spectrum below
+    cache, ses = {}, {"rfft": X, "whitened": W, "floors": SpectrumFloors(X)}
 
     def spectra(f0):
         """Pre-whitened SES (once, reaching the fastest blind candidate's decoys) and the SES of
@@ -118,29 +122,43 @@ def _speed(x, fs, geom, *, rpm, rpm_source, shaft_hz, tacho, pulses_per_rev, tol
         if "cpw" not in cache:
             fmax = min(0.49 * fs, spectrum_top(geom.fault_frequencies(BLIND_RANGE_HZ[1]), BLIND_RANGE_HZ[1],
                                                tolerance=tolerance, n_harmonics=n_harmonics))
-            ses["cpw"] = (*squared_envelope_spectrum(xw, fs, window="hann", fmax=fmax), fmax)
+            ses["cpw"] = (*record_ses(xw, fs, window="hann", fmax=fmax, spectrum=W), fmax)
             cache["cpw"] = CyclicSpectrum(*ses["cpw"][:2])
         line_top = n_harmonics * max(ff["bpfi"], 2 * ff["bsf"], ff["bpfo"]) * (1 + tolerance) + f0
         nb = int(2 ** np.floor(np.log2(max(1.0, fs / 2 / line_top))))
         if nb not in cache:
             try:
-                kg = fast_kurtogram(x, fs, min_bandwidth=fs / 2 / nb)
-                top = min(0.49 * fs, spectrum_top(geom.fault_frequencies(BLIND_RANGE_HZ[1]), BLIND_RANGE_HZ[1],
-                                                  tolerance=tolerance, n_harmonics=n_harmonics))
-                ses[("x", kg.band)] = (*squared_envelope_spectrum(x, fs, window="hann", band=kg.band, fmax=top), top)
-                cache[nb] = CyclicSpectrum(*ses[("x", kg.band)][:2])
-                cache[nb].band, cache[nb].kurtosis = kg.band, float(kg.kurtosis_max)
+                if "kurtogram" not in ses:  # one DFT and one pass per level for every band width asked
+                    ses["kurtogram"] = KurtogramTree(x, fs)
+                kg = ses["kurtogram"].kurtogram(min_bandwidth=fs / 2 / nb)
             except AnalysisError:
                 cache[nb] = None
+            else:
+                cache[nb] = _band_spectrum(x, fs, kg, geom, tolerance, n_harmonics, ses)
         return [cache["cpw"], cache[nb]]
 
     sp = resolve_speed(x, fs, geom, rpm=rpm, rpm_source=rpm_source, cs=spectra, tolerance=tolerance,
-                       min_family_rms=floor_in_units(units))
+                       min_family_rms=floor_in_units(units), spectrum=X,
+                       floors=ses["floors"])
     if sp["shaft_hz"] is None and fallback:
         # nothing to go by: the strongest harmonic family, for the fault-frequency table only
         sp["shaft_hz"] = float(shaft_frequency(x, fs, window="boxcar")[0])
         sp["note"] += f"; fault frequencies shown at the strongest line family, {sp['shaft_hz']:.3f} Hz"
     return x, sp, xw, ses
+
+
+def _band_spectrum(x, fs, kg, geom, tolerance, n_harmonics, ses):
+    """The kurtogram band's SES as the speed search reads it: a band below ``SK_MIN`` holds no impact
+    comb, and the search reads only its kurtosis then, so its SES is not computed (the routes compute
+    it if they need it)."""
+    if float(kg.kurtosis_max) < SK_MIN:
+        return SimpleNamespace(band=kg.band, kurtosis=float(kg.kurtosis_max))
+    top = min(0.49 * fs, spectrum_top(geom.fault_frequencies(BLIND_RANGE_HZ[1]), BLIND_RANGE_HZ[1],
+                                      tolerance=tolerance, n_harmonics=n_harmonics))
+    ses[("x", kg.band)] = (*record_ses(x, fs, window="hann", band=kg.band, fmax=top, spectrum=ses["rfft"]), top)
+    cs = CyclicSpectrum(*ses[("x", kg.band)][:2])
+    cs.band, cs.kurtosis = kg.band, float(kg.kurtosis_max)
+    return cs
 
 
 def _period(routes, decided, key, x, xw, fs, band):
@@ -187,7 +205,8 @@ def _run(x, fs, *, bearing, rpm=None, shaft_hz=None, tolerance=0.02, n_harmonics
     fr = float(speed["shaft_hz"])
     if speed["status"] == "unresolved":
         out = _unresolved(speed, geom, fs, xa.size, m, tolerance, n_harmonics)
-        return _below_floor_unresolved(out, band_rms(xa, fs, None), floor_in_units(units, fs / 2), units)
+        rms = band_rms(xa, fs, None, spectrum=ses.get("rfft") if xa is x else None)
+        return _below_floor_unresolved(out, rms, floor_in_units(units, fs / 2), units)
     res = run_routes(xa, fs, geom, fr, tolerance=tolerance, n_harmonics=n_harmonics, prewhiten=prewhiten,
                      xw=xw if xa is x else None, ses=ses if xa is x else None)
     routes = res["routes"]
@@ -195,7 +214,8 @@ def _run(x, fs, *, bearing, rpm=None, shaft_hz=None, tolerance=0.02, n_harmonics
                                  factors=geom.frequency_factors(), speed_status=speed["status"], tolerance=tolerance)
     width = fs / 2 if res["band"] is None else res["band"][1] - res["band"][0]
     floor = floor_in_units(units, width)
-    verdict = _floor_verdict(verdict, band_rms(xa, fs, res["band"]), floor, units)
+    rms = band_rms(xa, fs, res["band"], spectrum=res["rfft"] if xa is x else None)
+    verdict = _floor_verdict(verdict, rms, floor, units)
     decided = deciding_route(routes)
     key = {v: k for k, v in LABELS.items()}.get(verdict["diagnosis"]) if verdict["verdict"] == "diagnosed" else None
     period = None
