@@ -94,15 +94,19 @@ def ses_lines(env, order):
     return line(FR) / line(F), line(F - FR) / line(F), line(F + FR) / line(F)
 
 
-def detection_margin(x, period):
-    """Median impulse peak over the detection threshold, and the median crossing level it leaves."""
+def detection_margin(x, period, band="own"):
+    """Median impulse peak over the detection threshold, and the median crossing level it leaves, in ``band``
+    ("own": the signal's kurtogram band, as the row measures the recording; the row measures the simulation
+    in the recording's band)."""
     x = x[np.isfinite(x)]
-    band = fast_kurtogram(x, FS, min_bandwidth=min(4 / period, 0.2 * FS)).band
+    if isinstance(band, str):
+        band = fast_kurtogram(x, FS, min_bandwidth=min(4 / period, 0.2 * FS)).band
     y = bandpass(x, FS, band=band) if band is not None else x - x.mean()
     thr = DETECTION_FACTOR * float(np.median(np.sqrt(squared_envelope(y, FS))))
     imp = impulses(x, FS, band=band, min_separation=0.5 * period)
     level = np.minimum(np.maximum(0.1, thr / imp.peak), 0.999)
-    return band, thr, float(np.median(imp.peak)), float(np.median(level)), float(np.mean(~imp.resolved))
+    return (band, thr, float(np.median(imp.peak)), float(np.median(level)), float(np.mean(~imp.resolved)),
+            float(np.median(imp.duration)), float(np.median(np.diff(imp.time))) if imp.time.size > 1 else float("nan"))
 
 
 def _kurtosis(v):
@@ -141,12 +145,15 @@ def signals(out: Path):
         print(f"   {label}: kurtosis all {_kurtosis(x[ok]):.1f}, inside {_kurtosis(x[zone]):.1f}; RMS inside "
               f"{np.sqrt(np.mean(x[zone] ** 2)):.2f}, outside {np.sqrt(np.mean(x[ok & ~zone] ** 2)):.2f} m/s2")
     print("\n4. the impulse duration's detection: median impulse peak against the threshold (4 x median envelope), "
-          "median crossing level, share of impulses under two samples")
+          "median crossing level, share of impulses under two samples, median duration and spacing; the "
+          "simulation in the recording's band (as the row) and in its own")
     period = 1.0 / (ORDER["bpfi"] * FR)
-    for label in ("experiment", "path+background"):
-        band, thr, peak, level, unres = detection_margin(sim[label], period)
+    band_rec = detection_margin(sim["experiment"], period)[0]
+    for label, band in (("experiment", band_rec), ("path+background", band_rec), ("path+background", "own")):
+        band, thr, peak, level, unres, dur, gap = detection_margin(sim[label], period, band)
         print(f"   {label}: band {band}, threshold {thr:.2f}, median peak {peak:.2f} m/s2 ({peak / thr:.2f} x), "
-              f"crossing level {level:.2f}, unresolved {unres:.2f}")
+              f"crossing level {level:.2f}, unresolved {unres:.2f}, duration {dur * 1e3:.2f} ms, spacing "
+              f"{gap * 1e3:.2f} ms (BPFI period {period * 1e3:.2f} ms)")
 
 
 def preload(values_um=(-5.0, -10.0)):

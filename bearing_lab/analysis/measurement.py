@@ -7,7 +7,8 @@ impulse) is NaN with a note saying why, never a default number.
 
 Public API
 ----------
-measure(x, fs, *, bearing, rpm=None, shaft_hz=None, fault=None, duration_level=0.1)
+measure(x, fs, *, bearing, rpm=None, shaft_hz=None, fault=None, duration_level=0.1,
+        duration_band="own")
     -- dict of frequencies, metrics and impact quantities, plus ``extras``
 shaft_line(x, fs, expected_hz, *, tolerance=0.03) -- (measured Hz or None, SNR dB)
 """
@@ -54,13 +55,30 @@ def _num(v) -> float:
     return float(v) if v is not None else float("nan")
 
 
-def _impact_quantities(x, fs, period, level, out, notes):
+def _duration_band(duration_band, fs):
+    """The band the impulse duration is measured in: "own" (the signal's kurtogram band), None (the whole
+    band) or a (low, high) pair in Hz inside (0, fs / 2)."""
+    if duration_band is None or (isinstance(duration_band, str) and duration_band == "own"):
+        return duration_band
+    try:
+        lo, hi = (float(v) for v in duration_band)
+    except (TypeError, ValueError):
+        raise AnalysisError(f"measure: duration_band={duration_band!r} must be 'own', None or a (low, high) "
+                            "pair in Hz") from None
+    if not (math.isfinite(lo) and math.isfinite(hi) and 0 <= lo < hi <= fs / 2):
+        raise AnalysisError(f"measure: duration_band=({lo:g}, {hi:g}) Hz must be increasing and lie within "
+                            f"0 to fs / 2 = {fs / 2:g} Hz")
+    return lo, hi
+
+
+def _impact_quantities(x, fs, period, level, out, notes, duration_band="own"):
     from ._impulse import impulses
     band = _band_for(x, fs, 4.0 / period)
     times = impact_times(x, fs, period, band=band)
     out["impulse_strength"] = impulse_strength(x, fs, period, band=band)
+    dband = band if isinstance(duration_band, str) else duration_band
     try:
-        imp = impulses(x, fs, band=band, min_separation=0.5 * period, level=level)
+        imp = impulses(x, fs, band=dband, min_separation=0.5 * period, level=level)
         d = np.asarray(imp.duration, float)
         out["impulse_duration"] = float(np.median(d)) if d.size else float("nan")
         if not d.size:
@@ -103,7 +121,7 @@ def _fault_families(res, out, notes) -> dict:
 
 
 @fill_doc
-def measure(x, fs, *, bearing, rpm=None, shaft_hz=None, fault=None, duration_level=0.1):
+def measure(x, fs, *, bearing, rpm=None, shaft_hz=None, fault=None, duration_level=0.1, duration_band="own"):
     """The quantities of a validation table for one signal, measured the same way for recording
     and simulation.
 
@@ -122,13 +140,18 @@ def measure(x, fs, *, bearing, rpm=None, shaft_hz=None, fault=None, duration_lev
         Fault family whose period and impulses are measured (default: from the diagnosis).
     duration_level : float
         Relative level of the impulse duration (default 0.1).
+    duration_band : "own", None or (float, float)
+        Band (Hz) the impulse duration is measured in: "own" (default) this signal's kurtogram
+        band, None the whole band, or a given band.  A duration depends on the band (a ringing
+        outside it is not seen), so a simulation compared with a recording is measured in the
+        recording's band (its ``extras["band"]``).
 
     Returns
     -------
     dict
         The keys of :data:`MEASURED` (NaN where the signal shows nothing) and ``extras``:
         ``analysis`` (the :func:`bearing_lab.analysis.analyze` result), ``band``,
-        ``impact_times``, ``notes`` (why a value is NaN), ``fault``, ``shaft_hz_used``,
+        ``impact_times``, ``duration_band`` (the band the impulse duration was measured in), ``notes`` (why a value is NaN), ``fault``, ``shaft_hz_used``,
         ``families`` (per BPFO/BPFI: ``detected``, the ``route`` that detected it, and
         ``evidence_margin_score``, the best route's evidence above its decoy threshold: how far the
         detection is from flipping).  BPFO and BPFI carry a value only where a route of the
@@ -148,6 +171,7 @@ def measure(x, fs, *, bearing, rpm=None, shaft_hz=None, fault=None, duration_lev
     from .pipeline import analyze
     x = np.asarray(x, dtype=float)
     res = analyze(x, fs, bearing=bearing, rpm=rpm, shaft_hz=shaft_hz)
+    duration_band = _duration_band(duration_band, fs)
     fr = res["shaft_hz"]
     ff = res["fault_frequencies"]
     notes, out = {}, {}
@@ -167,10 +191,11 @@ def measure(x, fs, *, bearing, rpm=None, shaft_hz=None, fault=None, duration_lev
         out[k] = float(res["metrics"][k])
     band, times = None, np.array([])
     if period is not None and math.isfinite(period):
-        band, times = _impact_quantities(x, fs, period, duration_level, out, notes)
+        band, times = _impact_quantities(x, fs, period, duration_level, out, notes, duration_band)
     else:
         out["impulse_strength"] = out["impulse_duration"] = float("nan")
         notes["impulse_strength"] = notes["impulse_duration"] = "no impact train"
     out["extras"] = {"analysis": res, "band": band, "impact_times": times, "notes": notes, "families": families,
-                     "fault": key, "shaft_hz_used": fr}
+                     "fault": key, "shaft_hz_used": fr,
+                     "duration_band": band if isinstance(duration_band, str) else duration_band}
     return out

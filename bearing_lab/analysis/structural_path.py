@@ -20,15 +20,23 @@ Testing*, 2000, ch. 4, for single-mode fitting of measured responses):
 
 0. the 90th percentile of the impact peaks (weight 3): it mostly sets the gain;
 1. the Hilbert envelope pooled over the impacts (the measured impulse ringing), from
-   its peak to the end of the window: the decay sets the damping;
+   its peak on, where it exceeds :data:`FIT_ABOVE_FLOOR` times the recording's floor
+   (below that the pooled envelope is the floor's and says nothing of the decay): the
+   decay sets the damping;
 2. the mean power spectrum of the impact windows in 40 log-spaced bins from 300 Hz
    to 0.45 fs, kept where the recording rings (within 20 dB of its strongest bin):
    it sets the resonance frequency.
 
-The part of the recording's floor (median envelope) that the model's own floor does not
-hold is added to the model envelope in quadrature (independent powers add), so a quiet
-simulation is not pushed to fit background, and a simulation that already holds the
-recording's floor (the model's own recording) is not given it twice.  The search
+The recording's background is held apart in both shape views, measured between the
+impacts (0.45 to 0.85 of a period after each, where the ringing has died out): the part
+of its floor (median envelope there) that the model's own floor does not hold is added to
+the model envelope in quadrature (independent powers add), and the part of its power in
+each spectrum bin that the model's own background does not hold is added to the model's
+impact spectrum.  So a quiet simulation is not pushed to fit background (under sensor
+noise, a sharp resonance where there is only noise would otherwise win the spectrum
+view), and a simulation that already holds the recording's background (the model's own
+recording) is not given it twice.  Both are fixed before the fit, at the gain that
+matches the impact peaks.  The search
 starts at the strongest peaks of the measured impact spectrum inside the given
 bounds; the bounds are used as given (an upper frequency bound above 0.45 fs is
 lowered to 0.45 fs, and the fit says so).  A fit that ends at a bound, does not
@@ -56,7 +64,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import AnalysisError, check_choice
-from .impacts import impact_peaks, impact_times, mean_envelope, segment_spectrum
+from .impacts import between_impacts, impact_peaks, impact_times, mean_envelope, segment_spectrum
 
 __all__ = ["transmissibility", "Resonance", "StructuralPath", "fit_structural_path", "MIN_IMPACTS"]
 
@@ -64,6 +72,8 @@ __all__ = ["transmissibility", "Resonance", "StructuralPath", "fit_structural_pa
 MIN_IMPACTS = 5
 #: weight of the impact-peak view against the two shape views (each normalised to 1)
 PEAK_WEIGHT = 3.0
+#: the envelope's decay is fitted where the recording's pooled envelope exceeds this many times its floor
+FIT_ABOVE_FLOOR = 3.0
 
 
 def transmissibility(f, frequency_hz, damping_ratio):
@@ -224,11 +234,34 @@ def _jsonable(v):
 
 
 # ------------------------------------------------------------------ the fit
-def _floor(x) -> float:
-    """The floor of a signal: its median Hilbert envelope."""
+def _floor(x, fs, times, period) -> float:
+    """The floor of a signal: its median Hilbert envelope between the impacts (0.45 to 0.85 of a period
+    after each, :func:`between_impacts`), where the ringing has died out; the whole record's median
+    where no such stretch fits."""
     from scipy.signal import hilbert
     x = np.asarray(x, float)
-    return float(np.median(np.abs(hilbert(x - np.mean(x)))))
+    env = np.abs(hilbert(x - np.mean(x)))
+    mask = between_impacts(env.size, fs, times, period)
+    return float(np.median(env[mask] if mask.sum() >= 8 else env))
+
+
+def _background_power(x, fs, times, period, ranges, w2):
+    """Per frequency range: the mean power of ``x`` between its impacts (0.45 to 0.85 of a period after
+    each, where the ringing has died out: :func:`between_impacts`), as a Hann-windowed power spectrum
+    of a window whose squared window sum is ``w2`` would hold it.  Zeros when no such segment fits."""
+    n = int(round(0.4 * period * fs))
+    starts = [int(round((t + 0.45 * period) * fs)) for t in times]
+    segs = [x[i: i + n] for i in starts if n >= 8 and i + n <= x.size]
+    if not segs:
+        return np.zeros(len(ranges))
+    w = np.hanning(n)
+    psd = np.mean(np.abs(np.fft.rfft(np.stack(segs) * w, axis=1)) ** 2, axis=0) / float(np.sum(w * w))
+    f = np.fft.rfftfreq(n, 1 / fs)
+    out = []
+    for lo, hi in ranges:
+        sel = (f >= lo) & (f < hi)
+        out.append(psd[sel].mean() if sel.any() else np.interp(0.5 * (lo + hi), f, psd))
+    return np.asarray(out) * w2
 
 
 class _PathProblem:
@@ -248,20 +281,33 @@ class _PathProblem:
         if self.env_e is None:
             raise AnalysisError("structural path: no impact window fits inside the recording")
         self.pk = int(np.argmax(self.env_e))
-        self.floor = _floor(self.e)
+        self.floor = _floor(self.e, fs, self.te, period)
+        # the decay is fitted where the recording's envelope stands clear of its floor: below it
+        # the pooled envelope is the floor's, which says nothing about the path's damping
+        tail = self.env_e[self.pk:]
+        clear = tail > FIT_ABOVE_FLOOR * self.floor
+        self.fit_tail = clear if clear.sum() >= 5 else np.ones(tail.size, bool)
         self.f_seg, self.p_e = segment_spectrum(self.e, fs, self.te, pre=pre, post=post)
         edges = np.geomspace(300.0, 0.45 * fs, 41)
-        bins = [(self.f_seg >= lo) & (self.f_seg < hi) for lo, hi in zip(edges[:-1], edges[1:])]
-        bins = [b for b in bins if b.any()]
-        level = np.array([self.p_e[b].mean() for b in bins])
-        self.bins = [b for b, lv in zip(bins, level) if lv >= 0.01 * level.max()]
+        bins = [((self.f_seg >= lo) & (self.f_seg < hi), (lo, hi)) for lo, hi in zip(edges[:-1], edges[1:])]
+        bins = [b for b in bins if b[0].any()]
+        level = np.array([self.p_e[b].mean() for b, _ in bins])
+        kept = [b for b, lv in zip(bins, level) if lv >= 0.01 * level.max()]
+        self.bins = [b for b, _ in kept]
         self.peak_e = self.impact_peak(self.e, self.te)
         # the part of the recording's floor the model does not hold, fixed before the fit: the
         # model's own floor at the gain that matches the impact peaks (a floor that followed the
         # fitted gain would let the gain trade impact level for floor, and bias it)
         peak_s = self.impact_peak(self.s, self.ts) if self.ts.size else 0.0
         g0 = self.peak_e / peak_s if peak_s > 0 else 0.0
-        self.floor_add2 = max(self.floor ** 2 - (g0 * _floor(self.s)) ** 2, 0.0)
+        self.floor_add2 = max(self.floor ** 2 - (g0 * _floor(self.s, fs, self.ts, period)) ** 2, 0.0)
+        # the same for the spectrum view: the background's power in each bin (measured between the
+        # impacts, scaled to an impact window) that the model's own background does not hold
+        w2 = float(np.sum(np.hanning(int(round(pre * fs)) + int(round(post * fs))) ** 2))
+        ranges = [r for _, r in kept]
+        noise_e = _background_power(self.e, fs, self.te, period, ranges, w2)
+        noise_s = _background_power(self.s, fs, self.ts, period, ranges, w2)
+        self.spec_add = np.maximum(noise_e - g0 ** 2 * noise_s, 0.0)
 
     def impact_peak(self, y, times):
         return float(np.percentile(impact_peaks(y, self.fs, times, self.period), 90))
@@ -295,9 +341,10 @@ class _PathProblem:
 
     def residuals_of(self, y, parts=False):
         env_m = self.envelope(y)
-        r1 = np.log(env_m[self.pk:] / np.maximum(self.env_e[self.pk:], 1e-30))
+        r1 = np.log(env_m[self.pk:] / np.maximum(self.env_e[self.pk:], 1e-30))[self.fit_tail]
         _, p_m = segment_spectrum(y, self.fs, self.ts, pre=self.pre, post=self.post)
-        r2 = np.array([0.5 * np.log((p_m[b].mean() + 1e-30) / (self.p_e[b].mean() + 1e-30)) for b in self.bins])
+        r2 = np.array([0.5 * np.log((p_m[b].mean() + add + 1e-30) / (self.p_e[b].mean() + 1e-30))
+                       for b, add in zip(self.bins, self.spec_add)])
         r0 = np.array([PEAK_WEIGHT * np.log(max(self.impact_peak(y, self.ts), 1e-30) / max(self.peak_e, 1e-30))])
         r = np.concatenate([r0, r1 / math.sqrt(r1.size), r2 / math.sqrt(max(r2.size, 1))])
         return (r, (r0, r1, r2)) if parts else r

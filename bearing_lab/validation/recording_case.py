@@ -109,9 +109,11 @@ def simulate_signals(prep, path, background, *, scene=None, seed=None):
 
 
 def measure_signals(prep, signals: dict) -> dict:
+    """The simulation signals measured as the recording is; impulse durations in the recording's band."""
     rpm = prep.speed.rpm
-    return {k: measure(v, prep.fs, bearing=prep.bearing, rpm=rpm, shaft_hz=rpm / 60.0, fault=prep.fault)
-            for k, v in signals.items()}
+    band = prep.measured["segment"]["extras"]["band"]
+    return {k: measure(v, prep.fs, bearing=prep.bearing, rpm=rpm, shaft_hz=rpm / 60.0, fault=prep.fault,
+                       duration_band=band) for k, v in signals.items()}
 
 
 #: the signature's band: above the machine tones and the shaft harmonics (all below 1 kHz on

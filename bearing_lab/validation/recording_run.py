@@ -77,7 +77,7 @@ def healthy_reference(case, prep, path, background, reference) -> dict:
     sig["path+background"] = sig["path"] + (background.synthesize(n, seed=1) if background is not None else 0.0)
     kw = {"bearing": prep.bearing, "rpm": speed.rpm, "shaft_hz": speed.rpm / 60}
     exp = {"record": measure(xr, fs, **kw), "segment": measure(xr[:n], fs, **kw)}
-    sim = {k: measure(v, fs, **kw) for k, v in sig.items()}
+    sim = {k: measure(v, fs, **kw, duration_band=exp["segment"]["extras"]["band"]) for k, v in sig.items()}
     ctx = {"path": path, "path_fitted_here": False, "speed_estimated": spec_speed == "estimate",
            "span_text": {"record": f"reference: whole record ({xr.size / fs:.3g} s)",
                          "segment": f"reference: first {n / fs:g} s"}}

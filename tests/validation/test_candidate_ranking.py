@@ -113,17 +113,18 @@ def test_a_level_within_the_tolerance_costs_nothing_beyond_it_the_excess():
     assert misfit(sim, meas, level_tolerance_db=0.6)["score_db"] == pytest.approx(0.0, abs=1e-9)
 
 
-def test_the_paths_shape_residual_separates_a_valley_geometry_from_the_truth(rig):
+def test_the_valley_geometry_is_told_from_the_truth_through_the_fitted_path(rig):
     """A longer defect further off the centre (3.56 mm at H = 0.5 mm, θ = 31.3°) meets the ball over a
-    similar chord as the hidden 3 mm at 0.3 mm, 30°.  Against the recording its shape leans the way the
-    model's path departs from the rig's, so without the path's shape residual (measured on the calibration
-    recording) it scored as well as the truth (0.30 against 0.31 dB).  With the residual removed the truth
-    must win by more than the smallest identification threshold's half; break it: without it, it must not."""
+    similar chord as the hidden 3 mm at 0.3 mm, 30°; against each other the two differ by a few tenths of a
+    dB in shape, so a path whose own shape departs from the rig's by as much can make them score alike.
+    The path fitted on the calibration recording (with its background held apart) is the stand-in's
+    resonance, so its shape residual there is small, and the truth must win by more than the smallest
+    identification threshold's half, with the residual removed and without."""
     d, calib = rig
     case = load_case(hidden(d, "paper-O2", 0.3, 30.0, seed=23, calib=calib, name="valley", duration_s=0.5))
     prep = prepare(case)
     path = path_for(case, prep.recording, prep.measured["record"], prep.simulated["model"])
-    assert path.fit["signature_residual_rms_db"] > 0.1
+    assert 0 < path.fit["signature_residual_rms_db"] < 0.1
     bg = background_for(case, prep.recording, prep.measured["record"])
     cands = {"valley": {"defect.length_mm": 3.56, "defect.offset_mm": 0.5, "defect.skew_deg": 31.3},
              "true": {"defect.length_mm": 3.0, "defect.offset_mm": 0.3, "defect.skew_deg": 30.0}}
@@ -134,7 +135,7 @@ def test_the_paths_shape_residual_separates_a_valley_geometry_from_the_truth(rig
         without = score_candidates(prep, path, bg, cands)
     finally:
         path.fit["signature_residual_db"] = bare
-    assert abs(without["valley"]["score_db"] - without["true"]["score_db"]) < 0.1, without
+    assert list(without)[0] == "true" and without["valley"]["score_db"] - without["true"]["score_db"] > 0.15, without
 
 
 def test_the_shape_residual_is_never_taken_from_the_compared_recording(rig):

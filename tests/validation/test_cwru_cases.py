@@ -174,32 +174,71 @@ def _energy_outside_impacts(x, fs, period_s):
     return float(np.sqrt(outside / n_out)), inside / (inside + outside)
 
 
-def test_the_130_kurtosis_fails_as_a_known_limitation_whose_evidence_holds(cwru):
-    """The stated reason: the rig's impacts keep ringing after 2 ms, the model's one-resonance path has decayed."""
+def test_the_130_kurtosis_passes_with_a_path_that_rings_on_as_the_rig_does(cwru):
+    """The path fitted with the recording's background held apart rings on between the impacts as the rig does, and
+    the kurtosis, which counts that ringing, passes."""
     import xarray as xr
     out, _, _, sums = cwru
     row = _rows(sums["cwru-130"])["kurtosis"]
-    assert row["status"] == "known limitation" and row["simulation"] > row["experiment"]
-    assert "kurtosis" in sums["cwru-130"]["known_limitations"]
+    assert row["pass"] and row["status"] == "pass", row
     ds = xr.open_dataset(out / "cwru-130" / "comparison.nc")
     fs, period = float(ds.attrs["sampling_rate_hz"]), 1.0 / float(ds.attrs["bpfo_hz"])
     rms_rec, share_rec = _energy_outside_impacts(ds["waveform"].sel(signal="experiment").values, fs, period)
     rms_sim, share_sim = _energy_outside_impacts(ds["waveform"].sel(signal="path+background").values, fs, period)
-    assert rms_rec > 2 * rms_sim and share_sim > share_rec + 0.05, (rms_rec, rms_sim, share_rec, share_sim)
+    assert rms_sim > 0.5 * rms_rec and share_sim < share_rec + 0.05, (rms_rec, rms_sim, share_rec, share_sim)
     res = json.loads(ds.attrs["structural_path"])["resonances"]
-    assert len(res) == 1 and 1.0 / (res[0]["damping_ratio"] * 2 * np.pi * res[0]["frequency_hz"]) < 0.002
+    assert len(res) == 1 and 1.0 / (res[0]["damping_ratio"] * 2 * np.pi * res[0]["frequency_hz"]) > 0.001
 
 
-def _detection_margin(x, fs, period):
-    """Median impulse peak over the impulse detector's threshold (4 x the median envelope in the measured band)."""
+def _period_peaks(x, fs, period):
+    """The largest 2.5-4 kHz band envelope value in each fault period."""
+    import scipy.signal as ss
+    x = np.asarray(x, float)
+    x = x[np.isfinite(x)]
+    env = np.abs(ss.hilbert(ss.sosfiltfilt(ss.butter(4, [2500, 4000], "bandpass", fs=fs, output="sos"), x)))
+    n = int(period * fs)
+    return np.array([env[i * n:(i + 1) * n].max() for i in range(x.size // n)]), x - x.mean(), n
+
+
+def _equalized_shape(x, fs, period):
+    """Crest factor and kurtosis of ``x`` with every fault period scaled to the median impact peak."""
+    peaks, y, n = _period_peaks(x, fs, period)
+    y = np.concatenate([y[i * n:(i + 1) * n] * np.median(peaks) / p for i, p in enumerate(peaks)])
+    return float(np.abs(y).max() / y.std()), float(np.mean(y ** 4) / np.mean(y ** 2) ** 2)
+
+
+def test_the_234_shape_rows_fail_as_a_known_limitation_whose_evidence_holds(cwru):
+    """The stated reason: the record's impacts vary many-fold from one period to the next, the model's do not; with the
+    record's periods brought to one impact peak its crest factor and kurtosis come within the tolerance."""
+    import xarray as xr
+    out, _, _, sums = cwru
+    rows = _rows(sums["cwru-234"])
+    for q in ("crest_factor", "kurtosis"):
+        assert not rows[q]["pass"] and rows[q]["status"] == "known limitation", rows[q]
+        assert rows[q]["simulation"] < rows[q]["experiment"]
+    ds = xr.open_dataset(out / "cwru-234" / "comparison.nc")
+    fs, period = float(ds.attrs["sampling_rate_hz"]), 1.0 / float(ds.attrs["bpfo_hz"])
+    rec, sim = ds["waveform"].sel(signal="experiment").values, ds["waveform"].sel(signal="path+background").values
+    p_rec, p_sim = _period_peaks(rec, fs, period)[0], _period_peaks(sim, fs, period)[0]
+    assert p_rec.max() / p_rec.min() > 10 and p_sim.max() / p_sim.min() < 1.2, (p_rec, p_sim)
+    crest, kurt = _equalized_shape(rec, fs, period)
+    assert 0.5 < rows["crest_factor"]["simulation"] / crest < 2 and 0.5 < rows["kurtosis"]["simulation"] / kurt < 2, \
+        (crest, kurt)
+
+
+def _detection_margin(x, fs, period, band="own"):
+    """Median impulse peak over the impulse detector's threshold (4 x the median envelope in ``band``, "own": the
+    signal's kurtogram band), the band, and the median impulse spacing."""
     from bearing_lab.analysis._impulse import DETECTION_FACTOR, impulses
     from bearing_lab.analysis._spectral import bandpass, fast_kurtogram, squared_envelope
     x = np.asarray(x, float)
     x = x[np.isfinite(x)]
-    band = fast_kurtogram(x, fs, min_bandwidth=min(4 / period, 0.2 * fs)).band
+    if isinstance(band, str):
+        band = fast_kurtogram(x, fs, min_bandwidth=min(4 / period, 0.2 * fs)).band
     y = bandpass(x, fs, band=band) if band is not None else x - x.mean()
     thr = DETECTION_FACTOR * float(np.median(np.sqrt(squared_envelope(y, fs))))
-    return float(np.median(impulses(x, fs, band=band, min_separation=0.5 * period).peak)) / thr
+    imp = impulses(x, fs, band=band, min_separation=0.5 * period)
+    return float(np.median(imp.peak)) / thr, band, float(np.median(np.diff(imp.time)))
 
 
 def test_the_inner_race_impulse_rows_fail_as_a_known_limitation_whose_evidence_holds(cwru, datafile):
@@ -208,13 +247,14 @@ def test_the_inner_race_impulse_rows_fail_as_a_known_limitation_whose_evidence_h
     out, _, _, sums = cwru
     s = sums["cwru-105"]
     rows = _rows(s)
-    for q in ("shaft_hz", "bpfi", "excitation_period", "rms"):
+    for q in ("shaft_hz", "bpfi", "excitation_period", "rms", "peak"):
         assert rows[q]["pass"], rows[q]
-    for q in ("peak", "kurtosis", "impulse_strength", "impulse_duration"):
+    for q in ("kurtosis", "impulse_strength", "impulse_duration"):
         assert not rows[q]["pass"] and rows[q]["status"] == "known limitation", rows[q]
     assert not s["unexplained_failures"]
     # the same energy, packed into part of the turn: peak and kurtosis above the record's, the median impact below
-    assert rows["peak"]["simulation"] > 2 * rows["peak"]["experiment"]
+    assert rows["peak"]["simulation"] > 1.5 * rows["peak"]["experiment"]
+    assert rows["kurtosis"]["simulation"] > 2 * rows["kurtosis"]["experiment"]
     assert rows["impulse_strength"]["simulation"] < 0.5 * rows["impulse_strength"]["experiment"]
     # rig side, the whole record: impacts at every shaft angle (as record 130's pit, which stays in the load zone),
     # a weak shaft line in the squared envelope
@@ -225,8 +265,11 @@ def test_the_inner_race_impulse_rows_fail_as_a_known_limitation_whose_evidence_h
     fs = float(ds.attrs["sampling_rate_hz"])
     sim, shaft_sim = _peaks_by_shaft_angle(ds["waveform"].sel(signal="path").values, 1796.0, BPFI_ORDER, fs=fs)
     assert np.sum(sim < 0.1 * sim.max()) >= 3 and shaft_sim > 0.8, (sim, shaft_sim)
-    # the impulse duration: the record's impulses barely clear the detector's threshold, the model's clear it by far
+    # the impulse duration, both in the record's band: the record's impulses barely clear the detector's threshold,
+    # the model's clear it by far and ring from one load-zone impact into the next: one impulse a turn, longer than
+    # a BPFI period
     period = 1.0 / float(ds.attrs["bpfi_hz"])
-    m_rec = _detection_margin(ds["waveform"].sel(signal="experiment").values, fs, period)
-    m_sim = _detection_margin(ds["waveform"].sel(signal="path+background").values, fs, period)
+    m_rec, band, _ = _detection_margin(ds["waveform"].sel(signal="experiment").values, fs, period)
+    m_sim, _, spacing = _detection_margin(ds["waveform"].sel(signal="path+background").values, fs, period, band)
     assert m_rec < 1.5 and m_sim > 3, (m_rec, m_sim)
+    assert spacing > 3 * period and rows["impulse_duration"]["simulation"] > period, (spacing, period)

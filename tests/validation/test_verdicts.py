@@ -46,12 +46,12 @@ def test_an_error_exits_1_and_an_empty_case_is_no_pass():
 def test_who_declared_a_limitation(tmp_path):
     from bearing_lab.validation import load_case
     shipped = load_case("cwru-130")
-    assert shipped.tolerances["kurtosis"].declared_by == "bearing_lab (shipped case cwru-130)"
+    assert shipped.tolerances["impulse_strength_ratio"].declared_by == "bearing_lab (shipped case cwru-130)"
     assert not shipped.tolerances["rms"].declared_by
     text = shipped.text.replace('name = "cwru-130"', 'name = "mine"')
     (tmp_path / "mine.toml").write_text(text)
     mine = load_case(tmp_path / "mine.toml")
-    assert mine.tolerances["kurtosis"].declared_by == f"the author of {tmp_path / 'mine.toml'}"
+    assert mine.tolerances["impulse_strength_ratio"].declared_by == f"the author of {tmp_path / 'mine.toml'}"
 
 
 def test_pages_open_with_the_verdict_in_words_and_the_authors_reason(tmp_path):
