@@ -39,6 +39,7 @@ import contextvars
 import hashlib
 import importlib
 import importlib.util
+from importlib import metadata
 import inspect
 import json
 import os
@@ -52,6 +53,7 @@ import numpy as np
 
 from .._version import __version__
 from ..errors import BearingLabError, RecordingError
+from .. import schema
 from .. import units as _units
 
 MIN_RATE_HZ = 1e-3   # slower than a sample every 17 minutes: not a vibration recording
@@ -127,7 +129,6 @@ class RecordingReader(ABC):
 
 def library_versions(libraries) -> str:
     """Return ``"numpy 2.1.0, pyuff 2.5.8"`` for the given module names."""
-    from importlib import metadata
     out = []
     for lib in libraries:
         mod = sys.modules.get(lib)
@@ -573,8 +574,7 @@ class RecordingArrays:
 
     def to_dataset(self):
         """The recording Dataset of :mod:`bearing_lab.schema` (checked against it)."""
-        import xarray as xr
-        from .. import schema
+        import xarray as xr  # `info` reads plain arrays, without xarray
         tvar = xr.Variable("time", self.time, dict(_TIME_ATTRS))
         data_vars = {k: xr.Variable("time", c.values, c.attrs) for k, c in self.data_vars.items()}
         ds = xr.Dataset(data_vars, coords={"time": tvar}, attrs=self.attrs)

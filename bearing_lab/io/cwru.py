@@ -20,6 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import datasets
+from ..utils._files import sha256_file
 from ._base import ENGINES, RecordingBuilder, RecordingReader
 from ._matlab import load_mat, mat_variables, mat_version, signal_vector
 
@@ -82,7 +84,6 @@ class CwruReader(RecordingReader):
         -------
         xarray.Dataset
         """
-        from .. import datasets
 
         path = Path(path)
         b = RecordingBuilder(path, self, units=units, checksum=checksum)
@@ -173,8 +174,6 @@ class CwruReader(RecordingReader):
 
 def _registered_by_content(path):
     """The registry entry whose sha256 is this file's (None if none, or the file is large)."""
-    from .. import datasets
-    from ..utils._files import sha256_file
     if path.stat().st_size > 256 * 2 ** 20:
         return None
     known = [r for r in datasets.load_registry().values() if r.sha256 and r.dataset.startswith("cwru")]
