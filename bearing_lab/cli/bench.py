@@ -1,10 +1,12 @@
 """`bearing-lab bench`: speed against error (reports/performance/)."""
 from __future__ import annotations
 
+from ..errors import check_choice
+
 
 def json_summary(ds, output) -> dict:
     """What ``bench --json`` prints: every run and, per scene, the fastest setting within tolerance."""
-    from ..studies.bench import fastest_within_tolerance, rows_of
+    from ..studies.bench import fastest_within_tolerance, rows_of  # the command's imports load when it runs
     rows = rows_of(ds)
     scenes = list(dict.fromkeys(r["scene"] for r in rows))
     return {"output": str(output),
@@ -16,10 +18,9 @@ def json_summary(ds, output) -> dict:
 
 
 def _bench(args) -> int:
-    from ..studies.bench import SCENES, run_bench, summary_table
+    from ..studies.bench import SCENES, run_bench, summary_table  # the command's imports load when it runs
     names = [s[0] for s in SCENES]
     if args.scene:
-        from ..errors import check_choice
         for s in args.scene:
             check_choice(s, names, "--scene")
     ds = run_bench(args.output, duration=args.duration, scenes=args.scene,

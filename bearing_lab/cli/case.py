@@ -11,10 +11,13 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
+from . import check_output_path
+from ..errors import ValidationCaseError
+from ..utils._files import atomic_open
+
 
 def _cmd_new(args) -> int:
-    from ..errors import ValidationCaseError
-    from ..validation.newcase import new_case_text
+    from ..validation.newcase import new_case_text  # the command's imports load when it runs
     out = Path(args.output) if args.output else Path(args.recording).with_suffix(".toml")
     if out.suffix != ".toml":
         raise ValidationCaseError(f"-o {args.output}: a case file ends in .toml")
@@ -24,7 +27,6 @@ def _cmd_new(args) -> int:
         raise ValidationCaseError(f"-o {out}: directory {out.parent} does not exist")
     text = new_case_text(args.recording, name=args.name, bearing=args.bearing, speed=args.speed,
                          channel=args.channel, fmt=args.format, case_dir=out.parent)
-    from ..utils._files import atomic_open
     with atomic_open(out, "w", encoding="utf-8") as fh:
         fh.write(text)
     notes = [line[len("# NOTE: "):] for line in text.splitlines() if line.startswith("# NOTE: ")]
@@ -41,8 +43,7 @@ def _cmd_new(args) -> int:
 
 
 def _cmd_standin(args) -> int:
-    from . import check_output_path
-    from ..sim.scene import parse_set
+    from ..sim.scene import parse_set  # the command's imports load when it runs
     from ..validation.standin import make_standin_recording
     check_output_path(args.output, force=args.force, suffixes=(".uff", ".mat"))
     s = make_standin_recording(args.output, scene=args.scene, overrides=parse_set(args.set), rpm=args.rpm,

@@ -9,6 +9,10 @@ from __future__ import annotations
 
 import json
 import sys
+from pathlib import Path
+import signal
+
+from ..errors import ValidationCaseError
 
 
 def register(subparsers):
@@ -52,10 +56,9 @@ def register(subparsers):
 
 
 def run(args) -> int:
-    from ..validation import load_case
+    from ..validation import load_case  # the command's imports load when it runs
     from ..validation.identify import IdentificationInterrupted, default_grid, identify
     from ..validation.identify_report import write_identification
-    from ..errors import ValidationCaseError
     if args.workers < 1:
         raise ValidationCaseError(f"--workers {args.workers}: give 1 (in this process) or more Dask worker processes")
     case = load_case(args.case)
@@ -64,7 +67,6 @@ def run(args) -> int:
                        ("defect.skew_deg", args.skew_deg), ("defect.depth_mm", args.depth_mm)):
         if given:
             grid[key] = list(given)
-    from pathlib import Path
     journal = Path(args.output) / case.name / "identification-journal.jsonl"
     if args.restart and journal.is_file():
         journal.unlink()
@@ -101,7 +103,6 @@ class _term_stops:
     """SIGTERM (a kill) stops the run as Ctrl-C does, so the partial result is written (restored after)."""
 
     def __enter__(self):
-        import signal
         self.old = None
         try:
             self.old = signal.signal(signal.SIGTERM, self._raise)
@@ -114,7 +115,6 @@ class _term_stops:
         raise KeyboardInterrupt
 
     def __exit__(self, *exc):
-        import signal
         if self.old is not None:
             signal.signal(signal.SIGTERM, self.old)
         return False
@@ -122,7 +122,7 @@ class _term_stops:
 
 def _stopped(res, args, journal) -> int:
     """A stopped run: the partial result of the scenes done (if any) written and printed; exit status 130."""
-    from ..validation.identify_report import write_identification
+    from ..validation.identify_report import write_identification  # the command's imports load when it runs
     where = f"the scored scenes are kept in {journal}; rerun the same command to resume"
     if res is None:
         print(f"bearing-lab identify: interrupted before any scene finished; {where}", file=sys.stderr)

@@ -10,7 +10,7 @@ from ..units import G
 def _study(args) -> int:
     if args.which != "paper":
         raise BearingLabError(f"study {args.which!r}: the only study set is 'paper'")
-    from ..studies.paper import STUDIES, run_paper_studies
+    from ..studies.paper import STUDIES, run_paper_studies  # the command's imports load when it runs
     names = args.only or list(STUDIES)
     for n in names:
         check_choice(n, STUDIES, "--only")

@@ -18,7 +18,7 @@ import time
 
 
 def _epilog() -> str:
-    from ..validation.rows import VERDICTS
+    from ..validation.rows import VERDICTS  # the command's imports load when it runs
     from ..validation.rows import EXIT_STATUS
     lines = ["verdict of a case:"]
     lines += [f"  {k.upper():18s} {v}" for k, v in VERDICTS.items()]
@@ -80,7 +80,7 @@ def _json(outcomes, out_dir, status) -> dict:
 
 
 def run(args) -> int:
-    from ..validation import load_case, run_validation, shipped_cases
+    from ..validation import load_case, run_validation, shipped_cases  # the command's imports load when it runs
     if args.list:
         if args.json:
             from ..utils._json import dumps
