@@ -13,11 +13,11 @@ from pathlib import Path
 
 from . import check_output_path
 from ..errors import ValidationCaseError
-from ..utils._files import atomic_open
 
 
 def _cmd_new(args) -> int:
-    from ..validation.newcase import new_case_text  # the command's imports load when it runs
+    from ..utils._files import atomic_open  # the command's imports load when it runs
+    from ..validation.newcase import new_case_text
     out = Path(args.output) if args.output else Path(args.recording).with_suffix(".toml")
     if out.suffix != ".toml":
         raise ValidationCaseError(f"-o {args.output}: a case file ends in .toml")

@@ -10,7 +10,6 @@ from __future__ import annotations
 import json
 import sys
 from pathlib import Path
-import signal
 
 from ..errors import ValidationCaseError
 
@@ -103,6 +102,7 @@ class _term_stops:
     """SIGTERM (a kill) stops the run as Ctrl-C does, so the partial result is written (restored after)."""
 
     def __enter__(self):
+        import signal  # the command's imports load when it runs
         self.old = None
         try:
             self.old = signal.signal(signal.SIGTERM, self._raise)
@@ -115,6 +115,7 @@ class _term_stops:
         raise KeyboardInterrupt
 
     def __exit__(self, *exc):
+        import signal  # the command's imports load when it runs
         if self.old is not None:
             signal.signal(signal.SIGTERM, self.old)
         return False

@@ -11,11 +11,8 @@ from __future__ import annotations
 import json
 import sys
 import warnings
-from importlib import resources
 from pathlib import Path
-import shutil
 
-from .. import datasets
 from . import check_output_path
 from ..errors import RecordingError
 
@@ -151,18 +148,21 @@ def _cmd_info(args) -> int:
 
 
 def _cmd_fetch(args) -> int:
+    from .. import datasets  # the command's imports load when it runs
     got = {}
     for name in args.names:
         got[name] = str(datasets.fetch(name, mirror=args.mirror, dest=args.dest, download=not args.no_download))
         if not (args.quiet or args.json):
             print(f"{name}: {got[name]}")
     if args.json:
-        from ..utils._json import dumps  # the command's imports load when it runs
+        from ..utils._json import dumps
         print(dumps(got, indent=1))
     return 0
 
 
 def _cmd_sample(args) -> int:
+    from importlib import resources  # the command's imports load when it runs
+    import shutil
     out = check_output_path(args.output, force=args.force, suffixes=(".uff",))
     src = resources.files("bearing_lab").joinpath("data", "sample_recording.uff")
     with resources.as_file(src) as p:
@@ -178,6 +178,7 @@ def _cmd_sample(args) -> int:
 
 
 def _cmd_list(args) -> int:
+    from .. import datasets  # the command's imports load when it runs
     rows = []
     for r in datasets.load_registry().values():
         if args.dataset and not r.dataset.startswith(args.dataset):

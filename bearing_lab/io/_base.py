@@ -53,7 +53,6 @@ import numpy as np
 
 from .._version import __version__
 from ..errors import BearingLabError, RecordingError
-from .. import schema
 from .. import units as _units
 
 MIN_RATE_HZ = 1e-3   # slower than a sample every 17 minutes: not a vibration recording
@@ -575,6 +574,7 @@ class RecordingArrays:
     def to_dataset(self):
         """The recording Dataset of :mod:`bearing_lab.schema` (checked against it)."""
         import xarray as xr  # `info` reads plain arrays, without xarray
+        from .. import schema  # schema (6 ms) when a Dataset is made: `info` reads plain arrays
         tvar = xr.Variable("time", self.time, dict(_TIME_ATTRS))
         data_vars = {k: xr.Variable("time", c.values, c.attrs) for k, c in self.data_vars.items()}
         ds = xr.Dataset(data_vars, coords={"time": tvar}, attrs=self.attrs)

@@ -18,9 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import RecordingError
-from . import _mat5
 from ._guard import guarded
-from ._mat5 import Mat5Error
 
 HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 
@@ -67,11 +65,13 @@ def _variables(path: str, mtime: int, size: int, inode: int) -> tuple[str, ...]:
     if v == "7.3":  # libhdf5 reads the file in a child process: damage cannot crash us
         return guarded(path, "HDF5", _h5_names, path)
     if v == "5":
+        from . import _mat5  # _mat5 (6 ms) loads for a MATLAB file only: io imports this module
         return tuple(_mat5.variable_names(Path(path).read_bytes()))
     return ()
 
 
 def _corrupt(path, exc):
+    from ._mat5 import Mat5Error  # _mat5 (6 ms) loads for a MATLAB file only: io imports this module
     why = str(exc) if isinstance(exc, Mat5Error) else f"{type(exc).__name__}: {exc}"
     return RecordingError(f"{path}: the MATLAB file is truncated or corrupt ({why}); export or "
                           "download it again")
@@ -153,6 +153,7 @@ def _load_mat(path, variable_names):
     if v == "7.3":
         names = tuple(variable_names) if variable_names else None
         return guarded(path, "HDF5", _h5_load, str(path), names)
+    from . import _mat5  # _mat5 (6 ms) loads for a MATLAB file only: io imports this module
     return _mat5.load(Path(path).read_bytes(), variable_names=variable_names)
 
 

@@ -22,7 +22,6 @@ import tempfile
 
 import numpy as np
 
-from .. import schema
 from ..errors import BearingLabError, RecordingError
 from ._base import ENGINES, MAX_RATE_HZ, MIN_RATE_HZ, RecordingReader, speed_problem
 from ._guard import guarded
@@ -119,7 +118,7 @@ class NetcdfReader(RecordingReader):
         -------
         xarray.Dataset
         """
-
+        from .. import schema  # schema (6 ms) when a Dataset is made: `info` reads plain arrays
         path = Path(path)
         ds = guarded(path, "netCDF-C", _load, str(path))
         _check_values(ds, path)

@@ -61,7 +61,6 @@ import numpy as np
 
 from ...bearings import get_bearing
 from . import contact
-from ._halfspace_kernels import cg_direction, cg_step, update_displacement
 from .geometry import RaceGeometry, hertz_semi_axes
 from .model import Defect
 
@@ -237,6 +236,7 @@ class HalfSpace:
 
     def _iterate(self, h, approach, tol, maxiter, p0, precondition):
         """:meth:`solve_batch` on this grid's every cell."""
+        from ._halfspace_kernels import cg_direction, cg_step, update_displacement  # kernels (7 ms) at the first solve
         stencil = self.stencil if precondition else PLAIN
         allowed = h < approach
         if p0 is None:

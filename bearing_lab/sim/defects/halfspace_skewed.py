@@ -34,7 +34,6 @@ import math
 
 import numpy as np
 
-from ._halfspace_kernels import torus_gap
 from .geometry import RaceGeometry
 from .halfspace import (TABLE_CELLS, HalfSpace, _curve, _refine, _symmetry, contact_grid, e_star_of,
                         hertz_start, pressure_semi_axes)
@@ -112,6 +111,7 @@ def _track_coords(skew: float, g: SkewedGrid, fu: float, fv: float):
 def _gap(geom: RaceGeometry, S, Z, depth=0.0):
     """The intact (or, ``depth`` into the ring, the floor's) gap (m) at track positions S, Z
     relative to the ball; 1.0 where the ball cannot reach (compiled ``geom.approach``)."""
+    from ._halfspace_kernels import torus_gap  # kernels (7 ms) at the first solve
     S, Z = np.broadcast_arrays(np.asarray(S, dtype=float), np.asarray(Z, dtype=float))
     out = np.empty(S.shape)
     torus_gap(np.ascontiguousarray(S).ravel(), np.ascontiguousarray(Z).ravel(), float(depth),
