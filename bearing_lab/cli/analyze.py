@@ -18,6 +18,7 @@ import warnings
 
 from ..errors import AnalysisError, RecordingError, RecordingOptionError
 from . import check_output_path
+from ..utils._json import dumps
 
 
 def register(subparsers):
@@ -141,7 +142,6 @@ def run(args) -> int:
               f"finite (the largest |value| is {np.max(np.abs(x)):.3g} {units}): reported as null",
               file=sys.stderr)
     if args.json:
-        from ..utils._json import dumps
         print(dumps(result, indent=1))  # no NaN/Infinity tokens: strict parsers read it
         return 0
     if args.quiet:

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 from ..errors import check_choice
+from ..utils._json import dumps
 
 
 def json_summary(ds, output) -> dict:
@@ -29,7 +30,6 @@ def _bench(args) -> int:
                    scipy_duration=args.scipy_duration, rates=not args.no_rates,
                    rate_duration=args.rate_duration)
     if args.json:
-        from ..utils._json import dumps
         print(dumps(json_summary(ds, args.output), indent=1))
         return 0
     if args.quiet:

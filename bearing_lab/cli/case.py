@@ -13,6 +13,7 @@ from pathlib import Path
 
 from . import check_output_path
 from ..errors import ValidationCaseError
+from ..utils._json import dumps
 
 
 def _cmd_new(args) -> int:
@@ -31,7 +32,6 @@ def _cmd_new(args) -> int:
         fh.write(text)
     notes = [line[len("# NOTE: "):] for line in text.splitlines() if line.startswith("# NOTE: ")]
     if args.json:
-        from ..utils._json import dumps
         print(dumps({"case": str(out), "recording": args.recording, "notes": notes}, indent=1))
         return 0
     for note in notes:
@@ -51,7 +51,6 @@ def _cmd_standin(args) -> int:
                                resonance_hz=args.resonance_hz, noise_g=args.noise_g, seed=args.seed)
     h = s.hidden
     if args.json:
-        from ..utils._json import dumps
         print(dumps({"file": str(s.path), "hidden": h}, indent=1))
         return 0
     if args.quiet:

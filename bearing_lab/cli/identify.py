@@ -12,6 +12,7 @@ import sys
 from pathlib import Path
 
 from ..errors import ValidationCaseError
+from ..utils._json import clean
 
 
 def register(subparsers):
@@ -82,7 +83,6 @@ def run(args) -> int:
     for ext in ("json", "nc", "html"):      # a partial result of an earlier, stopped run is superseded
         (Path(args.output) / case.name / f"identification-partial.{ext}").unlink(missing_ok=True)
     if args.json:
-        from ..utils._json import clean
         print(json.dumps(clean(res.to_dict()), allow_nan=False))
         return 0
     if args.quiet:
@@ -130,7 +130,6 @@ def _stopped(res, args, journal) -> int:
         return 130
     paths = write_identification(res, args.output, stem="identification-partial")
     if args.json:
-        from ..utils._json import clean
         print(json.dumps(clean(res.to_dict()), allow_nan=False))
     elif not args.quiet:
         print(f"PARTIAL result (interrupted after {res.n_scenes} scenes):")

@@ -15,6 +15,7 @@ from pathlib import Path
 
 from . import check_output_path
 from ..errors import RecordingError
+from ..utils._json import dumps
 
 
 def _options(args) -> dict:
@@ -94,7 +95,6 @@ def _cmd_import(args) -> int:
     n = ds.sizes["time"]
     fs = ds.attrs["sampling_rate_hz"]
     if args.json:
-        from ..utils._json import dumps
         print(dumps({**describe(ds, args.file), "output": args.output}, indent=1))
     elif not args.quiet:
         print(f"{args.output}: {len(ds.data_vars)} channel(s) {', '.join(ds.data_vars)}, {n} samples "
@@ -110,7 +110,6 @@ def _cmd_info(args) -> int:
     if args.formats:
         from ..io import list_engines  # the command's imports load when it runs
         if args.json:
-            from ..utils._json import dumps
             print(dumps(list_engines(), indent=1))
             return 0
         for name, desc in list_engines().items():
@@ -122,7 +121,6 @@ def _cmd_info(args) -> int:
     ds = _open(args, arrays_only=True)  # no Dataset: info prints without importing xarray
     d = describe(ds, args.file)
     if args.json:
-        from ..utils._json import dumps
         print(dumps(d, indent=1))
         return 0
     if args.quiet:   # the file reads: exit status 0, nothing printed
@@ -155,7 +153,6 @@ def _cmd_fetch(args) -> int:
         if not (args.quiet or args.json):
             print(f"{name}: {got[name]}")
     if args.json:
-        from ..utils._json import dumps
         print(dumps(got, indent=1))
     return 0
 
@@ -168,7 +165,6 @@ def _cmd_sample(args) -> int:
     with resources.as_file(src) as p:
         shutil.copyfile(p, out)
     if args.json:
-        from ..utils._json import dumps  # the command's imports load when it runs
         from ..validation.standin import SAMPLE
         print(dumps({"file": str(out), **SAMPLE}, indent=1))
     elif not args.quiet:
@@ -194,7 +190,6 @@ def _cmd_list(args) -> int:
                                      f"{r.fs_hz:g} Hz" if r.fs_hz else "") if x)
         print(f"{r.name:34s} {'sha256' if r.sha256 else 'no-hash':7s} {cond}")
     if args.json:
-        from ..utils._json import dumps  # the command's imports load when it runs
         print(dumps(rows, indent=1))
     return 0
 

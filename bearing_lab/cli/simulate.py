@@ -6,13 +6,13 @@ import math
 
 from . import check_output_path
 from ..errors import BearingLabError, SceneError
+from ..utils._json import dumps
 
 
 def _scenes(args) -> int:
     from ..sim import list_scenes  # the command's imports load when it runs
     scenes = list_scenes()
     if args.json:
-        from ..utils._json import dumps
         print(dumps(scenes, indent=1))
         return 0
     if args.quiet:
@@ -44,7 +44,6 @@ def _simulate(args) -> int:
             "noise": ({"rms_g": args.noise_g, "color": args.noise_color, "seed": args.seed,
                        "channel": ds.attrs["measurement_noise_channel"]} if args.noise_g else None)}
     if args.json:
-        from ..utils._json import dumps
         print(dumps(info, indent=1))
     elif not args.quiet:
         noise = (f", {args.noise_color} noise {args.noise_g:g} g rms on {ds.attrs['measurement_noise_channel']} "

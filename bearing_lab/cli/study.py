@@ -5,6 +5,7 @@ import sys
 
 from ..errors import BearingLabError, check_choice
 from ..units import G
+from ..utils._json import dumps
 
 
 def _study(args) -> int:
@@ -16,7 +17,6 @@ def _study(args) -> int:
         check_choice(n, STUDIES, "--only")
     table = run_paper_studies(args.output, progress=not (args.quiet or args.json), studies=names)
     if args.json:
-        from ..utils._json import dumps
         print(dumps({"output": args.output, "rows": table.to_dataframe().reset_index().to_dict("records"),
                      "total_wall_time_s": table.attrs["total_wall_time_s"]}, indent=1))
         return 0

@@ -6,6 +6,7 @@ import warnings
 
 from ..errors import BearingLabError, SceneError
 from . import check_output_path
+from ..utils._json import dumps
 
 
 def parse_params(items) -> dict:
@@ -46,7 +47,6 @@ def _sweep(args) -> int:
     to_netcdf(ds, out, error=BearingLabError)
     dims = " x ".join(f"{d}={ds.sizes[d]}" for d in ds.attrs["sweep_dims"].split())
     if args.json:
-        from ..utils._json import dumps
         print(dumps({"file": str(out), "dims": {d: ds.sizes[d] for d in ds.attrs["sweep_dims"].split()},
                      **{k: ds.attrs[k] for k in ("sweep_n_scenes", "sweep_computed", "sweep_cache_hits",
                                                  "sweep_wall_time_s", "sweep_scheduler")}}, indent=1))
