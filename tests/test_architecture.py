@@ -170,9 +170,10 @@ FUNCTION_LEVEL_IMPORTS = {
     "cli/analyze.py": 5, "cli/bench.py": 2, "cli/case.py": 4, "cli/identify.py": 6, "cli/recording.py": 13,
     "cli/simulate.py": 5, "cli/study.py": 1, "cli/sweep.py": 5, "cli/validate.py": 3,
     "io/__init__.py": 1, "io/_base.py": 2, "io/_fuzz.py": 3, "io/_fuzz_struct.py": 1, "io/_guard.py": 2,
-    "io/_matlab.py": 6, "io/export.py": 1, "io/mdf.py": 1, "io/netcdf.py": 2, "io/tdms.py": 1, "io/wav.py": 1,
-    "sim/auto.py": 1, "sim/defects/halfspace.py": 2, "sim/defects/halfspace_skewed.py": 1, "sim/defects/model.py": 1, "sim/integrate.py": 1,
-    "sim/limits.py": 1, "sim/scene.py": 4,
+    "io/_matlab.py": 8, "io/cwru.py": 2, "io/export.py": 1, "io/mdf.py": 1, "io/netcdf.py": 3, "io/tdms.py": 1,
+    "io/wav.py": 1,
+    "sim/auto.py": 1, "sim/defects/halfspace.py": 2, "sim/defects/halfspace_skewed.py": 1, "sim/defects/model.py": 1,
+    "sim/integrate.py": 1, "sim/limits.py": 1, "sim/scene.py": 4,
     "studies/bench.py": 2, "studies/paper.py": 1, "sweep/__init__.py": 5, "sweep/store.py": 1,
     "utils/figures.py": 2,
 }

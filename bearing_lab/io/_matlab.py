@@ -18,7 +18,6 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import RecordingError
-from ._guard import guarded
 
 HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 
@@ -63,6 +62,7 @@ def _variables(path: str, mtime: int, size: int, inode: int) -> tuple[str, ...]:
         head = fh.read(1024)
     v = mat_version(head)
     if v == "7.3":  # libhdf5 reads the file in a child process: damage cannot crash us
+        from ._guard import guarded  # the child-process guard for a v7.3 file only: io imports this module
         return guarded(path, "HDF5", _h5_names, path)
     if v == "5":
         from . import _mat5  # _mat5 (6 ms) loads for a MATLAB file only: io imports this module
@@ -151,6 +151,7 @@ def _load_mat(path, variable_names):
         head = fh.read(1024)
     v = mat_version(head)
     if v == "7.3":
+        from ._guard import guarded  # the child-process guard for a v7.3 file only: io imports this module
         names = tuple(variable_names) if variable_names else None
         return guarded(path, "HDF5", _h5_load, str(path), names)
     from . import _mat5  # _mat5 (6 ms) loads for a MATLAB file only: io imports this module

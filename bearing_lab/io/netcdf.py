@@ -24,7 +24,6 @@ import numpy as np
 
 from ..errors import BearingLabError, RecordingError
 from ._base import ENGINES, MAX_RATE_HZ, MIN_RATE_HZ, RecordingReader, speed_problem
-from ._guard import guarded
 
 NC_FILL_DOUBLE = 9.969209968386869e36   # netCDF's default _FillValue for doubles
 NC_FILL_FLOAT = np.float32(9.96921e36)
@@ -119,6 +118,7 @@ class NetcdfReader(RecordingReader):
         xarray.Dataset
         """
         from .. import schema  # schema (6 ms) when a Dataset is made: `info` reads plain arrays
+        from ._guard import guarded  # the child-process guard: io imports every reader to sniff
         path = Path(path)
         ds = guarded(path, "netCDF-C", _load, str(path))
         _check_values(ds, path)
