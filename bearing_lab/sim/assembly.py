@@ -18,8 +18,10 @@ from . import _kernels as K
 from . import scene as _sc
 from .auto import resolve
 from .bearing3d import axial_support, groove_offsets, needs_3d, static_equilibrium_3d
-from . import defects  # defects.contact_table and contact.CONTACT_MODELS are read at call time (a model
-from .defects import contact  # registered, or a table builder replaced, at run time counts)
+# defects.contact_table and contact.CONTACT_MODELS are read at call time: a model registered or a
+# table builder replaced at run time counts
+from . import defects
+from .defects import contact
 from .hertz import race_contact, series_stiffness
 from .numerics import brentq
 from .scene import Scene
