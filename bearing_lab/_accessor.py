@@ -33,7 +33,7 @@ _FORWARDED = {  # accessor method -> function of bearing_lab.analysis.xr
 
 def _forward(name: str, target: str):
     def method(self, **kw):
-        from .analysis import xr as _x
+        from .analysis import xr as _x  # analysis (scipy) loads at first use: sim and io import this module
         return getattr(_x, target)(self._da, **kw)
     method.__name__ = method.__qualname__ = name
     method.__doc__ = f":func:`bearing_lab.analysis.xr.{target}` of this DataArray (keywords as there)."
@@ -49,8 +49,8 @@ class BearingAccessor:
 
     def analyze(self, *, bearing, dim="time", fs=None, **kw):
         """:func:`bearing_lab.analysis.analyze` of a 1-D DataArray (dict, see docs/analysis.md)."""
-        from .analysis import xr as _x
-        from .analysis.pipeline import analyze
+        from .analysis import xr as _x  # analysis (scipy) loads at first use: sim and io import this module
+        from .analysis.pipeline import analyze  # analysis (scipy) loads at first use: sim and io import this module
         fs = _x.sampling_rate(self._da, dim=dim, fs=fs)
         return analyze(self._da.transpose(dim).values, fs, bearing=bearing,
                        channel=str(self._da.name or ""), units=self._da.attrs.get("units", "1"), **kw)

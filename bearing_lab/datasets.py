@@ -27,10 +27,19 @@ import csv
 import functools
 import importlib.resources
 import os
+import shutil
+import tempfile
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import lazy_loader as lazy
+
 from .errors import RecordingError
+from .utils._files import atomic_path, sha256_file
+
+# the download library, loaded when a recording is fetched or the cache folder is asked
+pooch = lazy.load("pooch")
 
 # package data: present in a wheel install as in a checkout (data/README.md documents it)
 REGISTRY_FILE = importlib.resources.files("bearing_lab") / "data" / "recordings.csv"
@@ -139,12 +148,10 @@ def data_dir() -> Path:
     proj = _CHECKOUT_DATA
     if (proj / "README.md").is_file() and os.access(proj, os.W_OK):
         return proj / "cache"
-    import pooch
     return Path(pooch.os_cache("bearing_lab"))
 
 
 def _sha256(path: Path) -> str:
-    from .utils._files import sha256_file
     return sha256_file(path)
 
 
@@ -204,9 +211,6 @@ def _safe_target(dest: Path, rec: Recording) -> Path:
 
 def _install(src_copy, target: Path, rec: Recording, verify: bool, where: str) -> Path:
     """Copy ``src_copy`` (a path) to ``target`` atomically after checking its hash."""
-    import shutil
-    import warnings
-    from .utils._files import atomic_path
     if verify and rec.sha256:
         _check(rec, Path(src_copy), where)
     elif verify:
@@ -288,8 +292,6 @@ def fetch(name: str, mirror=None, dest=None, *, download: bool = True, verify: b
 
 
 def _download(rec: Recording, target: Path, verify: bool, stale) -> Path:
-    import tempfile
-    import pooch
     target.parent.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(dir=target.parent, prefix=".fetch-") as tmp:
         try:

@@ -161,6 +161,59 @@ def test_the_layer_checks_can_fail():
     assert "bearing_lab.validation.rig" in imported_modules("bearing_lab.validation.recording_run")
 
 
+#: the function-level imports left in each module (all others sit at the module top), each for the
+#: reason on its line (docs/architecture.md, "Imports"): an import circle, a CLI handler's command
+#: library (the parser imports no numpy), a library a light path must not pay for, a registry read
+#: at call time.  A module not listed has none.  analysis/ and validation/ are not counted yet.
+FUNCTION_LEVEL_IMPORTS = {
+    "_accessor.py": 3, "_xarray.py": 3, "compare.py": 1,
+    "cli/analyze.py": 5, "cli/bench.py": 2, "cli/case.py": 4, "cli/identify.py": 6, "cli/recording.py": 13,
+    "cli/simulate.py": 5, "cli/study.py": 1, "cli/sweep.py": 5, "cli/validate.py": 3,
+    "io/__init__.py": 1, "io/_base.py": 2, "io/_fuzz.py": 3, "io/_fuzz_struct.py": 1, "io/_guard.py": 2,
+    "io/_matlab.py": 8, "io/cwru.py": 2, "io/export.py": 1, "io/mdf.py": 1, "io/netcdf.py": 3, "io/tdms.py": 1,
+    "io/wav.py": 1,
+    "sim/auto.py": 1, "sim/defects/halfspace.py": 2, "sim/defects/halfspace_skewed.py": 1, "sim/defects/model.py": 1,
+    "sim/integrate.py": 1, "sim/limits.py": 1, "sim/scene.py": 4,
+    "studies/bench.py": 2, "studies/paper.py": 1, "sweep/__init__.py": 5, "sweep/store.py": 1,
+    "utils/figures.py": 2,
+}
+NOT_COUNTED = ("analysis/", "validation/")
+
+
+def function_level_imports(source: str) -> list[int]:
+    """Line numbers of the ``import`` statements inside a function (or lambda) of ``source``."""
+    out = []
+
+    def walk(node, in_function):
+        for child in ast.iter_child_nodes(node):
+            if in_function and isinstance(child, (ast.Import, ast.ImportFrom)):
+                out.append(child.lineno)
+            walk(child, in_function or isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda)))
+    walk(ast.parse(source), False)
+    return out
+
+
+def test_function_level_imports_do_not_creep_back():
+    over = []
+    for path in sorted(PKG.rglob("*.py")):
+        rel = path.relative_to(PKG).as_posix()
+        if rel.startswith(NOT_COUNTED):
+            continue
+        found = function_level_imports(path.read_text(encoding="utf-8"))
+        if len(found) > FUNCTION_LEVEL_IMPORTS.get(rel, 0):
+            over.append(f"{rel}: {len(found)} function-level imports (lines {found}), "
+                        f"at most {FUNCTION_LEVEL_IMPORTS.get(rel, 0)}: move them to the module top")
+    assert not over, "\n".join(over)
+    assert all((PKG / rel).is_file() for rel in FUNCTION_LEVEL_IMPORTS), "a listed module is gone"
+
+
+def test_the_function_level_import_count_can_fail():
+    src = ("import os\nfrom . import a\n\ndef f():\n    import json\n    g = lambda: __import__('x')\n"
+           "    class C:\n        from . import b\n    return json\n\nclass D:\n    def m(self):\n"
+           "        from .c import d\n")
+    assert function_level_imports(src) == [5, 8, 13]
+
+
 #: third-party libraries loaded once by the import server before it forks one child per module: a
 #: child then pays only for bearing_lab's own modules.  Only libraries whose submodules load on
 #: attribute access (or are named here) are preloaded, so a module that uses ``scipy.signal`` or

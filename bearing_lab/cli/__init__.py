@@ -19,6 +19,7 @@ import io
 import os
 import sys
 from pathlib import Path
+import warnings
 
 from .._version import __version__
 from ..errors import BearingLabError
@@ -93,7 +94,6 @@ def _warning_line(message, category, filename, lineno, file=None, line=None):
 
 
 def main(argv=None) -> int:
-    import warnings
     warnings.showwarning = _warning_line
     for stream in (sys.stdout, sys.stderr):  # a file name in another locale's bytes is printed
         try:                                 # with escapes, never a UnicodeEncodeError
@@ -109,7 +109,6 @@ def main(argv=None) -> int:
     try:
         return int(args.func(args) or 0)
     except BrokenPipeError:  # the reader of our stdout went away (`| head`): stop quietly, as `cat` does
-        import os
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())  # so the interpreter's final flush does not fail again
         return 141  # 128 + SIGPIPE, what the shell reports for a tool killed by the closed pipe

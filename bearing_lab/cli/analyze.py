@@ -14,8 +14,11 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
+import warnings
 
 from ..errors import AnalysisError, RecordingError, RecordingOptionError
+from . import check_output_path
+from ..utils._json import dumps
 
 
 def register(subparsers):
@@ -58,7 +61,7 @@ PLOT_SUFFIXES = (".png", ".svg", ".pdf")
 
 def _open(path: Path, fs):
     """(Dataset, sampling rate, note) with ``--fs`` passed to the reader or overriding the file."""
-    from ..io import open_recording
+    from ..io import open_recording  # the command's imports load when it runs
     if not path.is_file():
         raise RecordingError(f"{path}: no such file")
     if fs is None:
@@ -98,7 +101,7 @@ def _rpm(ds, value, path):
 
 
 def run(args) -> int:
-    import numpy as np
+    import numpy as np  # the command's imports load when it runs
 
     from ..analysis import analyze, plot_analysis
     from ..analysis.inputs import bearing_name, not_an_acceleration, pick_channel, pick_tacho
@@ -106,7 +109,6 @@ def run(args) -> int:
 
     path = Path(args.file)
     if args.plot:  # before reading: a bad or existing figure path is said at once
-        from . import check_output_path
         check_output_path(args.plot, force=args.force, suffixes=PLOT_SUFFIXES, flag="--plot")
     ds, fs, note = _open(path, args.fs)
     name = pick_channel(ds, args.channel, source=path)
@@ -121,7 +123,6 @@ def run(args) -> int:
     kw = dict(bearing=bearing, rpm=rpm, rpm_source=rpm_source, channel=str(name), units=units,
               pulses_per_rev=args.pulses_per_rev,
               tacho=None if tacho_name is None else np.asarray(ds[tacho_name].values, float))
-    import warnings
     with np.errstate(all="ignore"), warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # overflow is reported once, below
         if args.plot:
@@ -141,7 +142,6 @@ def run(args) -> int:
               f"finite (the largest |value| is {np.max(np.abs(x)):.3g} {units}): reported as null",
               file=sys.stderr)
     if args.json:
-        from ..utils._json import dumps
         print(dumps(result, indent=1))  # no NaN/Infinity tokens: strict parsers read it
         return 0
     if args.quiet:

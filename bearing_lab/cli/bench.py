@@ -1,10 +1,13 @@
 """`bearing-lab bench`: speed against error (reports/performance/)."""
 from __future__ import annotations
 
+from ..errors import check_choice
+from ..utils._json import dumps
+
 
 def json_summary(ds, output) -> dict:
     """What ``bench --json`` prints: every run and, per scene, the fastest setting within tolerance."""
-    from ..studies.bench import fastest_within_tolerance, rows_of
+    from ..studies.bench import fastest_within_tolerance, rows_of  # the command's imports load when it runs
     rows = rows_of(ds)
     scenes = list(dict.fromkeys(r["scene"] for r in rows))
     return {"output": str(output),
@@ -16,10 +19,9 @@ def json_summary(ds, output) -> dict:
 
 
 def _bench(args) -> int:
-    from ..studies.bench import SCENES, run_bench, summary_table
+    from ..studies.bench import SCENES, run_bench, summary_table  # the command's imports load when it runs
     names = [s[0] for s in SCENES]
     if args.scene:
-        from ..errors import check_choice
         for s in args.scene:
             check_choice(s, names, "--scene")
     ds = run_bench(args.output, duration=args.duration, scenes=args.scene,
@@ -28,7 +30,6 @@ def _bench(args) -> int:
                    scipy_duration=args.scipy_duration, rates=not args.no_rates,
                    rate_duration=args.rate_duration)
     if args.json:
-        from ..utils._json import dumps
         print(dumps(json_summary(ds, args.output), indent=1))
         return 0
     if args.quiet:

@@ -11,9 +11,13 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
+from . import check_output_path
+from ..errors import ValidationCaseError
+from ..utils._json import dumps
+
 
 def _cmd_new(args) -> int:
-    from ..errors import ValidationCaseError
+    from ..utils._files import atomic_open  # the command's imports load when it runs
     from ..validation.newcase import new_case_text
     out = Path(args.output) if args.output else Path(args.recording).with_suffix(".toml")
     if out.suffix != ".toml":
@@ -24,12 +28,10 @@ def _cmd_new(args) -> int:
         raise ValidationCaseError(f"-o {out}: directory {out.parent} does not exist")
     text = new_case_text(args.recording, name=args.name, bearing=args.bearing, speed=args.speed,
                          channel=args.channel, fmt=args.format, case_dir=out.parent)
-    from ..utils._files import atomic_open
     with atomic_open(out, "w", encoding="utf-8") as fh:
         fh.write(text)
     notes = [line[len("# NOTE: "):] for line in text.splitlines() if line.startswith("# NOTE: ")]
     if args.json:
-        from ..utils._json import dumps
         print(dumps({"case": str(out), "recording": args.recording, "notes": notes}, indent=1))
         return 0
     for note in notes:
@@ -41,8 +43,7 @@ def _cmd_new(args) -> int:
 
 
 def _cmd_standin(args) -> int:
-    from . import check_output_path
-    from ..sim.scene import parse_set
+    from ..sim.scene import parse_set  # the command's imports load when it runs
     from ..validation.standin import make_standin_recording
     check_output_path(args.output, force=args.force, suffixes=(".uff", ".mat"))
     s = make_standin_recording(args.output, scene=args.scene, overrides=parse_set(args.set), rpm=args.rpm,
@@ -50,7 +51,6 @@ def _cmd_standin(args) -> int:
                                resonance_hz=args.resonance_hz, noise_g=args.noise_g, seed=args.seed)
     h = s.hidden
     if args.json:
-        from ..utils._json import dumps
         print(dumps({"file": str(s.path), "hidden": h}, indent=1))
         return 0
     if args.quiet:

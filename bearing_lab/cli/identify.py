@@ -9,6 +9,10 @@ from __future__ import annotations
 
 import json
 import sys
+from pathlib import Path
+
+from ..errors import ValidationCaseError
+from ..utils._json import clean
 
 
 def register(subparsers):
@@ -52,10 +56,9 @@ def register(subparsers):
 
 
 def run(args) -> int:
-    from ..validation import load_case
+    from ..validation import load_case  # the command's imports load when it runs
     from ..validation.identify import IdentificationInterrupted, default_grid, identify
     from ..validation.identify_report import write_identification
-    from ..errors import ValidationCaseError
     if args.workers < 1:
         raise ValidationCaseError(f"--workers {args.workers}: give 1 (in this process) or more Dask worker processes")
     case = load_case(args.case)
@@ -64,7 +67,6 @@ def run(args) -> int:
                        ("defect.skew_deg", args.skew_deg), ("defect.depth_mm", args.depth_mm)):
         if given:
             grid[key] = list(given)
-    from pathlib import Path
     journal = Path(args.output) / case.name / "identification-journal.jsonl"
     if args.restart and journal.is_file():
         journal.unlink()
@@ -81,7 +83,6 @@ def run(args) -> int:
     for ext in ("json", "nc", "html"):      # a partial result of an earlier, stopped run is superseded
         (Path(args.output) / case.name / f"identification-partial.{ext}").unlink(missing_ok=True)
     if args.json:
-        from ..utils._json import clean
         print(json.dumps(clean(res.to_dict()), allow_nan=False))
         return 0
     if args.quiet:
@@ -101,7 +102,7 @@ class _term_stops:
     """SIGTERM (a kill) stops the run as Ctrl-C does, so the partial result is written (restored after)."""
 
     def __enter__(self):
-        import signal
+        import signal  # the command's imports load when it runs
         self.old = None
         try:
             self.old = signal.signal(signal.SIGTERM, self._raise)
@@ -114,7 +115,7 @@ class _term_stops:
         raise KeyboardInterrupt
 
     def __exit__(self, *exc):
-        import signal
+        import signal  # the command's imports load when it runs
         if self.old is not None:
             signal.signal(signal.SIGTERM, self.old)
         return False
@@ -122,14 +123,13 @@ class _term_stops:
 
 def _stopped(res, args, journal) -> int:
     """A stopped run: the partial result of the scenes done (if any) written and printed; exit status 130."""
-    from ..validation.identify_report import write_identification
+    from ..validation.identify_report import write_identification  # the command's imports load when it runs
     where = f"the scored scenes are kept in {journal}; rerun the same command to resume"
     if res is None:
         print(f"bearing-lab identify: interrupted before any scene finished; {where}", file=sys.stderr)
         return 130
     paths = write_identification(res, args.output, stem="identification-partial")
     if args.json:
-        from ..utils._json import clean
         print(json.dumps(clean(res.to_dict()), allow_nan=False))
     elif not args.quiet:
         print(f"PARTIAL result (interrupted after {res.n_scenes} scenes):")

@@ -11,6 +11,11 @@ from __future__ import annotations
 import json
 import sys
 import warnings
+from pathlib import Path
+
+from . import check_output_path
+from ..errors import RecordingError
+from ..utils._json import dumps
 
 
 def _options(args) -> dict:
@@ -49,12 +54,11 @@ def _add_read_options(p):
 
 
 def _open(args, arrays_only=False):
-    from ..io import open_recording, read_arrays
+    from ..io import open_recording, read_arrays  # the command's imports load when it runs
     opts = _options(args)
     fmt = args.format
     if fmt is None:
         from ..io import guess_format
-        from pathlib import Path
         p = Path(args.file)
         if p.is_file() and p.stat().st_size:
             fmt = guess_format(p)
@@ -65,7 +69,6 @@ def _open(args, arrays_only=False):
             dropped = [k for k in opts if k not in known]
             if dropped:
                 flags = ", ".join("--" + k.replace("_", "-") for k in dropped)
-                from ..errors import RecordingError
                 raise RecordingError(f"{args.file}: the {fmt!r} reader does not use {flags}")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # they are in ds.attrs['warnings'] and printed below
@@ -73,13 +76,11 @@ def _open(args, arrays_only=False):
 
 
 def _cmd_import(args) -> int:
-    from ..io import get_warnings, to_netcdf
+    from ..io import get_warnings, to_netcdf  # the command's imports load when it runs
     from ..io.summary import dataset_kind, describe
-    from . import check_output_path
     check_output_path(args.output, force=args.force)  # before reading: a bad -o is said at once
     ds = _open(args)
     if args.rpm is not None:
-        from ..errors import RecordingError
         from ..io import speed_problem
         problem = speed_problem(args.rpm)
         if problem is not None:
@@ -94,7 +95,6 @@ def _cmd_import(args) -> int:
     n = ds.sizes["time"]
     fs = ds.attrs["sampling_rate_hz"]
     if args.json:
-        from ..utils._json import dumps
         print(dumps({**describe(ds, args.file), "output": args.output}, indent=1))
     elif not args.quiet:
         print(f"{args.output}: {len(ds.data_vars)} channel(s) {', '.join(ds.data_vars)}, {n} samples "
@@ -108,22 +108,19 @@ def _fmt(v, spec="", none="-"):
 
 def _cmd_info(args) -> int:
     if args.formats:
-        from ..io import list_engines
+        from ..io import list_engines  # the command's imports load when it runs
         if args.json:
-            from ..utils._json import dumps
             print(dumps(list_engines(), indent=1))
             return 0
         for name, desc in list_engines().items():
             print(f"{name:14s} {desc}")
         return 0
     if not args.file:
-        from ..errors import RecordingError
         raise RecordingError("info: give a FILE (or --formats)")
     from ..io.summary import describe
     ds = _open(args, arrays_only=True)  # no Dataset: info prints without importing xarray
     d = describe(ds, args.file)
     if args.json:
-        from ..utils._json import dumps
         print(dumps(d, indent=1))
         return 0
     if args.quiet:   # the file reads: exit status 0, nothing printed
@@ -149,28 +146,25 @@ def _cmd_info(args) -> int:
 
 
 def _cmd_fetch(args) -> int:
-    from .. import datasets
+    from .. import datasets  # the command's imports load when it runs
     got = {}
     for name in args.names:
         got[name] = str(datasets.fetch(name, mirror=args.mirror, dest=args.dest, download=not args.no_download))
         if not (args.quiet or args.json):
             print(f"{name}: {got[name]}")
     if args.json:
-        from ..utils._json import dumps
         print(dumps(got, indent=1))
     return 0
 
 
 def _cmd_sample(args) -> int:
+    from importlib import resources  # the command's imports load when it runs
     import shutil
-    from importlib import resources
-    from . import check_output_path
     out = check_output_path(args.output, force=args.force, suffixes=(".uff",))
     src = resources.files("bearing_lab").joinpath("data", "sample_recording.uff")
     with resources.as_file(src) as p:
         shutil.copyfile(p, out)
     if args.json:
-        from ..utils._json import dumps
         from ..validation.standin import SAMPLE
         print(dumps({"file": str(out), **SAMPLE}, indent=1))
     elif not args.quiet:
@@ -180,7 +174,7 @@ def _cmd_sample(args) -> int:
 
 
 def _cmd_list(args) -> int:
-    from .. import datasets
+    from .. import datasets  # the command's imports load when it runs
     rows = []
     for r in datasets.load_registry().values():
         if args.dataset and not r.dataset.startswith(args.dataset):
@@ -196,7 +190,6 @@ def _cmd_list(args) -> int:
                                      f"{r.fs_hz:g} Hz" if r.fs_hz else "") if x)
         print(f"{r.name:34s} {'sha256' if r.sha256 else 'no-hash':7s} {cond}")
     if args.json:
-        from ..utils._json import dumps
         print(dumps(rows, indent=1))
     return 0
 

@@ -2,13 +2,17 @@
 from __future__ import annotations
 
 import sys
+import math
+
+from . import check_output_path
+from ..errors import BearingLabError, SceneError
+from ..utils._json import dumps
 
 
 def _scenes(args) -> int:
-    from ..sim import list_scenes
+    from ..sim import list_scenes  # the command's imports load when it runs
     scenes = list_scenes()
     if args.json:
-        from ..utils._json import dumps
         print(dumps(scenes, indent=1))
         return 0
     if args.quiet:
@@ -20,21 +24,17 @@ def _scenes(args) -> int:
 
 
 def _simulate(args) -> int:
-    from ..sim import simulate
+    from ..sim import simulate  # the command's imports load when it runs
     from ..sim.noise import add_measurement_noise
     from ..sim.scene import merge_overrides, parse_set
     overrides = merge_overrides(parse_set(args.set), **{"output.duration_s": args.duration,
                                                         "output.sample_rate_hz": args.fs})
-    from . import check_output_path
     out = check_output_path(args.output, force=args.force)
-    import math
     if args.noise_g is not None and not (math.isfinite(args.noise_g) and args.noise_g >= 0):
-        from ..errors import SceneError   # said before the simulation runs
         raise SceneError(f"--noise-g {args.noise_g:g}: give the noise RMS as a number of g, 0 or more")
     ds = simulate(args.scene, progress=not (args.quiet or args.json), **overrides)
     if args.noise_g:
         ds = add_measurement_noise(ds, args.noise_g, seed=args.seed, color=args.noise_color)
-    from ..errors import BearingLabError
     from ..io.export import to_netcdf
     to_netcdf(ds, out, error=BearingLabError)
     info = {"file": str(out), "samples": int(ds.sizes["time"]), "sampling_rate_hz": float(ds.attrs["sampling_rate_hz"]),
@@ -44,7 +44,6 @@ def _simulate(args) -> int:
             "noise": ({"rms_g": args.noise_g, "color": args.noise_color, "seed": args.seed,
                        "channel": ds.attrs["measurement_noise_channel"]} if args.noise_g else None)}
     if args.json:
-        from ..utils._json import dumps
         print(dumps(info, indent=1))
     elif not args.quiet:
         noise = (f", {args.noise_color} noise {args.noise_g:g} g rms on {ds.attrs['measurement_noise_channel']} "

@@ -5,18 +5,18 @@ import sys
 
 from ..errors import BearingLabError, check_choice
 from ..units import G
+from ..utils._json import dumps
 
 
 def _study(args) -> int:
     if args.which != "paper":
         raise BearingLabError(f"study {args.which!r}: the only study set is 'paper'")
-    from ..studies.paper import STUDIES, run_paper_studies
+    from ..studies.paper import STUDIES, run_paper_studies  # the command's imports load when it runs
     names = args.only or list(STUDIES)
     for n in names:
         check_choice(n, STUDIES, "--only")
     table = run_paper_studies(args.output, progress=not (args.quiet or args.json), studies=names)
     if args.json:
-        from ..utils._json import dumps
         print(dumps({"output": args.output, "rows": table.to_dataframe().reset_index().to_dict("records"),
                      "total_wall_time_s": table.attrs["total_wall_time_s"]}, indent=1))
         return 0

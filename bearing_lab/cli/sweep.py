@@ -2,13 +2,16 @@
 from __future__ import annotations
 
 import sys
+import warnings
 
-from ..errors import SceneError
+from ..errors import BearingLabError, SceneError
+from . import check_output_path
+from ..utils._json import dumps
 
 
 def parse_params(items) -> dict:
     """``["speed_rpm=900,1800", "defect.offset_mm=0,0.5"]`` -> ``{key: [values]}``."""
-    from ..sim.scene import parse_value
+    from ..sim.scene import parse_value  # the command's imports load when it runs
     out = {}
     for item in items or []:
         if "=" not in item:
@@ -28,26 +31,22 @@ def parse_params(items) -> dict:
 
 
 def _sweep(args) -> int:
-    from ..sweep import run_sweep
+    from ..sweep import run_sweep  # the command's imports load when it runs
     from ..sim.scene import parse_set
     params = parse_params(args.param)
     overrides = parse_set(args.set)
-    from . import check_output_path
     out = check_output_path(args.output, force=args.force)
     cache = False if args.no_cache else args.cache_dir
-    import warnings
     from ..sweep import CacheWarning
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", CacheWarning)  # said below, in one line
         ds = run_sweep(args.scene, params, scheduler=args.scheduler, n_workers=args.workers,
                        cache_dir=cache, progress=not (args.quiet or args.json), duration=args.duration, fs=args.fs,
                        **overrides)
-    from ..errors import BearingLabError
     from ..io.export import to_netcdf
     to_netcdf(ds, out, error=BearingLabError)
     dims = " x ".join(f"{d}={ds.sizes[d]}" for d in ds.attrs["sweep_dims"].split())
     if args.json:
-        from ..utils._json import dumps
         print(dumps({"file": str(out), "dims": {d: ds.sizes[d] for d in ds.attrs["sweep_dims"].split()},
                      **{k: ds.attrs[k] for k in ("sweep_n_scenes", "sweep_computed", "sweep_cache_hits",
                                                  "sweep_wall_time_s", "sweep_scheduler")}}, indent=1))

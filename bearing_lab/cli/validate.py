@@ -16,9 +16,11 @@ import os
 import sys
 import time
 
+from ..utils._json import dumps
+
 
 def _epilog() -> str:
-    from ..validation.rows import VERDICTS
+    from ..validation.rows import VERDICTS  # the command's imports load when it runs
     from ..validation.rows import EXIT_STATUS
     lines = ["verdict of a case:"]
     lines += [f"  {k.upper():18s} {v}" for k, v in VERDICTS.items()]
@@ -80,10 +82,9 @@ def _json(outcomes, out_dir, status) -> dict:
 
 
 def run(args) -> int:
-    from ..validation import load_case, run_validation, shipped_cases
+    from ..validation import load_case, run_validation, shipped_cases  # the command's imports load when it runs
     if args.list:
         if args.json:
-            from ..utils._json import dumps
             print(dumps([{"case": n, "default": load_case(n).default, "title": load_case(n).title}
                          for n in shipped_cases()], indent=1))
             return 0
@@ -97,7 +98,6 @@ def run(args) -> int:
     outcomes, status = run_validation(args.cases or None, args.output, strict=args.strict,
                                       progress=progress, mirror=args.mirror)
     if args.json:
-        from ..utils._json import dumps
         print(dumps(_json(outcomes, args.output, status), indent=1))
     elif not args.quiet:
         for o in outcomes:

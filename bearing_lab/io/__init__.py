@@ -26,9 +26,12 @@ An option a reader does not know is refused with the list of those it knows
 from __future__ import annotations
 
 import errno
+import importlib
+from importlib.metadata import entry_points
 import os
 from pathlib import Path
 import stat
+import warnings
 
 from ..errors import BearingLabError, RecordingError, RecordingOptionError, check_choice
 from ._base import (ARRAYS_ONLY, ENGINES, RecordingArrays, RecordingReader,  # noqa: F401
@@ -47,8 +50,6 @@ ENTRY_POINT_GROUP = "bearing_lab.readers"
 
 def _load_plugin_readers() -> list[str]:
     """Register the readers of :data:`ENTRY_POINT_GROUP`; a broken one is skipped with a warning."""
-    import warnings
-    from importlib.metadata import entry_points
     added = []
     for ep in entry_points(group=ENTRY_POINT_GROUP):
         why = None
@@ -72,7 +73,6 @@ def _load_plugin_readers() -> list[str]:
 
 
 def _register_readers():
-    import importlib
     for name in SNIFF_ORDER:
         importlib.import_module(f".{name}", __name__)
     _load_plugin_readers()

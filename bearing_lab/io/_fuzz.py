@@ -30,19 +30,35 @@ space limit.  Verdicts, one per mutant:
 """
 from __future__ import annotations
 
+import argparse
 import json
 import os
 from pathlib import Path
+import re
+import resource
+import select
 import shutil
+import signal
+import struct
 import subprocess
 import sys
 import tempfile
 import time
 import warnings
 
+import lazy_loader as lazy
 import numpy as np
 
+from .. import schema
+from ..errors import RecordingError
 from ..units import G
+from . import open_recording, to_netcdf, to_uff58b
+from ._matlab import load_mat
+
+# the corpus builders' format libraries (optional ones included): loaded when a builder runs
+asammdf = lazy.load("asammdf")
+h5py = lazy.load("h5py")
+nptdms = lazy.load("nptdms")
 
 VERDICTS = ("ok", "renamed", "refused", "uncaught", "silent", "invalid", "crash", "hang", "memory")
 BAD = ("uncaught", "silent", "invalid", "crash", "hang", "memory")
@@ -59,7 +75,6 @@ def _mirror_file(rel):
 
 
 def _ims_channels(mirror):
-    from . import open_recording
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         ds = open_recording(mirror / "ims" / "2004.02.17.07.12.39")
@@ -68,7 +83,6 @@ def _ims_channels(mirror):
 
 def _build_tdms(mirror: Path, tmp: Path) -> Path:
     """Two channels of a real IMS snapshot, 20 000 samples, streamed in two segments."""
-    import nptdms
     ds = _ims_channels(mirror)
     p = tmp / "ims_b1_b2.tdms"
     props = {"wf_increment": 1.0 / ds.attrs["sampling_rate_hz"], "wf_start_offset": 0.0,
@@ -82,8 +96,6 @@ def _build_tdms(mirror: Path, tmp: Path) -> Path:
 
 def _build_v73(mirror: Path, tmp: Path) -> Path:
     """The real Testlab export re-saved as a MATLAB v7.3 (HDF5) file, values deflated."""
-    import h5py
-    from ._matlab import load_mat
     sig = load_mat(mirror / "lms" / "testlab_acceler.mat")["Signal"]
     p = tmp / "testlab_acceler_v73.mat"
 
@@ -113,8 +125,7 @@ def _build_v73(mirror: Path, tmp: Path) -> Path:
 
 def _build_wav(mirror: Path, tmp: Path) -> Path:
     """CWRU drive-end and fan-end signals as a 16-bit stereo WAV (full scale 10 g)."""
-    import scipy.io.wavfile
-    from . import open_recording
+    import scipy.io.wavfile  # lazy.load imports scipy.io at once (workers: memory limit)
     ds = open_recording(mirror / "cwru" / "130_OR007@6_0.mat")
     x = np.stack([ds["DE"].values, ds["FE"].values], axis=1)[:40000] / G / 10.0
     p = tmp / "cwru130_de_fe.wav"
@@ -124,7 +135,6 @@ def _build_wav(mirror: Path, tmp: Path) -> Path:
 
 def _build_nc(mirror: Path, tmp: Path) -> Path:
     """A bearing_lab netCDF4 file: a real IMS snapshot imported."""
-    from . import to_netcdf
     ds = _ims_channels(mirror)
     p = tmp / "ims_import.nc"
     to_netcdf(ds, p)
@@ -153,7 +163,6 @@ def _build_testlab_text(mirror: Path, tmp: Path) -> Path:
 
 
 def _build_mdf(mirror: Path, tmp: Path) -> Path:
-    import asammdf
     ds = _ims_channels(mirror)
     t = ds["time"].values[:5000]
     m = asammdf.MDF(version="4.10")
@@ -206,8 +215,6 @@ _TOKENS = [b"0", b"-1", b"1", b"nan", b"inf", b"1e309", b"-0", b"", b" ", b"\t",
 
 def hot_spots(data: bytes, fmt: str) -> np.ndarray:
     """Byte positions in the file's structure (headers, tags, lead-ins) rather than bulk data."""
-    import re
-    import struct
     size = len(data)
     spots = []
     if fmt == "uff":  # the text lines (headers, delimiters), not the binary payloads
@@ -295,7 +302,6 @@ def _summary(ds) -> dict:
 
 
 def _open_quietly(path, options):
-    from . import open_recording
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         with np.errstate(all="ignore"):
@@ -303,7 +309,6 @@ def _open_quietly(path, options):
 
 
 def exception_verdict(exc, path: Path) -> tuple[str, str]:
-    from ..errors import RecordingError
     if isinstance(exc, RecordingError):
         if path.name not in str(exc):
             return "uncaught", f"RecordingError without the file name: {exc}"
@@ -313,7 +318,6 @@ def exception_verdict(exc, path: Path) -> tuple[str, str]:
 
 def verdict(path: Path, source: Source, ref, truncation: bool) -> tuple[str, str]:
     """Read one mutant and judge it against the original's Dataset ``ref``."""
-    from .. import schema
     try:
         ds = _open_quietly(path, source.options)
     except KeyboardInterrupt:
@@ -348,12 +352,10 @@ def verdict(path: Path, source: Source, ref, truncation: bool) -> tuple[str, str
 
 
 def _peak_rss_mb() -> float:
-    import resource
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
 
 
 def limit_address_space(extra_mb: int) -> None:
-    import resource
     try:
         with open("/proc/self/status") as fh:
             vm = next(int(ln.split()[1]) for ln in fh if ln.startswith("VmSize")) * 1024
@@ -420,7 +422,6 @@ def _injected_faults() -> dict[int, str]:
 
 
 def _inject(kind: str, path: Path) -> tuple[str, str]:
-    import signal
     if kind == "crash":
         os.kill(os.getpid(), signal.SIGSEGV)
     if kind == "hang":
@@ -437,7 +438,6 @@ class Worker:
         self._boot(cmd, name, startup_s)
 
     def _boot(self, cmd, name, startup_s=120.0):
-        import select
         self._select = select.select
         self.proc = subprocess.Popen(cmd, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
                                      stderr=subprocess.DEVNULL, text=True, bufsize=1)
@@ -535,7 +535,7 @@ while True:
 
 
 def _version(n: int, k: int):
-    import xarray as xr
+    import xarray as xr  # fuzz workers: memory limit, only what a format needs
     t = np.arange(n) / 10000.0
     return xr.Dataset({"acc": ("time", np.sin(t * (1 + k % 2)), {
         "units": "m s-2", "quantity": "acceleration", "original_units": "m/s2"})},
@@ -546,7 +546,6 @@ def _version(n: int, k: int):
 
 def write_version(target, kind: str, n: int, k: int) -> None:
     """Write version ``k`` (two alternating signals) of a test recording to ``target``."""
-    from . import to_netcdf, to_uff58b
     (to_netcdf if kind == "netcdf" else to_uff58b)(_version(n, k), target)
 
 
@@ -568,9 +567,6 @@ def kill_writes(target: Path, kills: int, *, kind: str = "netcdf", seed: int = 0
     """SIGKILL a process that writes ``target`` over and over; after each kill the file must
     open and hold one complete version.  Returns counts: ``intact``, ``destroyed``,
     ``never_written`` (killed before the first write) and ``temporaries`` left behind."""
-    import signal
-    from ..errors import RecordingError
-    from . import open_recording
     target = Path(target)
     rng = np.random.default_rng(seed)
     versions = _written_versions(n)
@@ -601,7 +597,6 @@ def kill_writes(target: Path, kills: int, *, kind: str = "netcdf", seed: int = 0
 
 
 def main(argv=None) -> int:
-    import argparse
     ap = argparse.ArgumentParser(prog="python -m bearing_lab.io._fuzz")
     sub = ap.add_subparsers(dest="cmd", required=True)
     w = sub.add_parser("worker")
@@ -621,7 +616,7 @@ def main(argv=None) -> int:
         worker(args.name, args.seed, args.mem_mb)
         return 0
     if args.cmd == "structured":
-        from ._fuzz_struct import structured_worker
+        from ._fuzz_struct import structured_worker  # circle: _fuzz_struct imports _fuzz
         structured_worker(args.kind, args.seed)
         return 0
     p = _save(args.name, args.seed, args.index, Path(args.out))

@@ -20,17 +20,28 @@ import json
 import os
 from pathlib import Path
 import shutil
+import struct
 import subprocess
 import sys
 import tempfile
 import time
 import warnings
+import zlib
 
+import lazy_loader as lazy
 import numpy as np
 
+from .. import schema
 from ..units import G
 from . import _fuzz
 from ._fuzz import Worker, exception_verdict, limit_address_space, scratch
+from ._testing import uff58_block
+
+# the structured mutants' format libraries: loaded when a mutant of that format is made
+h5py = lazy.load("h5py")
+netCDF4 = lazy.load("netCDF4")
+pyuff = lazy.load("pyuff")
+scipy_io = lazy.load("scipy.io", suppress_warning=True)
 
 STRUCT_KINDS = ("mat5", "v73", "netcdf", "wav", "uff", "special")
 STRUCT_VERDICTS = ("ok", "refused", "unverified", "uncaught", "silent", "invalid", "crash", "hang",
@@ -50,13 +61,11 @@ def _field(rng, fields: dict):
 
 def _mi(typ, payload: bytes) -> bytes:
     """One MAT v5 data element (tag + payload padded to 8 bytes)."""
-    import struct
     return struct.pack("<II", typ, len(payload)) + payload + b"\0" * (-len(payload) % 8)
 
 
 def _mat5_array(name: str, cls: int, dims, data_type: int, real: bytes, imag: bytes | None = None,
                 logical=False) -> bytes:
-    import struct
     flags = cls | (0x800 if imag is not None else 0) | (0x200 if logical else 0)
     body = (_mi(6, struct.pack("<II", flags, 0)) + _mi(5, struct.pack(f"<{len(dims)}i", *dims))
             + _mi(1, name.encode()) + _mi(data_type, real)
@@ -75,7 +84,6 @@ _MAT_CLASSES = {"double": (6, 9, "<f8"), "single": (7, 7, "<f4"), "int16": (10, 
 
 def _case_mat5(rng, tmp: Path, n: int):
     """A CWRU-style file: X130_DE_time (+ X130_FE_time, X130RPM) with fields set on purpose."""
-    import zlib
     x = np.round(np.sin(np.arange(n) / 3.7) * 100.0)
     f, chosen = _field(rng, {
         "class": ("double", ["single", "int16", "int32", "uint8", "complex", "logical"]),
@@ -133,13 +141,11 @@ def _case_mat5(rng, tmp: Path, n: int):
 
 
 def _compressed(stream: bytes) -> bytes:
-    import struct
     return struct.pack("<II", 15, len(stream)) + stream
 
 
 def _case_v73(rng, tmp: Path, n: int):
     """A CWRU-style MATLAB v7.3 file written with h5py (MATLAB stores arrays transposed)."""
-    import h5py
     x = np.sin(np.arange(n) / 3.7)
     f, chosen = _field(rng, {"shape": ((1, n), [(n,), (n, 1), (2, n), (n, 2)]),
                              "dtype": ("<f8", ["<f4", "<i2", "complex"]),
@@ -164,7 +170,7 @@ def _case_v73(rng, tmp: Path, n: int):
 
 def _case_netcdf(rng, tmp: Path, n: int):
     """A netCDF written by xarray with bearing_lab's attributes set on purpose (or missing)."""
-    import xarray as xr
+    import xarray as xr  # fuzz workers: memory limit, only what a format needs
     fs = 12000.0
     t = np.arange(n) / fs
     attrs = {"bearing_lab_version": "0", "source_file": "x", "source_sha256": "", "reader": "csv",
@@ -208,7 +214,6 @@ def _case_netcdf(rng, tmp: Path, n: int):
 
 def _case_wav(rng, tmp: Path, n: int):
     """A 16-bit stereo WAV whose fmt fields are set on purpose."""
-    import struct
     x = (np.sin(np.arange(2 * n) / 3.7) * 20000).astype("<i2").reshape(n, 2)
     payload = x.tobytes()
     f, chosen = _field(rng, {"channels": (2, [1, 0, 3, 4]), "bits": (16, [8, 0, 12, 24, 32, 7]),
@@ -232,7 +237,6 @@ _UFF_164 = ("    -1\n   164\n         2mm (milli newton)         2\n"
 
 def _case_uff(rng, tmp: Path, n: int):
     """A UFF 58b set with its increment, point count, unit label and units set chosen on purpose."""
-    from ._testing import uff58_block
     x = np.sin(np.arange(n) / 3.7)
     f, chosen = _field(rng, {
         "inc": ("1.00000E-03", ["1.00000E-320", "0.00000E+00", "-1.0000E-03", "1.00000E+300", "NaN",
@@ -302,8 +306,6 @@ def _one_channel(v, name):
 def _mat5_streams(path: Path) -> None:
     """Inflate every compressed element with zlib alone: anything after its first stream is
     content (a second stream, appended bytes) that one stream's reader would drop."""
-    import struct
-    import zlib
     data = path.read_bytes()
     pos = 128
     while pos + 8 <= len(data):
@@ -326,11 +328,9 @@ def reference_values(path: Path, kind: str) -> dict | None:
     NotOneChannel
         The file holds something no channel can be read as without a change.
     """
-    import struct
     if kind == "mat5":
-        import scipy.io
         _mat5_streams(path)
-        m = scipy.io.loadmat(path)  # only reached for files bearing_lab accepted
+        m = scipy_io.loadmat(path)  # only reached for files bearing_lab accepted
         out = {}
         for c in ("DE", "FE"):
             v = m.get(f"X130_{c}_time")
@@ -339,7 +339,6 @@ def reference_values(path: Path, kind: str) -> dict | None:
                 out[c] = np.asarray(v, dtype=np.float64).ravel(order="F") * G
         return out
     if kind == "v73":
-        import h5py
         with h5py.File(path, "r") as f:
             d = f["X130_DE_time"]
             cls = d.attrs.get("MATLAB_class", b"")
@@ -349,7 +348,6 @@ def reference_values(path: Path, kind: str) -> dict | None:
             v = np.asarray(v, dtype=np.float64).T
         return {"DE": v.ravel(order="F") * G}
     if kind == "netcdf":
-        import netCDF4
         with netCDF4.Dataset(path) as f:
             out = {k: np.asarray(v[:], dtype=np.float64) for k, v in f.variables.items()
                    if k != "time" and v.dimensions == ("time",)}
@@ -379,7 +377,6 @@ def reference_values(path: Path, kind: str) -> dict | None:
         out["__rate__"] = float(rate)
         return out
     if kind == "uff":
-        import pyuff
         found = pyuff.UFF(str(path)).read_sets()
         found = found if isinstance(found, list) else [found]
         sets = [s for s in found if s.get("type") == 58]
@@ -401,7 +398,6 @@ def reference_values(path: Path, kind: str) -> dict | None:
 
 def structured_verdict(path: Path, options: dict, kind: str) -> tuple[str, str]:
     """Read one structured case and compare what was read with the independent decoder."""
-    from .. import schema
     try:
         ds = _fuzz._open_quietly(path, options)
     except KeyboardInterrupt:
@@ -517,7 +513,6 @@ def truncate_while_reading(target: Path, *, mb: float = 64.0, trials: int = 5, s
     Counts how each read ends: ``refused`` (a message), ``ok`` (read before the cut), or
     ``crash`` (a signal such as SIGBUS: the defect a memory-mapped reader had).
     """
-    from ._testing import uff58_block
     rng = np.random.default_rng(seed)
     n = int(mb * 1e6 / 8)
     x = np.sin(np.arange(n) / 3.7)

@@ -18,6 +18,7 @@ single-threaded child in milliseconds; elsewhere each read spawns an interpreter
 from __future__ import annotations
 
 import contextlib
+import faulthandler
 import os
 import threading
 
@@ -29,7 +30,6 @@ DEFAULT_TIMEOUT_S = 20.0
 
 
 def _child(conn, func, args):
-    import faulthandler
     faulthandler.disable()  # a crash is reported once, by the parent, as a RecordingError
     try:
         result = ("ok", func(*args))
@@ -52,7 +52,7 @@ def _context():
     """A fresh single-threaded process for each read: a child of the fork server (Linux),
     else a spawned interpreter.  Never a plain fork of this process: other threads of it
     (Dask, tqdm, a notebook) may hold locks, which the copy would inherit held."""
-    import multiprocessing
+    import multiprocessing  # 8 ms that a read without a child process does not pay
     if "forkserver" in multiprocessing.get_all_start_methods():
         ctx = multiprocessing.get_context("forkserver")
         ctx.set_forkserver_preload(_PRELOAD)  # once the server runs, children start in ms
@@ -74,7 +74,7 @@ def _without_main():
     open its file again, and make the read look like a crash of the C library.  The
     preparation data therefore leave the main module out (for this start only, under a lock).
     """
-    from multiprocessing import spawn
+    from multiprocessing import spawn  # 8 ms that a read without a child process does not pay
     with _START_LOCK:
         original = spawn.get_preparation_data
 

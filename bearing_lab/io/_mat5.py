@@ -34,6 +34,7 @@ Reference: The MathWorks, *MAT-File Format*, version 7 (2019), chapter 1.
 """
 from __future__ import annotations
 
+import os
 import struct
 import zlib
 
@@ -300,7 +301,6 @@ def _element(r: _Reader, pos, end, where, depth):
 def max_inflate_ratio() -> float:
     """The largest inflate ratio accepted for a variable above :data:`INFLATE_FREE_BYTES`
     (``BEARING_LAB_MAX_INFLATE_RATIO`` overrides :data:`MAX_INFLATE_RATIO`)."""
-    import os
     text = os.environ.get("BEARING_LAB_MAX_INFLATE_RATIO", "")
     try:
         value = float(text) if text else MAX_INFLATE_RATIO

@@ -33,7 +33,7 @@ def mat_version(head: bytes) -> str | None:
 
 def _h5_names(path: str) -> tuple[str, ...]:
     """Variable names of a v7.3 file (runs in the guarded child)."""
-    import h5py
+    import h5py  # loads when it reads (every reader is imported to sniff)
     try:
         with h5py.File(path, "r") as f:
             return tuple(k for k in f.keys() if not k.startswith("#"))
@@ -43,7 +43,7 @@ def _h5_names(path: str) -> tuple[str, ...]:
 
 def _h5_load(path: str, variable_names) -> dict:
     """Variables of a v7.3 file as plain Python (runs in the guarded child)."""
-    import h5py
+    import h5py  # loads when it reads (every reader is imported to sniff)
     out = {}
     try:
         with h5py.File(path, "r") as f:
@@ -62,16 +62,16 @@ def _variables(path: str, mtime: int, size: int, inode: int) -> tuple[str, ...]:
         head = fh.read(1024)
     v = mat_version(head)
     if v == "7.3":  # libhdf5 reads the file in a child process: damage cannot crash us
-        from ._guard import guarded
+        from ._guard import guarded  # the child-process guard for a v7.3 file only: io imports this module
         return guarded(path, "HDF5", _h5_names, path)
     if v == "5":
-        from . import _mat5
+        from . import _mat5  # _mat5 (6 ms) loads for a MATLAB file only: io imports this module
         return tuple(_mat5.variable_names(Path(path).read_bytes()))
     return ()
 
 
 def _corrupt(path, exc):
-    from ._mat5 import Mat5Error
+    from ._mat5 import Mat5Error  # _mat5 (6 ms) loads for a MATLAB file only: io imports this module
     why = str(exc) if isinstance(exc, Mat5Error) else f"{type(exc).__name__}: {exc}"
     return RecordingError(f"{path}: the MATLAB file is truncated or corrupt ({why}); export or "
                           "download it again")
@@ -100,7 +100,7 @@ def mat_variables(path) -> tuple[str, ...]:
 
 
 def _h5_plain(f, obj):
-    import h5py
+    import h5py  # loads when it reads (every reader is imported to sniff)
     if isinstance(obj, h5py.Group):
         return {k: _h5_plain(f, obj[k]) for k in obj.keys() if not k.startswith("#")}
     cls = obj.attrs.get("MATLAB_class", b"")
@@ -151,10 +151,10 @@ def _load_mat(path, variable_names):
         head = fh.read(1024)
     v = mat_version(head)
     if v == "7.3":
-        from ._guard import guarded
+        from ._guard import guarded  # the child-process guard for a v7.3 file only: io imports this module
         names = tuple(variable_names) if variable_names else None
         return guarded(path, "HDF5", _h5_load, str(path), names)
-    from . import _mat5
+    from . import _mat5  # _mat5 (6 ms) loads for a MATLAB file only: io imports this module
     return _mat5.load(Path(path).read_bytes(), variable_names=variable_names)
 
 

@@ -6,9 +6,15 @@ from any test directory without path tricks.
 """
 from __future__ import annotations
 
+import lazy_loader as lazy
 import numpy as np
 
 from .. import schema
+from . import get_warnings, guess_format, open_recording, to_netcdf
+
+# loaded when a check runs (the fuzz workers import this module for its UFF writer)
+netCDF4 = lazy.load("netCDF4")
+xr = lazy.load("xarray")
 
 
 def check_reader(path, *, format=None, tmp_path=None, **options):
@@ -20,8 +26,6 @@ def check_reader(path, *, format=None, tmp_path=None, **options):
     identical data (no state kept between calls), and, with ``tmp_path``, the
     netCDF4 round trip is bit-for-bit and the file is compressed.
     """
-    import xarray as xr
-    from . import guess_format, open_recording, to_netcdf, get_warnings
 
     ds = open_recording(path, format=format, **options)
     schema.check_dataset(ds, kind="recording")
@@ -49,7 +53,6 @@ def check_reader(path, *, format=None, tmp_path=None, **options):
         out = to_netcdf(ds, tmp_path / "roundtrip.nc")
         back = xr.load_dataset(out)
         assert back.identical(ds), "netCDF round trip is not bit-for-bit"
-        import netCDF4
         with netCDF4.Dataset(out) as nc:
             for name in ds.data_vars:
                 assert nc[name].filters()["zlib"], f"{name} not compressed"

@@ -20,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..utils._files import sha256_file
 from ._base import ENGINES, RecordingBuilder, RecordingReader
 from ._matlab import load_mat, mat_variables, mat_version, signal_vector
 
@@ -82,7 +83,6 @@ class CwruReader(RecordingReader):
         -------
         xarray.Dataset
         """
-        from .. import datasets
 
         path = Path(path)
         b = RecordingBuilder(path, self, units=units, checksum=checksum)
@@ -125,6 +125,7 @@ class CwruReader(RecordingReader):
         # then the variables' record
         cands = [n for n in dict.fromkeys([file_no, rec]) if n is not None]
         by_sha = _registered_by_content(path)
+        from .. import datasets  # the registry (csv, importlib.resources) for a CWRU file only
         regs = {n: datasets.cwru_record(n) for n in cands}
         rates = {r.fs_hz for r in regs.values() if r is not None and r.fs_hz}
         reg = regs.get(file_no) or regs.get(rec)
@@ -173,10 +174,9 @@ class CwruReader(RecordingReader):
 
 def _registered_by_content(path):
     """The registry entry whose sha256 is this file's (None if none, or the file is large)."""
-    from .. import datasets
-    from ..utils._files import sha256_file
     if path.stat().st_size > 256 * 2 ** 20:
         return None
+    from .. import datasets  # the registry (csv, importlib.resources) for a CWRU file only
     known = [r for r in datasets.load_registry().values() if r.sha256 and r.dataset.startswith("cwru")]
     if not known:
         return None

@@ -16,15 +16,17 @@ a dataset 164 that declares SI units.
 """
 from __future__ import annotations
 
+import errno
 import os
 from datetime import datetime
 from pathlib import Path
+import shutil
 
 import numpy as np
 
 from .. import units as _units
 from ..errors import RecordingError, check_choice
-from ..utils._files import atomic_path
+from ..utils._files import atomic_open, atomic_path, sha256_file
 
 # quantity -> (UFF specific data type, length exponent, force exponent)
 _SPEC = {"acceleration": (12, 1, 0), "velocity": (11, 1, 0), "displacement": (8, 1, 0),
@@ -91,8 +93,7 @@ def to_netcdf(ds, path, *, complevel: int = 4, checksum_file: bool = False, erro
     >>> xr.load_dataset("out.nc").identical(ds)   # doctest: +SKIP
     True
     """
-    from .. import _xarray  # noqa: F401  (xarray writes without importing dask)
-    from ..utils._files import atomic_open, sha256_file
+    from .. import _xarray  # noqa: F401  (xarray writes without dask; `info` imports this module)
     path = Path(path)
     enc = {}
     for name, var in ds.variables.items():
@@ -130,8 +131,6 @@ def checksum_path(path) -> Path:
 def _write_failure(path: Path, exc, ds) -> str:
     """The true cause of a failed write.  netCDF-C/HDF5 report a full disk as "HDF error" or
     as "Permission denied"; the free space and the directory's permissions tell them apart."""
-    import errno
-    import shutil
     directory = path.parent if str(path.parent) else Path(".")
     needed = sum(int(v.nbytes) for v in ds.variables.values())
     try:
@@ -265,7 +264,6 @@ def to_uff58b(ds, path, *, channels=None, units: str = "si", id1=None, id2=None,
         out.append("".join(text).encode("utf-8"))
         out.append(y.astype(bo_char + "f8").tobytes())
         out.append(b"%6i\n" % -1)
-    from ..utils._files import atomic_open
     try:
         with atomic_open(path, "wb") as fh:  # an existing file survives any failure
             for chunk in out:

@@ -40,7 +40,7 @@ class MdfReader(RecordingReader):
         -------
         xarray.Dataset
         """
-        from asammdf import MDF
+        from asammdf import MDF  # loads when it reads (every reader is imported to sniff)
 
         path = Path(path)
         b = RecordingBuilder(path, self, units=units, sensitivity=sensitivity, checksum=checksum)

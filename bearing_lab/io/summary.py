@@ -13,6 +13,10 @@ QUANTITY_OF_UNITS        -- the quantity a channel's SI unit implies, where it s
 """
 from __future__ import annotations
 
+import numpy as np
+
+from ._base import get_warnings
+
 __all__ = ["describe", "dataset_kind", "channel_rms", "QUANTITY_OF_UNITS"]
 
 #: the quantity a channel's unit implies, for a Dataset whose variables do not say
@@ -35,7 +39,6 @@ def channel_rms(values) -> float | None:
     Scaled by the largest magnitude before squaring, so values near the float limit do not
     overflow.  None for an empty array or one holding NaN or inf; 0 for zeros.
     """
-    import numpy as np
     x = np.asarray(values, dtype=float).ravel()
     if not x.size:
         return None
@@ -52,7 +55,6 @@ def describe(ds, path=None) -> dict:
     does not have are None.  ``path`` names the file where the Dataset does not
     (``source_file``).
     """
-    from ._base import get_warnings
     n = ds.sizes.get("time", 0)
     fs = float(ds.attrs.get("sampling_rate_hz", 0.0) or 0.0)
     kind = dataset_kind(ds)

@@ -93,7 +93,7 @@ class TdmsReader(RecordingReader):
         -------
         xarray.Dataset
         """
-        from nptdms import TdmsFile
+        from nptdms import TdmsFile  # loads when it reads (every reader is imported to sniff)
 
         path = Path(path)
         b = RecordingBuilder(path, self, units=units, sensitivity=sensitivity, checksum=checksum)

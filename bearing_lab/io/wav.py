@@ -139,7 +139,7 @@ class WavReader(RecordingReader):
         -------
         xarray.Dataset
         """
-        import scipy.io.wavfile as wavfile
+        import scipy.io.wavfile as wavfile  # loads when it reads (every reader is imported to sniff)
 
         path = Path(path)
         b = RecordingBuilder(path, self, sensitivity=sensitivity, checksum=checksum)

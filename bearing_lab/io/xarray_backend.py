@@ -22,6 +22,9 @@ from pathlib import Path
 
 from xarray.backends import BackendEntrypoint
 
+from ..errors import RecordingError
+from . import open_recording
+
 #: every keyword a reader takes (the union of the readers' option_names(); a test keeps it so)
 READER_OPTIONS = ("channels", "fs", "sensitivity", "units", "allow_truncated", "full_scale", "record",
                   "time_column", "allow_uneven", "byte_order", "snap_rate", "checksum")
@@ -37,15 +40,12 @@ class BearingLabBackendEntrypoint(BackendEntrypoint):
     open_dataset_parameters = ("filename_or_obj", "drop_variables", "format", *READER_OPTIONS)
 
     def open_dataset(self, filename_or_obj, *, drop_variables=None, format=None, **options):
-        from . import open_recording
         if not isinstance(filename_or_obj, (str, os.PathLike)):
-            from ..errors import RecordingError
             msg = (f"engine='bearing_lab' reads files by path; got a {type(filename_or_obj).__name__} "
                    "(save it to a file first)")
             raise RecordingError(msg)
         unknown = sorted(set(options) - set(READER_OPTIONS))
         if unknown:
-            from ..errors import RecordingError
             raise RecordingError(f"{filename_or_obj}: engine='bearing_lab' takes no keyword {unknown[0]!r}; the "
                                  f"reader keywords are {', '.join(READER_OPTIONS)}")
         ds = open_recording(filename_or_obj, format=format, **{k: v for k, v in options.items() if v is not None})

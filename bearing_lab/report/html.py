@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import html
 import itertools
+import json
 import math
 import re
 from pathlib import Path
@@ -251,7 +252,6 @@ def index_rows(entries: list) -> str:
 
 
 def kv_html(info: dict) -> str:
-    import json
     items = []
     for k, v in info.items():
         if isinstance(v, str) and ("\n" in v or len(v) > 160):

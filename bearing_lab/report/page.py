@@ -8,8 +8,11 @@ from pathlib import Path
 
 from .._version import __version__
 from ..errors import check_choice
+from ..utils._files import atomic_open
+from ..utils.figures import new_figure
 from .html import (css, esc, figure_html, kv_html, notice_html, rows_table, table_html, template,
                    index_rows)
+from .provenance import citation, environment
 
 __all__ = ["Report", "write_index"]
 
@@ -99,7 +102,6 @@ class Report:
         """A :class:`~bearing_lab.compare.ComparisonResult`: its table, and its figures."""
         self.add_rows(result.rows, title, intro=intro)
         if figures:
-            from ..utils.figures import new_figure
             fig = new_figure(figsize=(10, 9), layout="constrained")
             axes = fig.subplots(3, 1)
             result.plot_waveforms(ax=axes[0], window_s=(0, 0.1))
@@ -120,7 +122,6 @@ class Report:
     def add_provenance(self, info: dict | None = None, title="Provenance", *, software=True):
         """Where the results came from: ``info`` (inputs, checksums) and, with ``software``, the
         package versions, source revision, host and date."""
-        from .provenance import environment
         merged = dict(info or {})
         if software:
             merged.update(environment())
@@ -128,7 +129,6 @@ class Report:
         return self.add_html(kv_html(merged), title)
 
     def add_citation(self, title="How to cite", *, note=""):
-        from .provenance import citation
         c = citation()
         body = template("cite.html").substitute(software=esc(c["software"]), paper=esc(c["paper"]), note=esc(note))
         return self.add_html(body, title)
@@ -171,7 +171,6 @@ class Report:
 
     def save(self, path, *, overwrite=True):
         """Write ``.html`` (self-contained page) or ``.json`` (sections, rows, info: reloadable), atomically."""
-        from ..utils._files import atomic_open
         path = Path(path)
         if path.exists() and not overwrite:
             raise FileExistsError(f"{path} exists (pass overwrite=True)")
@@ -227,7 +226,6 @@ def write_index(path, entries: list, *, title="bearing_lab validation", notes=()
     >>> 'href="rig3/index.html"' in p.read_text(encoding="utf-8")
     True
     """
-    from ..utils._files import atomic_open
     notes_html = "".join(f'<p class="note">{esc(n)}</p>' for n in notes)
     page = template("index.html").substitute(title=esc(title), css=css(), date=_now(), version=__version__,
                                               rows=index_rows(entries), notes=notes_html,

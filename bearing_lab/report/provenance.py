@@ -10,6 +10,7 @@ citation()            -- {"software": str, "paper": str}: the "how to cite" bloc
 from __future__ import annotations
 
 import datetime as _dt
+import importlib.metadata as md
 import os
 import platform
 import subprocess
@@ -25,7 +26,6 @@ PAPER_CITATION = ("Liu, Xu, Wang, Xu, Tang: Influence of the local defect distri
 
 
 def software_versions() -> dict:
-    import importlib.metadata as md
     out = {"python": platform.python_version()}
     for pkg in ("bearing_lab", "numpy", "scipy", "numba", "xarray", "netCDF4", "matplotlib"):
         try:

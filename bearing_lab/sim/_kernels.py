@@ -87,10 +87,14 @@ TWO_PI = 2.0 * math.pi
 # have it, the kernels compile with reference counting: slower, same results.
 
 
+try:
+    from numba.core.cpu import CPUTargetOptions
+except ImportError:          # a numba without it: reference counting stays on
+    CPUTargetOptions = None
+
+
 def _no_refcount() -> dict:
-    try:
-        from numba.core.cpu import CPUTargetOptions
-    except ImportError:
+    if CPUTargetOptions is None:
         return {}
     return {"_nrt": False} if hasattr(CPUTargetOptions, "_nrt") else {}
 

@@ -21,7 +21,10 @@ the number of balls); a dynamic cage and ball defects take the loop over balls.
 """
 from __future__ import annotations
 
+import hashlib
+import inspect
 import math
+from pathlib import Path
 
 import numpy as np
 from numba import njit
@@ -401,9 +404,6 @@ def drop_stale_machine_code(fns, sources) -> None:
     """numba keys a cached function on its own source file only; ``fns`` also depend on the files
     ``sources`` (the right-hand side of ``_kernels.py`` is compiled into them): when one of those
     changes (a development install), drop the functions' cached machine code so it is compiled anew."""
-    import hashlib
-    import inspect
-    from pathlib import Path
     stamp = hashlib.sha256(b"".join(Path(f).read_bytes() for f in sources)).hexdigest()
     for fn in fns:
         cache = getattr(fn, "_cache", None)

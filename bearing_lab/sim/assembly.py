@@ -6,6 +6,7 @@ outside the time loop.
 """
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 import math
 import time
@@ -14,7 +15,13 @@ import numpy as np
 
 from ..errors import SceneError, check_choice
 from . import _kernels as K
+from . import scene as _sc
+from .auto import resolve
 from .bearing3d import axial_support, groove_offsets, needs_3d, static_equilibrium_3d
+# defects.contact_table and contact.CONTACT_MODELS are read at call time: a model registered or a
+# table builder replaced at run time counts
+from . import defects
+from .defects import contact
 from .hertz import race_contact, series_stiffness
 from .numerics import brentq
 from .scene import Scene
@@ -68,9 +75,8 @@ def choose_contact_model(defect, requested: str, bearing) -> str:
     cache.  They stay selectable with ``contact_model = "area"``, ``"drop"`` or
     ``"profile"``.
     """
-    from .defects.contact import CONTACT_MODELS
     if requested and requested != "auto":
-        return check_choice(requested, ("auto", *CONTACT_MODELS), "defect.contact_model", SceneError)
+        return check_choice(requested, ("auto", *contact.CONTACT_MODELS), "defect.contact_model", SceneError)
     return "halfspace"
 
 
@@ -82,7 +88,6 @@ def track_offset(defect, st, race, psi0, bearing):
     r_g) - alpha), and for an unskewed rectangle or ellipse its axial edges alike (its width then
     grows by about 1 / cos(alpha)); a skewed outline or a polygon only moves.  The along-track
     radius change ((1 - cos alpha) r_g / R, 0.2 % at 10 deg) is neglected."""
-    import dataclasses
     a_i, a_o = groove_offsets(bearing)
     if race == "outer":
         r_g = a_o + bearing.ball_diameter / 2
@@ -129,7 +134,6 @@ def static_3d(scene: Scene, fid: str) -> dict:
 def _table_entries(scene: Scene, lz: float):
     """(models, entries): each defect's contact model and its table entries (race code, defect used for
     the table, psi0, ball, model); a ball defect gets one entry per race it meets."""
-    import dataclasses
     d, b = scene.data, scene.bearing
     models = []
     entries = []  # (race code, defect used for the table, psi0, ball, model)
@@ -162,8 +166,6 @@ def _defect_tables(scene: Scene, lz: float, delta_max: float, material, delta_to
     """Each defect's contact table, packed for the kernels: a ball defect gets one table per
     race it meets.  Returns (models, tables, entries, dint, dflt, hbuf, gbuf, table_time_s)."""
     b = scene.bearing
-    from .defects import contact_table
-    from .defects.contact import CONTACT_MODELS
     models, entries = _table_entries(scene, lz)
     tables = []
     n_e = max(len(entries), 1)
@@ -175,10 +177,10 @@ def _defect_tables(scene: Scene, lz: float, delta_max: float, material, delta_to
     for kk, (code, dfc, psi0, ball, model) in enumerate(entries):
         top = None if delta_top is None else delta_top[kk]
         dfc, kw = _table_request(scene, entries[kk], delta_max, material, top, st3d)
-        tab = contact_table(dfc, b, **kw)
+        tab = defects.contact_table(dfc, b, **kw)
         tables.append(tab)
         psi = np.asarray(tab.psi, dtype=float)
-        kind = 1 if CONTACT_MODELS[model].tabulated else 0
+        kind = 1 if contact.CONTACT_MODELS[model].tabulated else 0
         h = np.ascontiguousarray(tab.drop, dtype=float)
         # the kernel interpolates G^(2/3) (see _kernels._interp_g)
         G = np.ascontiguousarray(np.maximum(tab.G, 0.0) ** (2.0 / 3.0), dtype=float)
@@ -315,7 +317,6 @@ def _parameters(scene: Scene, fid, st, hi, ho, k_eff, masses, loads, ftf, phi_c0
         p[K.P_KZO], p[K.P_CZO] = axial_support(d["mount"])
         p[K.P_ZIR], p[K.P_ZOR] = st["rest_zi"], st["rest_zo"]
         p[K.P_FIZ], p[K.P_FOZ] = st["f_inz"], st["f_outz"]
-        from . import scene as _sc
         p[K.P_ZSET] = _sc.SETTLE_AXIAL_RATE
         p[K.P_TZSET] = max(scene.settle - _sc.SETTLE_FREE_S, 0.0)
     return p, dyn
@@ -347,7 +348,6 @@ def scene_statics(scene: Scene, fidelity=None):
     d, b = scene.data, scene.bearing
     fid = fidelity or scene.fidelity
     if fid == "auto":
-        from .auto import resolve
         fid = resolve(scene)["fidelity"]
     hi, ho = race_contacts(scene)
     m_b = scene.masses()[2]

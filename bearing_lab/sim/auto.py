@@ -30,8 +30,14 @@ from functools import lru_cache
 import math
 from pathlib import Path
 import tomllib
+import warnings
 
 import numpy as np
+
+from ..errors import BearingLabError, SolverError
+from .bearing3d import groove_offsets, needs_3d
+from .defects.geometry import RaceGeometry
+from .scene import SceneWarning
 
 RULES_FILE = Path(__file__).with_name("auto_rules.toml")
 DEFAULT = {"fidelity": "multibody", "method": "dp54", "rtol": 1e-5, "max_step_s": 2.5e-5,
@@ -60,9 +66,7 @@ def _track_3d(scene, fid):
     """(each defect as the 3-D contact track meets it, what the track is): a race defect turned across
     the groove by the static contact angle at its position, as its contact table is built
     (:func:`.assembly.track_offset`); a ball defect as it is."""
-    from ..errors import BearingLabError, SolverError
-    from .assembly import track_offset, load_zone_angle, static_3d
-    from .bearing3d import groove_offsets
+    from .assembly import track_offset, load_zone_angle, static_3d  # circle: assembly imports auto
     try:
         with np.errstate(all="ignore"):
             st = static_3d(scene, fid)
@@ -98,7 +102,6 @@ def track_defects(scene, fid=None):
     --------
     scene_kind, resolve
     """
-    from .bearing3d import needs_3d
     if not scene.defects or not needs_3d(scene):
         return scene.defects, "planar contact track (groove bottom)"
     fid = fid or (scene.fidelity if scene.fidelity != "auto" else DEFAULT["fidelity"])
@@ -209,8 +212,6 @@ def resolve(scene) -> dict:
                           + ": the rule's accuracy is not measured for a grazed defect (one came out at 12 times the "
                           "converged peak); set solver.method = 'dp54' and solver.rtol = 1e-6")
         if scene.data["solver"]["method"] == "auto":
-            import warnings
-            from .scene import SceneWarning
             warnings.warn(f"scene {scene.name!r}: " + out["reason"].split("; ", 1)[1], SceneWarning, stacklevel=3)
     out["kind"] = kind
     out["track"] = track
@@ -219,7 +220,6 @@ def resolve(scene) -> dict:
 
 def _gap(scene, defect) -> float:
     """The approach (m) a ball on the track needs before it reaches the race defect's nearest point."""
-    from .defects.geometry import RaceGeometry
     return float(RaceGeometry.from_bearing(scene.bearing, defect.race, clearance=scene.clearance)
                  .approach(0.0, defect.min_abs_axial()))
 

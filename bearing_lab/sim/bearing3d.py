@@ -46,6 +46,8 @@ import lazy_loader as lazy
 import numpy as np
 
 from ..errors import SceneError, SolverError
+from ._equilibrium_kernel import balls_3d
+from .limits import MAX_SUPPORT_DEFLECTION
 from .numerics import brentq
 
 #: scipy.optimize (Powell's hybrid method, Levenberg-Marquardt) for the 3-D starts: imported the first
@@ -164,7 +166,6 @@ def _balls_multibody(u, z_i, fc, pd4, a_i, a_o, k_in, k_out, e):
     """(q, w, out) of every ball (:func:`._equilibrium_kernel.balls_3d`, compiled: a scipy root per
     ball cost 25-35 ms of every 3-D multibody start): Newton's method from the line through the
     curvature centres; a ball it leaves unbalanced is solved by :func:`_ball_multibody`."""
-    from ._equilibrium_kernel import balls_3d
     z = u.size
     co = np.stack([np.full(z, pd4 - a_o), np.zeros(z)])
     ci = np.stack([u - pd4 + a_i, np.full(z, float(z_i))])
@@ -291,7 +292,6 @@ def static_equilibrium_3d(scene, phi_c0, k_in, k_out, *, ball_mass=0.0, omega_ca
                           f"residual {r:.3g})" + (_preload_hint(b, pd, pre, k_eff, exponent) if pre else ""))
     fi, fo, q_in, q_out, al_i, al_o, q, w = forces(e)
     xi, xo, rest_i, rest_o = _ring_positions(path, on_outer, e, fi, fo, f_in, f_out, ks, km, bool(pre))
-    from .limits import MAX_SUPPORT_DEFLECTION
     for sec, x, k in (("shaft", xi[2], ks[2]), ("mount", xo[2], km[2])):
         if abs(x) > MAX_SUPPORT_DEFLECTION:
             raise SceneError(f"{sec}.stiffness_z_n_m={k:g} (unset: the Y stiffness): holding the bearing's axial "

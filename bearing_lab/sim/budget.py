@@ -28,6 +28,7 @@ from __future__ import annotations
 import math
 
 from ..errors import SceneError
+from .auto import resolve
 
 RK_STABILITY = 2.8       # |h·ω| limit of explicit RK4 / DP5 / BS3 on an undamped oscillator
 CHUNK_S = 0.01           # simulated time per streamed chunk (integrate._run)
@@ -63,7 +64,6 @@ def work_estimate(scene, *, method: str | None = None, step=None, max_step=None)
     if method is None or method == "auto":
         method = d["solver"]["method"]
         if method == "auto":
-            from .auto import resolve
             choice = resolve(scene)
             method = choice["method"]
             max_step = max_step if max_step is not None else (d["solver"]["max_step_s"]

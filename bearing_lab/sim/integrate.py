@@ -34,7 +34,9 @@ from . import _kernels as K
 from . import _stepper as S
 from . import _variants as V
 from .assembly import assemble
-from .scene import load_scene
+from .auto import resolve
+from .budget import check_budget
+from .scene import load_scene, merge_overrides
 from ..schema import DEFAULT_CHANNEL, QUANTITY_OF_UNITS
 
 #: the integration methods (written out in _stepper): Dormand-Prince 5(4) and Bogacki-Shampine
@@ -182,7 +184,7 @@ def _run(asm, method, rtol, *, progress, t_end_override=None, step=None, max_ste
     try:
         while t < t_end:
             if bar is None and _time.perf_counter() >= bar_at:
-                from tqdm.auto import tqdm
+                from tqdm.auto import tqdm  # measured exception: only a run that shows its bar pays for tqdm
                 bar = tqdm(total=round(t_end, 6), initial=round(t, 6), unit="s sim", leave=False,
                            desc=f"simulate {scene.name}",
                            bar_format="{l_bar}{bar}| {n:.3f}/{total:.3f} s sim [{elapsed}<{remaining}]")
@@ -347,17 +349,14 @@ def simulate(scene, *, fidelity: str | None = None, duration: float | None = Non
     >>> bool(ds["ball_load_outer"].sum("ball").min() >= 150.0)
     True
     """
-    from .scene import merge_overrides
     ov = merge_overrides(overrides, **{"output.duration_s": duration, "output.sample_rate_hz": fs,
                                        "solver.rtol": rtol, "solver.method": method,
                                        "solver.step_s": step, "fidelity": fidelity})
     sc = load_scene(scene, **ov)
-    from .budget import check_budget
     check_budget(sc)  # before any work: a scene that would run for days is refused here
     t_start = _time.perf_counter()
     asm = _assemble(sc)
     d = sc.data
-    from .auto import resolve
     choice = resolve(sc)
     method_name = d["solver"]["method"]
     max_step = d["solver"]["max_step_s"]

@@ -11,7 +11,8 @@ import warnings
 
 import numpy as np
 
-from ..errors import SceneError
+from ..errors import BearingLabError, SceneError
+from .scene import SceneWarning
 
 MAX_SPEED_FACTOR = 3e6
 """n·d_m (r/min × mm) above which no ball bearing runs: about 1e6 is the usual oil-lubricated
@@ -83,9 +84,7 @@ def warn_off_track(scene) -> None:
     """A defect the balls never touch makes a healthy bearing: say so (a 5 for a 0.5?).  Judged on
     the track the scene runs on (:func:`.auto.track_defects`: under an axial load, the 3-D track at
     the static contact angle; a 3-D start that is not found is reported by the run, not here)."""
-    from ..errors import BearingLabError
-    from .auto import MISS_DELTA, track_defects
-    from .scene import SceneWarning
+    from .auto import MISS_DELTA, track_defects  # circle: bearing3d -> limits -> auto -> bearing3d
     try:
         defects, track = track_defects(scene)
     except BearingLabError:

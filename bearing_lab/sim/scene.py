@@ -43,6 +43,8 @@ from .._docdict import fill_doc
 from ..bearings import BearingGeometry, CATALOG, get_bearing
 from ..errors import SceneError, check_choice
 from ..units import G
+from .defects import Defect  # the 2-D defect description
+from .defects import contact  # its registry CONTACT_MODELS, read at call time (models register at run time)
 from .scene_keys import _NUM, DEFECT_KEYS, SCHEMA, STEEL_DENSITY  # noqa: F401  (the table of scene keys)
 
 
@@ -221,20 +223,18 @@ class Scene:
     def from_mapping(cls, raw: dict) -> "Scene":
         d = _validate_mapping(copy.deepcopy(raw))
         bearing = _bearing_from(d)
-        from .defects import Defect  # the 2-D defect description
         defects = []
         for i, m in enumerate(d["defect"]):
             where = "defect" if len(d["defect"]) == 1 else f"defect[{i}]"
             m = {k: convert_value(v, k, f"{where}.{k}") for k, v in m.items()}
-            from .defects.contact import CONTACT_MODELS  # the registry names the allowed models
-            check_choice(m.pop("contact_model", "auto"), ("auto", *CONTACT_MODELS),
+            check_choice(m.pop("contact_model", "auto"), ("auto", *contact.CONTACT_MODELS),
                          f"{where}.contact_model", SceneError)
             defect = Defect.from_mapping(m, where=where)
             defect.validate(bearing)
             defects.append(defect)
         scene = cls(d, bearing, tuple(defects))
         scene._check_physics()
-        from .limits import warn_off_track
+        from .limits import warn_off_track  # circle: scene -> limits -> scene (and bearing3d -> limits)
         warn_off_track(scene)
         return scene
 
@@ -269,13 +269,13 @@ class Scene:
         if pd > 0.02 * b.ball_diameter:
             raise SceneError(f"clearance.radial_um={pd*1e6:g} is larger than 2 % of the ball diameter: "
                              "not a bearing")
-        from .bearing3d import check_axial_keys
+        from .bearing3d import check_axial_keys  # circle: scene -> limits -> scene (and bearing3d -> limits)
         check_axial_keys(self)
         if self.fs_out < 1000:
             raise SceneError(f"output.sample_rate_hz={self.fs_out:g} is below 1 kHz: too coarse for bearing vibration")
         if d["output"]["duration_s"] > 600:
             raise SceneError(f"output.duration_s={d['output']['duration_s']:g} s exceeds 600 s; split the run")
-        from .limits import check_limits
+        from .limits import check_limits  # circle: scene -> limits -> scene (and bearing3d -> limits)
         check_limits(self)
 
     # ---- SI accessors
@@ -314,7 +314,7 @@ class Scene:
         paper-healthy under 300 N it removes an axial ringing that 0.5 s undamped still holds
         (axial RMS -96 %).  Massless balls (no axial ball states) settle within 0.03 s alike."""
         s = self.data["output"]["settle_s"]
-        from .bearing3d import needs_3d
+        from .bearing3d import needs_3d  # circle: scene -> limits -> scene (and bearing3d -> limits)
         if needs_3d(self):
             return max(s, SETTLE_3D_S)
         return s

@@ -17,6 +17,7 @@ import numpy as np
 
 from ..errors import SceneError, SolverError
 from .hertz import series_stiffness
+from ._equilibrium_kernel import split_contacts
 from .numerics import brentq
 from .scene import Scene
 
@@ -49,7 +50,6 @@ def ball_contact_loads(e, phis, k_in, k_out, pd, body_force, exponent=1.5):
     ``K_o d_o^n - K_i (T - d_o)^n = body_force`` (increasing in ``d_o``), by Newton's
     method kept inside a bracket.  A ball that cannot touch both races rests on one.
     """
-    from ._equilibrium_kernel import split_contacts
     u = np.stack([np.cos(phis), np.sin(phis)])
     T = np.ascontiguousarray(np.asarray(e, dtype=float) @ u - pd / 2, dtype=float)
     fb = np.ascontiguousarray(np.broadcast_to(np.asarray(body_force, dtype=float), T.shape))

@@ -22,6 +22,7 @@ tolerance per kind of scene, which ``fidelity = "auto"`` reads when it is copied
 """
 from __future__ import annotations
 
+import csv
 import math
 from pathlib import Path
 import time
@@ -30,9 +31,14 @@ import numpy as np
 import xarray as xr
 
 from .._version import __version__
+from ..errors import BearingLabError
+from ..io.export import to_netcdf
+from ..report import Report
+from ..report.html import esc, figure_html, table_html
 from ..sim.assembly import assemble
 from ..sim.integrate import METHODS, _run, _warm_up, anti_alias_taps
 from ..utils._files import savefig, write_text
+from ..utils.figures import new_figure
 from .bench_common import TOL_PEAK, TOL_PERIOD, bench_scene, measures, rel_err
 from .bench_speed import all_rows_table, equal_accuracy, tables
 
@@ -102,8 +108,7 @@ def run_rate_study(out_dir="reports/performance", *, duration=1.0, rates=RATES_H
     rate, against a converged reference at that rate (dp54 rtol 1e-9, 2 µs ceiling; checked by
     rtol 1e-10, 1 µs).  Writes ``auto_rate_study.csv`` (one row per scene, rate and setting) and
     returns the rows."""
-    import csv
-    from tqdm.auto import tqdm
+    from tqdm.auto import tqdm  # tqdm only when the bar is shown
     _warm_up()
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -137,7 +142,6 @@ def run_rate_study(out_dir="reports/performance", *, duration=1.0, rates=RATES_H
 
 def read_rate_study(path) -> list:
     """The rows of an ``auto_rate_study.csv`` (numbers as floats)."""
-    import csv
     with open(path, newline="") as fh:
         rows = list(csv.DictReader(fh))
     for r in rows:
@@ -213,7 +217,7 @@ def run_bench(out_dir="reports/performance", *, duration=0.3, scipy_duration=0.1
 
     With ``rates`` the rate study (:func:`run_rate_study`, ``rate_duration`` simulated seconds per
     run) also runs, and its per-rate rules join ``auto_rules.toml``."""
-    from tqdm.auto import tqdm
+    from tqdm.auto import tqdm  # tqdm only when the bar is shown
     _warm_up()
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -262,8 +266,6 @@ def run_bench(out_dir="reports/performance", *, duration=0.3, scipy_duration=0.1
                      "reference_self_check": repr(notes), "tolerance_peak": TOL_PEAK,
                      "tolerance_period": TOL_PERIOD, "sampling_rate_hz": 0.0,
                      "bearing_lab_version": __version__})
-    from ..errors import BearingLabError
-    from ..io.export import to_netcdf
     to_netcdf(ds, out / "performance.nc", error=BearingLabError)
     rules = _rules(rows)
     if rates:
@@ -333,7 +335,6 @@ def _rules(rows) -> str:
 
 def _work_precision_figure(sc, rs):
     """Log cost against log peak-acceleration error of one scene's rows."""
-    from ..utils.figures import new_figure
     fig = new_figure(figsize=(6.5, 4.2))
     ax = fig.subplots()
     groups = [(f"{fid} ({solver})", mk, col,
@@ -368,8 +369,6 @@ def _work_precision_figure(sc, rs):
 def _report(out, rows, notes, speed_md=""):
     """The benchmark's page through the report layer: per scene the reference's self-check, the
     fastest setting within tolerance, the work-precision figure and every row."""
-    from ..report import Report
-    from ..report.html import esc, figure_html, table_html
     rep = Report("Speed against error", verdict=False)
     rep.add_html(f"<p>{esc(__doc__.split('Outputs')[0])}</p>"
                  f"<p>Tolerance: {TOL_PEAK:.0%} in peak acceleration, {TOL_PERIOD:.1%} in excitation period. "

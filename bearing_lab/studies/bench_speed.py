@@ -24,10 +24,19 @@ from __future__ import annotations
 
 import json
 import math
+import subprocess
+import sys
 import time
 
 import numpy as np
 
+from .. import sim
+from ..errors import SolverError
+from ..sim import integrate as I
+from ..sim import load_scene
+from ..sim.assembly import assemble
+from ..sim.auto import resolve
+from ..sim.integrate import METHODS, _run, _warm_up
 from ..units import G
 from .bench_common import TOL_PEAK, TOL_PERIOD, bench_scene, measures, rel_err, scipy_acc
 
@@ -67,8 +76,6 @@ def _ok(row, ref_period):
 
 def equal_accuracy(label, base, ov, *, duration=0.1, scipy=True, repeats=2, progress=None):
     """Rows (one per setting) of ours and scipy's methods against one converged reference."""
-    from ..sim.assembly import assemble
-    from ..sim.integrate import METHODS, _run
     sc = bench_scene(base, ov, duration)
     asm = assemble(sc)
     fs = sc.fs_out
@@ -95,7 +102,6 @@ def equal_accuracy(label, base, ov, *, duration=0.1, scipy=True, repeats=2, prog
             progress(row)
         return row
 
-    from ..errors import SolverError
     for method, rtol, step in OURS:
         setting = f"h={step:g}" if step else f"rtol={rtol:g}"
         try:
@@ -125,15 +131,12 @@ QS_SETTINGS = [("bs32", 1e-3, 1e-4), ("bs32", 1e-4, 1e-4), ("dp54", 1e-4, 1e-4),
 def quasi_static(label, base, ov, *, duration=0.1, repeats=2):
     """Quasi-static rows: CPU s/s, and the error against the multibody reference (what a user
     gets: model plus numerical error) and against its own converged run (numerical error)."""
-    from ..sim.assembly import assemble
-    from ..sim.integrate import _run
     sc_mb = bench_scene(base, ov, duration)
     sc = bench_scene(base, ov, duration, "quasi-static")
     asm = assemble(sc)
     ref_mb = measures(_run(assemble(sc_mb), 0, 1e-9, progress=False, max_step=2e-6)["acc"][:, 1], sc.fs_out, sc_mb)
     ref_qs = measures(_run(asm, 0, 1e-9, progress=False, max_step=2e-6)["acc"][:, 1], sc.fs_out, sc)
     rows = []
-    from ..sim.integrate import METHODS
     for method, rtol, mx in QS_SETTINGS:
         res, cpu = _cpu(_run, asm, METHODS[method], rtol, progress=False, max_step=mx, repeats=repeats)
         m = measures(res["acc"][:, 1], sc.fs_out, sc)
@@ -170,8 +173,6 @@ def best_per_method(rows):
 
 def default_cost(label, base, ov, *, duration=1.0, repeats=3):
     """``simulate`` as users call it (auto), warm caches: CPU of the time loop and the whole call."""
-    from .. import sim
-    from ..sim import integrate as I
     loop_cpu = []
     orig = I._run
 
@@ -207,8 +208,6 @@ def default_costs_as_users_get_them(chosen, *, duration=1.0):
     """:func:`default_cost` of each scene in a new interpreter, which loads the kernels from
     numba's disk cache (warmed by this process) as a user's process does: code compiled in the
     measuring process can differ from what the cache hands out."""
-    import subprocess
-    import sys
     code = ("import json, sys; from bearing_lab.studies.bench_speed import default_cost; "
             "print(json.dumps([default_cost(l, b, o, duration=float(sys.argv[2])) "
             "for l, b, o in json.loads(sys.argv[1])]))")
@@ -221,9 +220,6 @@ def default_costs_as_users_get_them(chosen, *, duration=1.0):
 
 def default_accuracy(label, base, ov, *, duration=0.1):
     """The default's settings on the equal-accuracy record: its error against the reference."""
-    from ..sim.assembly import assemble
-    from ..sim.auto import resolve
-    from ..sim.integrate import METHODS, _run
     sc = bench_scene(base, ov, duration)
     ch = resolve(load_auto(base, ov, duration))
     ref = _run(assemble(sc), METHODS["dp54"], 1e-9, progress=False, max_step=2e-6)
@@ -237,7 +233,6 @@ def default_accuracy(label, base, ov, *, duration=0.1):
 
 
 def load_auto(base, ov, duration):
-    from ..sim import load_scene
     return load_scene(base, **ov, **{"output.duration_s": duration})
 
 
@@ -289,7 +284,6 @@ def all_rows_table(rows) -> str:
 def run_speed(scenes=None, *, duration=0.1, default_duration=1.0, scipy=True, progress=True, qs=True):
     """Both measurements (and the quasi-static fidelity) on the speed scenes; returns (markdown
     summary, rows, infos, defaults, quasi-static rows)."""
-    from ..sim.integrate import _warm_up
     _warm_up()
     chosen = [s for s in SPEED_SCENES if scenes is None or s[0] in scenes]
     rows, infos, defaults, accs, qrows = [], [], [], [], []

@@ -44,6 +44,13 @@ import time
 import numpy as np
 import xarray as xr
 
+from ..analysis import excitation_duration
+from ..errors import BearingLabError
+from ..io.export import to_netcdf
+from ..report import Report
+from ..report.html import esc, figure_html, table_html
+from ..sim import load_scene, simulate
+from ..sim.assembly import assemble
 from ..units import G
 from ..utils._files import savefig
 from ..utils.figures import new_figure
@@ -121,8 +128,6 @@ def _passage(ds, scene):
 
 
 def _one(scene_name, overrides):
-    from ..sim import load_scene, simulate
-    from ..analysis import excitation_duration
     sc = load_scene(scene_name, **overrides)
     ds = simulate(sc, duration=0.1, fs=STUDY_FS, progress=False, **{"output.oversample": 4})
     tc, half, ball, t_cross = _passage(ds, sc)
@@ -166,7 +171,6 @@ def _one(scene_name, overrides):
 def _contact_along(sc, t, rpm):
     """Carried share and intact fraction of the Hertz ellipse along the passage (times t
     from the centre crossing) at the static approach of the most loaded ball."""
-    from ..sim.assembly import assemble
     asm = assemble(sc)
     tab = asm.tables[0]
     q_static = float(np.max(asm.static["ball_loads"]))
@@ -197,7 +201,7 @@ def run_paper_studies(out_dir="reports/studies", *, progress=True, studies=None)
     minimum load, minimum carried share and intact fraction, the contact model and the
     compute time (SI units).
     """
-    from tqdm.auto import tqdm
+    from tqdm.auto import tqdm  # tqdm only when the bar is shown
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     names = list(studies or STUDIES)
@@ -214,8 +218,6 @@ def run_paper_studies(out_dir="reports/studies", *, progress=True, studies=None)
     for name, fig in figs.items():
         savefig(fig, out / f"{name}.png", dpi=110 if name != "mechanism" else 100)
     table = _table(rows, time.perf_counter() - t0)
-    from ..errors import BearingLabError
-    from ..io.export import to_netcdf
     to_netcdf(table, out / "studies.nc", error=BearingLabError)
     _write_html(out, names, rows, figs)
     return table
@@ -326,8 +328,6 @@ _PAGE_COLUMNS = (("peak displacement (µm)", "peak_disp_um", 4), ("peak accelera
 
 def _write_html(out, names, rows, figs):
     """The studies page through the report layer: per study its table, findings and pulse figure."""
-    from ..report import Report
-    from ..report.html import esc, figure_html, table_html
     rep = Report("The paper's section-5 studies on the 2-D defect model", verdict=False)
     rep.add_html(
         "<p>Peak displacement is the largest deviation of the outer-ring Y displacement from its "

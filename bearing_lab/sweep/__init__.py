@@ -56,16 +56,21 @@ from __future__ import annotations
 import hashlib
 import itertools
 import json
+import logging
 import math
 import os
 from pathlib import Path
 import time as _time
+import tomllib
 import uuid
 
 import numpy as np
 
 from .._version import __version__
 from ..errors import BearingLabError, SceneError
+from ..sim import load_scene, simulate
+from ..sim.budget import check_budget
+from ..sim.scene import SET_ALIASES as _ALIASES, convert_value as _convert, merge_overrides, parse_value as _parse_value
 from .store import (CacheWarning, checksum_path as _checksum_path,  # noqa: F401
                            from_cache as _from_cache, METRIC_SIGNAL as _METRIC_SIGNAL,
                            SWEEP_METRICS as _METRICS, Stack as _Stack, write_cache as _write_cache)
@@ -104,7 +109,6 @@ def key_units(key: str) -> str | None:
 
 
 def _canonical(key: str) -> str:
-    from ..sim.scene import SET_ALIASES as _ALIASES
     return _ALIASES.get(key, key)
 
 
@@ -149,7 +153,6 @@ def scene_hash(scene_toml: str, simulate_kwargs: dict | None = None) -> str:
 
 def _values(key, values) -> list:
     """The swept values of one key as a list (strings with units converted)."""
-    from ..sim.scene import convert_value as _convert, parse_value as _parse_value
     if isinstance(values, (str, bytes)) or not hasattr(values, "__iter__"):
         raise SceneError(f"sweep parameter {key!r}: give a list of values, got {values!r}")
     out = []
@@ -202,8 +205,6 @@ def _simulate_scene(scene_toml: str, digest: str, cache_path: str | None):
 
     The same function runs in-process (serial) and on Dask workers.
     """
-    import tomllib
-    from ..sim import load_scene, simulate
     scene = load_scene(tomllib.loads(scene_toml))
     ds = simulate(scene, progress=False)
     ds.attrs["sweep_scene_hash"] = digest
@@ -215,10 +216,8 @@ def _simulate_scene(scene_toml: str, digest: str, cache_path: str | None):
 # ---------------------------------------------------------------- the sweep
 def _resolve(scene, params: dict, simulate_kwargs: dict):
     """Validate the sweep; return (keys, value lists, base Scene, fixed overrides, scenes in C order)."""
-    from ..sim import load_scene
     if not isinstance(params, dict) or not params:
         raise SceneError("sweep: give the swept parameters as a dict {key: [values, ...]}")
-    from ..sim.scene import merge_overrides
     unknown_kw = {"progress"} & set(simulate_kwargs)
     if unknown_kw:
         raise BearingLabError("sweep: 'progress' is the sweep's own progress bar, not a simulate option")
@@ -257,7 +256,6 @@ def _resolve(scene, params: dict, simulate_kwargs: dict):
         except SceneError as exc:
             what = ", ".join(f"{k}={v!r}" for k, v in ov.items())
             raise SceneError(f"sweep scene {what}: {exc}") from None
-    from ..sim.budget import check_budget
     for combo, sc in zip(itertools.product(*values), scenes):
         try:
             check_budget(sc)  # every scene, before any runs
@@ -281,7 +279,7 @@ def _resolve(scene, params: dict, simulate_kwargs: dict):
 def _client_for(scheduler, n_workers):
     """(client, cluster-or-None, own_client, description)."""
     try:
-        from dask.distributed import Client, LocalCluster
+        from dask.distributed import Client, LocalCluster  # dask once a sweep uses it (_xarray reads sys.modules)
     except ImportError:  # pragma: no cover
         raise BearingLabError("sweep: Dask is not installed; `pip install bearing_lab[sweep]` "
                               "or use scheduler='serial'") from None
@@ -293,8 +291,7 @@ def _client_for(scheduler, n_workers):
         n = 2 if n_workers is None else int(n_workers)
         if n < 1:
             raise BearingLabError(f"sweep: n_workers={n_workers!r} must be at least 1")
-        import logging
-        import dask
+        import dask  # dask once a sweep uses it (_xarray reads sys.modules)
         # the workers' statistical profiler samples the running task every 10 ms: ~5 % of a scene
         try:
             with dask.config.set({"distributed.worker.profile.enabled": False}):
@@ -347,7 +344,7 @@ def _compute(todo, tomls, digests, cdir, acc, scheduler, n_workers, bar, failed)
     client, cluster, own, desc = _client_for(scheduler, n_workers)
     remote = cluster is None  # an existing cluster's workers may not share our disk
     try:
-        from dask.distributed import as_completed
+        from dask.distributed import as_completed  # dask once a sweep uses it (_xarray reads sys.modules)
         futures = {}
         for i in todo:
             # workers of a local cluster share our disk and write the cache themselves
@@ -389,7 +386,7 @@ def _assemble(acc, keys, values, shape, digests, metrics):
     out = acc.dataset(sdims, coords)
     if metrics:
         units = out[_METRIC_SIGNAL].attrs.get("units", "") if _METRIC_SIGNAL in out else ""
-        from ..analysis._metrics import METRICS, metric_units
+        from ..analysis._metrics import METRICS, metric_units  # read at call time (run-time metrics)
         for name in _METRICS:
             out[name] = (sdims, acc.metrics[name].reshape(shape),
                          {"units": metric_units(name, units),
@@ -469,7 +466,7 @@ def run_sweep(scene, params: dict, *, scheduler=None, n_workers: int | None = No
 
     bar = None
     if progress:
-        from tqdm.auto import tqdm
+        from tqdm.auto import tqdm  # tqdm only when the bar is shown
         bar = tqdm(total=n, initial=hits, unit="scene", desc=f"sweep {base.name}", leave=False)
 
     def label(i):

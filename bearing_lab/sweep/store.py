@@ -5,12 +5,15 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+import warnings
 
 import numpy as np
 
+from .._xarray import xr
 from ..errors import BearingLabError, SceneError
 from ..io.export import checksum_path, to_netcdf
 from ..schema import DEFAULT_CHANNEL
+from ..utils._files import sha256_file
 
 SWEEP_METRICS = ("rms", "peak", "crest_factor", "kurtosis")   # the analysis METRICS stored per scene
 METRIC_SIGNAL = DEFAULT_CHANNEL  # the simulator's accelerometer signal
@@ -58,8 +61,6 @@ def _read_cache(path: Path, digest: str, expect: dict):
     The file's bytes are checked against its checksum file before netCDF reads them
     (a damaged file never reaches the C library), then the content is validated.
     """
-    import xarray as xr
-    from ..utils._files import sha256_file
     if not path.is_file():
         return None, None
     sums = checksum_path(path)
@@ -108,7 +109,6 @@ def from_cache(cdir, scenes, digests, acc):
             acc.put(i, ds, cached=True)
             hits += 1
     if rejected:
-        import warnings
         warnings.warn(f"sweep: {len(rejected)} damaged cache entr{'y' if len(rejected) == 1 else 'ies'} "
                       f"in {cdir} computed again: {'; '.join(rejected)}", CacheWarning, stacklevel=3)
     return hits, todo, rejected
@@ -116,7 +116,7 @@ def from_cache(cdir, scenes, digests, acc):
 
 def _metrics(x: np.ndarray) -> dict:
     """The sweep's metrics (the analysis table's functions; NaN where undefined)."""
-    from ..analysis._metrics import METRICS
+    from ..analysis._metrics import METRICS  # read at call time (run-time metrics)
     out = {}
     for name in SWEEP_METRICS:
         try:
@@ -182,7 +182,6 @@ class Stack:
             self.on_put(i, ds, cached)
 
     def dataset(self, sdims, coords):
-        import xarray as xr
         t = self.template
         data_vars = {}
         for name, arr in self.arrays.items():

@@ -9,8 +9,7 @@ from __future__ import annotations
 
 import json
 import math
-
-import numpy as np
+import sys
 
 __all__ = ["clean", "dumps"]
 
@@ -21,14 +20,18 @@ def clean(v):
         return {str(k): clean(x) for k, x in v.items()}
     if isinstance(v, (list, tuple)):
         return [clean(x) for x in v]
-    if isinstance(v, (bool, np.bool_)):
-        return bool(v)
-    if isinstance(v, np.integer):
-        return int(v)
-    if isinstance(v, (float, np.floating)):
+    if isinstance(v, bool):
+        return v
+    np = sys.modules.get("numpy")  # a numpy value exists only once numpy is imported: the CLI's
+    if np is not None:             # parsers import this module without numpy
+        if isinstance(v, np.bool_):
+            return bool(v)
+        if isinstance(v, np.integer):
+            return int(v)
+        if isinstance(v, np.ndarray):
+            return clean(v.tolist())
+    if isinstance(v, float) or (np is not None and isinstance(v, np.floating)):
         return float(v) if math.isfinite(v) else None
-    if isinstance(v, np.ndarray):
-        return clean(v.tolist())
     return v
 
 
@@ -37,6 +40,7 @@ def dumps(obj, **kwargs) -> str:
 
     Examples
     --------
+    >>> import numpy as np
     >>> dumps({"a": float("nan"), "b": np.float64(2.5)})
     '{"a": null, "b": 2.5}'
     """

@@ -11,6 +11,9 @@
 """
 from __future__ import annotations
 
+import base64
+import io
+
 __all__ = ["new_figure", "figure_png"]
 
 
@@ -25,7 +28,7 @@ def new_figure(figsize=None, *, layout=None, **kwargs):
     >>> fig in map(plt.figure, plt.get_fignums())   # not tracked by pyplot
     False
     """
-    import matplotlib.pyplot as plt
+    import matplotlib.pyplot as plt  # lazy.load would import matplotlib itself (0.075 s) with this module
     fig = plt.figure(figsize=figsize, layout=layout, **kwargs)
     plt.close(fig)
     return fig
@@ -46,11 +49,9 @@ def figure_png(fig, dpi=80) -> str:
     >>> base64.b64decode(figure_png(fig, dpi=50))[1:4]      # the PNG signature
     b'PNG'
     """
-    import base64
-    import io
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=dpi)
     if getattr(fig.canvas, "manager", None) is not None:
-        import matplotlib.pyplot as plt
+        import matplotlib.pyplot as plt  # lazy.load would import matplotlib itself (0.075 s) with this module
         plt.close(fig)
     return base64.b64encode(buf.getvalue()).decode("ascii")

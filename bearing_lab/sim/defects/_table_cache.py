@@ -27,6 +27,11 @@ import numpy as np
 
 from bearing_lab.utils._files import atomic_path, cache_dir, sha256_bytes
 
+from . import contact  # a module (contact imports this one): its names are read at call time
+from .halfspace import (COARSE_STEP, DIRECT_UPDATE_CELLS, ENTER_SCALE, REFINE_TOL, REFRESH_EVERY, SOLVE_TOL,
+                        TABLE_CELLS)
+from .halfspace_skewed import INTACT_LATTICE
+
 FORMAT = 1
 _ARRAYS = ("psi", "delta", "G", "drop", "intact_fraction")
 _SOURCE: list = []
@@ -67,16 +72,12 @@ def table_key(defect, bearing, **args) -> str:
 
     ``defect`` must have angle 0: where the defect sits around the ring does not enter
     the table."""
-    from .contact import ABOVE_NODE_STEP, HALFSPACE_NODES
-    from .halfspace import (COARSE_STEP, DIRECT_UPDATE_CELLS, ENTER_SCALE, REFINE_TOL, REFRESH_EVERY,
-                            SOLVE_TOL, TABLE_CELLS)
-    from .halfspace_skewed import INTACT_LATTICE
     payload = {"format": FORMAT, "code": code_fingerprint(), "defect": _plain(defect),
                "bearing": {f: _plain(getattr(bearing, f)) for f in BEARING_FIELDS},
                "args": _plain(args),
-               "halfspace": _plain([HALFSPACE_NODES, ABOVE_NODE_STEP, TABLE_CELLS, SOLVE_TOL, REFINE_TOL,
-                                    COARSE_STEP, INTACT_LATTICE, DIRECT_UPDATE_CELLS, REFRESH_EVERY,
-                                    ENTER_SCALE])}
+               "halfspace": _plain([contact.HALFSPACE_NODES, contact.ABOVE_NODE_STEP, TABLE_CELLS, SOLVE_TOL,
+                                    REFINE_TOL, COARSE_STEP, INTACT_LATTICE, DIRECT_UPDATE_CELLS,
+                                    REFRESH_EVERY, ENTER_SCALE])}
     return hashlib.sha256(json.dumps(payload, sort_keys=True).encode()).hexdigest()
 
 
@@ -142,7 +143,6 @@ def _problem(meta: dict, arrays: dict, key: str) -> str | None:
 
 def load(key: str, model: str | None = None):
     """The cached table for ``key``, or None (missing, or damaged: then warned)."""
-    from .contact import ContactTable
     if model is None:
         candidates = sorted(cache_dir("tables").glob(f"*-{key[:40]}.npz"))
         if not candidates:
@@ -175,8 +175,8 @@ def load(key: str, model: str | None = None):
     for name, parts in tuples.items():
         info[name] = tuple(parts[i] for i in sorted(parts))
     info["source"] = "disk"
-    return ContactTable(psi=arrays["psi"], delta=arrays["delta"], G=arrays["G"], drop=arrays["drop"],
-                        intact_fraction=arrays["intact_fraction"], model=meta["model"],
-                        race=meta["race"], psi_min=float(meta["psi_min"]),
-                        psi_max=float(meta["psi_max"]), track_radius=float(meta["track_radius"]),
-                        info=info)
+    return contact.ContactTable(psi=arrays["psi"], delta=arrays["delta"], G=arrays["G"], drop=arrays["drop"],
+                                intact_fraction=arrays["intact_fraction"], model=meta["model"],
+                                race=meta["race"], psi_min=float(meta["psi_min"]),
+                                psi_max=float(meta["psi_max"]), track_radius=float(meta["track_radius"]),
+                                info=info)

@@ -77,12 +77,21 @@ from typing import Callable
 import math
 import time
 
+import lazy_loader as lazy
 import numpy as np
+import xarray as xr
 
 from bearing_lab.errors import SceneError, check_choice
 
+from ...utils.figures import new_figure
+from . import _table_cache
 from .geometry import RaceGeometry, drop_profile_1d, drop_profile_2d, hertz_semi_axes
+from .halfspace import TABLE_CELLS, ratio_curve
 from .model import Defect
+
+# the table's FFT products and the half-space curves' interpolation: loaded when a table is built
+sfft = lazy.load("scipy.fft", suppress_warning=True)
+_interpolate = lazy.load("scipy.interpolate", suppress_warning=True)
 
 # CONTACT_MODELS, the registry of models (one entry each), closes this module.
 #: approach nodes of the "halfspace" model, as fractions of delta_max (the loaded range)
@@ -169,7 +178,6 @@ class ContactTable:
 
     def to_dataset(self):
         """The table as an xarray Dataset (SI, ``units`` attributes), e.g. for netCDF."""
-        import xarray as xr
         coords = {"psi": ("psi", np.asarray(self.psi), {"units": "rad",
                   "long_name": "ball-centre angle minus defect-centre angle"}),
                   "delta": ("delta", np.asarray(self.delta), {"units": "m",
@@ -190,7 +198,6 @@ class ContactTable:
         """Plot G / delta^1.5 (carried share of the intact load) and the intact fraction of
         the Hertz ellipse against the ball's track position, at the approaches ``deltas``
         (m).  Returns the figure."""
-        from ...utils.figures import new_figure
         scale = {"mm": 1e3, "m": 1.0, "um": 1e6}[s_units]
         if ax is None:
             fig = new_figure(figsize=(6, 3.5))
@@ -257,7 +264,6 @@ def _correlate(f: np.ndarray, kern: np.ndarray, m: int, n_psi: int) -> np.ndarra
     FFT rather than a loop of small matrix products: the products would go to a
     multithreaded BLAS, which on a shared machine spends more time waiting than working.
     """
-    from scipy import fft as sfft
     n_glob = f.shape[0]
     cols = np.flatnonzero(f.any(axis=0))          # only the axial cells the outline covers
     n_fft = sfft.next_fast_len(n_glob, real=True)
@@ -281,7 +287,6 @@ def _correlate(f: np.ndarray, kern: np.ndarray, m: int, n_psi: int) -> np.ndarra
 def _arguments_and_key(defect, bearing, *, model, clearance=0.0, delta_max, n_psi=None, n_delta=41, against=None,
                        material=None, above_drop=None, delta_top=None):
     """The table's normalised arguments and its cache key, as :func:`contact_table` forms them."""
-    from . import _table_cache
     material = DEFAULT_MATERIAL if material is None else (float(material[0]), float(material[1]))
     args = dict(model=model, clearance=float(clearance), delta_max=float(delta_max), n_psi=n_psi,
                 n_delta=int(n_delta), against=against, material=material)
@@ -295,7 +300,6 @@ def _arguments_and_key(defect, bearing, *, model, clearance=0.0, delta_max, n_ps
 def table_is_cached(defect: Defect, bearing, **kw) -> bool:
     """Whether :func:`contact_table` with these arguments would read its table back (from memory or the
     disk cache) instead of building it."""
-    from . import _table_cache
     _, key = _arguments_and_key(defect, bearing, **kw)
     return key in _MEMORY or _table_cache.entry_path(key, kw["model"]).is_file()
 
@@ -347,7 +351,6 @@ def contact_table(defect: Defect, bearing, *, model: str, clearance: float = 0.0
     -------
     ContactTable
     """
-    from . import _table_cache
     args, key = _arguments_and_key(defect, bearing, model=model, clearance=clearance, delta_max=delta_max,
                                    n_psi=n_psi, n_delta=n_delta, against=against, material=material,
                                    above_drop=above_drop, delta_top=delta_top)
@@ -518,7 +521,6 @@ def _halfspace_G(defect, geom, s_tab, delta, drop, *, e_star, misses, settings=N
     ``settings`` (for convergence studies) overrides ``nodes`` (fractions of delta_max),
     ``cells``, ``richardson`` and the keywords of :func:`.halfspace.ratio_curve`
     (``tol``, ``refine_tol``, ``coarse_step``)."""
-    from .halfspace import TABLE_CELLS, ratio_curve
     settings = dict(settings or {})
     n_psi, n_delta = s_tab.size, delta.size
     loaded = settings.pop("loaded_range", delta[-1])
@@ -554,7 +556,6 @@ def _halfspace_G(defect, geom, s_tab, delta, drop, *, e_star, misses, settings=N
     # G^(2/3) between the nodes by a monotone cubic (Fritsch-Carlson, scipy's PCHIP)
     # through (0, 0) and (drop, 0): exact for delta^1.5 scaling and for a rigid drop, and
     # the share curves' bends between nodes cost a quarter of what straight lines did
-    from scipy.interpolate import PchipInterpolator
     g23 = (r ** (2 / 3)) * nodes_d[None, :]
     xd = np.concatenate([[0.0], nodes_d])
     # rows the ball's rigid drop does not touch share one set of nodes: one interpolant
@@ -562,7 +563,7 @@ def _halfspace_G(defect, geom, s_tab, delta, drop, *, e_star, misses, settings=N
     G = np.empty((n_psi, n_delta))
     if np.any(plain):
         yd = np.column_stack([np.zeros(int(plain.sum())), g23[plain]])
-        G[plain] = np.maximum(PchipInterpolator(xd, yd, axis=1)(delta), 0.0) ** 1.5
+        G[plain] = np.maximum(_interpolate.PchipInterpolator(xd, yd, axis=1)(delta), 0.0) ** 1.5
     for j in np.flatnonzero(~plain):
         if drop[j] >= delta[-1]:
             G[j] = 0.0
@@ -570,7 +571,7 @@ def _halfspace_G(defect, geom, s_tab, delta, drop, *, e_star, misses, settings=N
         keep = xd > drop[j]
         xj = np.concatenate([[0.0, drop[j]], xd[keep]])
         yj = np.concatenate([[0.0, 0.0], g23[j, keep[1:]]])
-        G[j] = (np.maximum(PchipInterpolator(xj, yj)(delta), 0.0) ** 1.5 if xj.size >= 3
+        G[j] = (np.maximum(_interpolate.PchipInterpolator(xj, yj)(delta), 0.0) ** 1.5 if xj.size >= 3
                 else np.interp(delta, xj, yj) ** 1.5)
     far = np.all(r == 1.0, axis=1)
     G[far] = delta[None, :] ** 1.5

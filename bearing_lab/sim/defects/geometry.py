@@ -52,11 +52,16 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 import math
 
+import lazy_loader as lazy
 import numpy as np
 
 from bearing_lab.errors import SceneError, check_choice
 
 from .model import Defect
+
+# only the exact Hertz semi-axes need them (sim/numerics.py serves the simulator's own)
+_optimize = lazy.load("scipy.optimize", suppress_warning=True)
+_special = lazy.load("scipy.special", suppress_warning=True)
 
 
 @dataclass(frozen=True)
@@ -177,17 +182,15 @@ def hertz_semi_axes(geom: RaceGeometry, delta) -> tuple[np.ndarray, np.ndarray]:
     ``b = a sqrt(1 - e^2)`` (Johnson, Contact Mechanics, eqs 3.58-3.60; K, E complete
     elliptic integrals of modulus e).  6308 outer race at 4.382 µm (300 N): 0.90 x 0.16 mm.
     """
-    from scipy.optimize import brentq
-    from scipy.special import ellipe, ellipk
     A, B = 0.5 / geom.ry, 0.5 / geom.rx
     if B <= A:
         raise ValueError("the along-track curvature must exceed the across-track one")
 
     def f(m):       # m = e^2
-        K, E = ellipk(m), ellipe(m)
+        K, E = _special.ellipk(m), _special.ellipe(m)
         return (E / (1 - m) - K) / (K - E) - B / A
-    m = brentq(f, 1e-12, 1 - 1e-15, xtol=1e-16, rtol=1e-14, maxiter=500)
-    K, E = ellipk(m), ellipe(m)
+    m = _optimize.brentq(f, 1e-12, 1 - 1e-15, xtol=1e-16, rtol=1e-14, maxiter=500)
+    K, E = _special.ellipk(m), _special.ellipe(m)
     delta = np.asarray(delta, dtype=float)
     a = np.sqrt(np.maximum(delta, 0.0) * (K - E) / (A * m * K))
     return a, a * math.sqrt(1 - m)

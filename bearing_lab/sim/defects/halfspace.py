@@ -56,11 +56,16 @@ from __future__ import annotations
 from dataclasses import dataclass
 import math
 
+import lazy_loader as lazy
 import numpy as np
-from scipy import fft as sfft
 
-from .geometry import RaceGeometry
+from ...bearings import get_bearing
+from . import contact
+from .geometry import RaceGeometry, hertz_semi_axes
 from .model import Defect
+
+# the FFT of the influence coefficients: loaded when a half-space is first solved
+sfft = lazy.load("scipy.fft", suppress_warning=True)
 
 #: cells (across, along the track) over the interpenetration region at each approach
 TABLE_CELLS = (32, 24)
@@ -231,7 +236,7 @@ class HalfSpace:
 
     def _iterate(self, h, approach, tol, maxiter, p0, precondition):
         """:meth:`solve_batch` on this grid's every cell."""
-        from ._halfspace_kernels import cg_direction, cg_step, update_displacement
+        from ._halfspace_kernels import cg_direction, cg_step, update_displacement  # kernels (7 ms) at the first solve
         stencil = self.stencil if precondition else PLAIN
         allowed = h < approach
         if p0 is None:
@@ -376,7 +381,6 @@ def hertz_start(hs: HalfSpace, geom: RaceGeometry, gap: np.ndarray, Z: np.ndarra
     """A start for the intact solve: Hertz's ellipsoidal pressure on the cells (semi-axes of
     :func:`.geometry.hertz_semi_axes`), scaled to the gap in the least-squares sense.  It
     saves about a third of the iterations from a uniform start (33 -> 22 at tol 1e-6)."""
-    from .geometry import hertz_semi_axes
     a, b = hertz_semi_axes(geom, delta)
     q = np.sqrt(np.maximum(1.0 - (Z / a) ** 2 - (S / b) ** 2, 0.0))
     u = hs.displacement(q[None])[0]
@@ -426,7 +430,7 @@ def ratio_curve(defect: Defect, geom: RaceGeometry, delta: float, *, cells=TABLE
     meet the outline), and info (intact force N, semi-axes m, cells, solves, iterations).
     """
     if defect.shape == "rectangle" and aligned_sides(defect) is None:
-        from .halfspace_skewed import ratio_curve_skewed
+        from .halfspace_skewed import ratio_curve_skewed  # circle: halfspace_skewed imports halfspace
         return ratio_curve_skewed(defect, geom, delta, cells=cells, e_star=e_star, tol=tol,
                                   refine_tol=refine_tol, coarse_step=coarse_step)
     base = intact_contact(geom, delta, cells=cells, e_star=e_star, tol=min(tol, 1e-6),
@@ -575,14 +579,12 @@ def compare_local_law(bearing=None, *, load: float = 300.0, k_hertz: float = 3.2
     semi-axes, and for each ball position ``s`` (m from the defect centre) the share of the
     intact force still carried: fine half-space solve, local-law table, half-space table.
     """
-    from bearing_lab.bearings import get_bearing
-    from .contact import contact_table
     bearing = get_bearing("6308") if bearing is None else bearing
     geom = RaceGeometry.from_bearing(bearing, "outer")
     d = Defect(length=1e-3, width=1e-3, depth=0.5e-3)
     delta = (load / k_hertz) ** (2 / 3)
     intact = race_contact(geom, None, delta, dx=dx, dy=dy)
-    tables = {m: contact_table(d, bearing, model=m, delta_max=2 * delta, n_delta=81)
+    tables = {m: contact.contact_table(d, bearing, model=m, delta_max=2 * delta, n_delta=81)
               for m in ("area", "halfspace")}
     out = {"approach": delta, "intact_force": intact["force"], "a": intact["a"], "b": intact["b"],
            "iterations": intact["iterations"], "positions": []}

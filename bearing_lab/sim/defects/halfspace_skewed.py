@@ -35,6 +35,8 @@ import math
 import numpy as np
 
 from .geometry import RaceGeometry
+from .halfspace import (TABLE_CELLS, HalfSpace, _curve, _refine, _symmetry, contact_grid, e_star_of,
+                        hertz_start, pressure_semi_axes)
 from .model import Defect
 
 #: odd sizes of the lattice of the ball's sub-cell offsets on which the intact force is solved:
@@ -109,7 +111,7 @@ def _track_coords(skew: float, g: SkewedGrid, fu: float, fv: float):
 def _gap(geom: RaceGeometry, S, Z, depth=0.0):
     """The intact (or, ``depth`` into the ring, the floor's) gap (m) at track positions S, Z
     relative to the ball; 1.0 where the ball cannot reach (compiled ``geom.approach``)."""
-    from ._halfspace_kernels import torus_gap
+    from ._halfspace_kernels import torus_gap  # kernels (7 ms) at the first solve
     S, Z = np.broadcast_arrays(np.asarray(S, dtype=float), np.asarray(Z, dtype=float))
     out = np.empty(S.shape)
     torus_gap(np.ascontiguousarray(S).ravel(), np.ascontiguousarray(Z).ravel(), float(depth),
@@ -190,7 +192,6 @@ class IntactForce:
 def _intact_diagnostics(defect: Defect, g: SkewedGrid, p: np.ndarray):
     """Intact force (N) and semi-axes (a across, b along the track; m, from the pressure's
     moments) of the intact pressure ``p`` on the window of the ball at the defect centre."""
-    from .halfspace import pressure_semi_axes
     fu, fv = _anchor(defect, g, 0.0)[2:]
     S, Z = _track_coords(defect.skew, g, fu, fv)
     c, sn = math.cos(defect.skew), math.sin(defect.skew)
@@ -204,8 +205,6 @@ def ratio_curve_skewed(defect: Defect, geom: RaceGeometry, delta: float, *, cell
     """:func:`.halfspace.ratio_curve` for a rectangle inclined to the track: the same
     returns, computed on the defect-anchored rotated grid.  Ball positions are whole
     numbers of the track-aligned grid's along-track cells from the defect centre."""
-    from .halfspace import (TABLE_CELLS, HalfSpace, _curve, _refine, _symmetry, contact_grid,
-                            e_star_of, hertz_start)
     e_star = e_star_of() if e_star is None else e_star
     step = contact_grid(None, geom, delta, cells).dy
     g = skewed_grid(defect, geom, delta, cells)
