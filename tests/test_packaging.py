@@ -26,6 +26,9 @@ def _imported_top_level(folder):
                 names |= {a.name.split(".")[0] for a in node.names}
             elif isinstance(node, ast.ImportFrom) and node.module and not node.level:
                 names.add(node.module.split(".")[0])
+            elif (isinstance(node, ast.Call) and getattr(node.func, "attr", None) == "load" and node.args
+                  and isinstance(node.args[0], ast.Constant) and isinstance(node.args[0].value, str)):
+                names.add(node.args[0].value.split(".")[0])     # lazy_loader's lazy.load("pkg.sub")
     return {n.lower().replace("_", "-") for n in names}
 
 

@@ -448,7 +448,7 @@ def route_verdict(families, cs, *, shaft_hz, ftf_hz, n_harmonics=5):
     cs : CyclicSpectrum
         The spectrum they were found in.
     shaft_hz, ftf_hz : float
-        Modulating rates used to explain lines away.
+        Modulating rates with which lines are explained away.
     n_harmonics : int
         As in the search.
 

@@ -61,8 +61,9 @@ def _format_problem(data: bytes):
     """Check the ``fmt `` chunk's fields against each other; return the problem or None.
 
     scipy.io.wavfile picks the sample type from ``block_align`` and the channel count, so a
-    ``block_align`` that disagrees with channels × bytes per sample used to read int16 data as
-    int8 or int32 garbage without a word, and 0 channels ended in a ZeroDivisionError.
+    ``block_align`` that disagrees with channels × bytes per sample would read int16 data as
+    int8 or int32 garbage without a word, and 0 channels would end in a ZeroDivisionError: both are
+    refused here.
     """
     if data[:4] not in (b"RIFF", b"RIFX") or len(data) < 12:
         return None  # RF64 and non-WAV content: left to scipy

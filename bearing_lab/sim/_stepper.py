@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 from numba import njit
 
-from . import _kernels as K
+from . import _kernels as K  # K: the name sim/_variants.py rebinds in each per-kind copy of these kernels
 
 TWO_PI = 2.0 * math.pi
 
@@ -216,12 +216,11 @@ def work_arrays(n, z):
 
 
 # Python calls the kernels below directly, on work arrays it allocates (``work_arrays``), and
-# they are compiled without reference counting (they allocate nothing).  They used to sit behind
-# a wrapper kernel that allocated the work arrays: numba's disk cache stores the wrapper's
-# machine code with its own copy of the loop, and that copy ran 0.077-0.089 CPU s per simulated
-# second where the loop's own copy, which a compiling process happens to call, ran 0.050-0.062
-# (same scenes, bitwise the same results).  Called directly, the cached code is the code that
-# was measured.
+# they are compiled without reference counting (they allocate nothing).  No wrapper kernel
+# allocates the work arrays: numba's disk cache would store such a wrapper's machine code with its
+# own copy of the loop, and that copy runs 0.077-0.089 CPU s per simulated second where the loop's
+# own copy runs 0.050-0.062 (same scenes, bitwise the same results, measured).  Called directly,
+# the cached code is the code that was measured.
 
 
 @njit(cache=True, error_model="numpy", **K.NO_REFCOUNT)

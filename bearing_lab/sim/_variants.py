@@ -30,7 +30,7 @@ import types
 
 from numba import njit
 
-from . import _kernels as K
+from . import _kernels as K  # the same alias as _stepper.py's, the global a per-kind copy rebinds
 from . import _stepper as S
 
 #: the ball models of ``rhs`` and ``_rhs_3d``, with the number of values each returns

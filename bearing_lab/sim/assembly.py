@@ -14,7 +14,7 @@ import time
 import numpy as np
 
 from ..errors import SceneError, check_choice
-from . import _kernels as K
+from . import _kernels as kernels
 from . import scene as _sc
 from .auto import resolve
 from .bearing3d import axial_support, groove_offsets, needs_3d, static_equilibrium_3d
@@ -53,7 +53,7 @@ class Assembly:
 
     @property
     def sensor_index(self) -> int:
-        return int(self.p[K.P_SENSOFF])
+        return int(self.p[kernels.P_SENSOFF])
 
 
 def load_zone_angle(scene: Scene) -> float:
@@ -170,7 +170,7 @@ def _defect_tables(scene: Scene, lz: float, delta_max: float, material, delta_to
     tables = []
     n_e = max(len(entries), 1)
     dint = np.zeros((n_e, 7), dtype=np.int64)
-    dflt = np.zeros((n_e, K.N_DFLT))
+    dflt = np.zeros((n_e, kernels.N_DFLT))
     hparts, gparts = [], []
     hoff = goff = 0
     t_tables = time.perf_counter()
@@ -204,7 +204,7 @@ def _initial_state(scene: Scene, st, p, fid, dyn, hi, ho, k_eff, m_b, g, omega_c
     b, z, sens = scene.bearing, scene.bearing.n_balls, scene.data["sensor"]
     n_ball_states = 0 if fid == "quasi-static" else (5 * z + 2 if dyn else 2 * z)
     n = 8 + n_ball_states + (4 if sens["enabled"] else 0)
-    p[K.P_SENSOFF] = 8 + n_ball_states
+    p[kernels.P_SENSOFF] = 8 + n_ball_states
     y0 = np.zeros(n)
     y0[0:2] = st["xi"]
     y0[4:6] = st["xo"]
@@ -258,67 +258,67 @@ def _parameters(scene: Scene, fid, st, hi, ho, k_eff, masses, loads, ftf, phi_c0
     d, b, z = scene.data, scene.bearing, scene.bearing.n_balls
     m_i, m_o, m_b = masses
     tstep, f_in2, f_out2, g = loads
-    p = np.zeros(K.P_SIZE + 2 * z)
-    p[K.P_Z] = z
+    p = np.zeros(kernels.P_SIZE + 2 * z)
+    p[kernels.P_Z] = z
     # the balls' angular offsets around the cage (cos, sin), read by the right-hand side
-    p[K.P_TRIG:K.P_TRIG + z] = np.cos(2 * np.pi * np.arange(z) / z)
-    p[K.P_TRIG + z:K.P_TRIG + 2 * z] = np.sin(2 * np.pi * np.arange(z) / z)
-    p[K.P_RP] = b.pitch_diameter / 2
-    p[K.P_PD] = scene.clearance
-    p[K.P_KI], p[K.P_KO], p[K.P_KEFF] = hi.stiffness, ho.stiffness, k_eff
-    p[K.P_CMAX] = d["contact"]["damping_n_s_m"]
-    p[K.P_DPEN] = d["contact"]["penetration_um"] * 1e-6
-    p[K.P_EXP] = d["contact"]["exponent"]
-    p[K.P_DRATE] = 1.0 if d["contact"]["defect_damping"] == "penetration_rate" else 0.0
-    p[K.P_MI], p[K.P_MO], p[K.P_MB] = m_i, m_o, m_b
-    p[K.P_KSX], p[K.P_KSY] = d["shaft"]["stiffness_x_n_m"], d["shaft"]["stiffness_y_n_m"]
-    p[K.P_CSX], p[K.P_CSY] = d["shaft"]["damping_x_n_s_m"], d["shaft"]["damping_y_n_s_m"]
-    p[K.P_KMX], p[K.P_KMY] = d["mount"]["stiffness_x_n_m"], d["mount"]["stiffness_y_n_m"]
-    p[K.P_CMX], p[K.P_CMY] = d["mount"]["damping_x_n_s_m"], d["mount"]["damping_y_n_s_m"]
-    p[K.P_XIR], p[K.P_YIR] = st["rest_i"]
-    p[K.P_XOR], p[K.P_YOR] = st["rest_o"]
-    p[K.P_FIX], p[K.P_FIY] = st["f_in"]
-    p[K.P_FOX], p[K.P_FOY] = st["f_out"]
-    p[K.P_TSTEP] = tstep
-    p[K.P_FIX2], p[K.P_FIY2] = f_in2
-    p[K.P_FOX2], p[K.P_FOY2] = f_out2
-    p[K.P_G] = g
-    p[K.P_FTF] = ftf
-    p[K.P_PHI0] = phi_c0
+    p[kernels.P_TRIG:kernels.P_TRIG + z] = np.cos(2 * np.pi * np.arange(z) / z)
+    p[kernels.P_TRIG + z:kernels.P_TRIG + 2 * z] = np.sin(2 * np.pi * np.arange(z) / z)
+    p[kernels.P_RP] = b.pitch_diameter / 2
+    p[kernels.P_PD] = scene.clearance
+    p[kernels.P_KI], p[kernels.P_KO], p[kernels.P_KEFF] = hi.stiffness, ho.stiffness, k_eff
+    p[kernels.P_CMAX] = d["contact"]["damping_n_s_m"]
+    p[kernels.P_DPEN] = d["contact"]["penetration_um"] * 1e-6
+    p[kernels.P_EXP] = d["contact"]["exponent"]
+    p[kernels.P_DRATE] = 1.0 if d["contact"]["defect_damping"] == "penetration_rate" else 0.0
+    p[kernels.P_MI], p[kernels.P_MO], p[kernels.P_MB] = m_i, m_o, m_b
+    p[kernels.P_KSX], p[kernels.P_KSY] = d["shaft"]["stiffness_x_n_m"], d["shaft"]["stiffness_y_n_m"]
+    p[kernels.P_CSX], p[kernels.P_CSY] = d["shaft"]["damping_x_n_s_m"], d["shaft"]["damping_y_n_s_m"]
+    p[kernels.P_KMX], p[kernels.P_KMY] = d["mount"]["stiffness_x_n_m"], d["mount"]["stiffness_y_n_m"]
+    p[kernels.P_CMX], p[kernels.P_CMY] = d["mount"]["damping_x_n_s_m"], d["mount"]["damping_y_n_s_m"]
+    p[kernels.P_XIR], p[kernels.P_YIR] = st["rest_i"]
+    p[kernels.P_XOR], p[kernels.P_YOR] = st["rest_o"]
+    p[kernels.P_FIX], p[kernels.P_FIY] = st["f_in"]
+    p[kernels.P_FOX], p[kernels.P_FOY] = st["f_out"]
+    p[kernels.P_TSTEP] = tstep
+    p[kernels.P_FIX2], p[kernels.P_FIY2] = f_in2
+    p[kernels.P_FOX2], p[kernels.P_FOY2] = f_out2
+    p[kernels.P_G] = g
+    p[kernels.P_FTF] = ftf
+    p[kernels.P_PHI0] = phi_c0
     sens = d["sensor"]
-    p[K.P_SENS] = 1.0 if sens["enabled"] else 0.0
-    p[K.P_SW] = 2 * math.pi * sens["frequency_hz"]
-    p[K.P_SZ] = sens["damping_ratio"]
-    p[K.P_FID] = 1.0 if fid == "quasi-static" else 0.0
+    p[kernels.P_SENS] = 1.0 if sens["enabled"] else 0.0
+    p[kernels.P_SW] = 2 * math.pi * sens["frequency_hz"]
+    p[kernels.P_SZ] = sens["damping_ratio"]
+    p[kernels.P_FID] = 1.0 if fid == "quasi-static" else 0.0
     dyn = d["cage"]["model"] == "dynamic"
     if dyn and fid == "quasi-static":
         raise SceneError("cage.model='dynamic' needs fidelity='multibody' (massless balls have no "
                          "orbital dynamics)")
-    p[K.P_CAGE] = 1.0 if dyn else 0.0
+    p[kernels.P_CAGE] = 1.0 if dyn else 0.0
     cg = d["cage"]
-    p[K.P_MU] = cg["traction_coefficient"]
-    p[K.P_VREF] = cg["traction_slip_m_s"]
-    p[K.P_KPOCK] = cg["pocket_stiffness_n_m"]
-    p[K.P_CPOCK] = cg["pocket_clearance_mm"] * 1e-3
-    p[K.P_DPOCK] = cg["pocket_damping_n_s_m"]
+    p[kernels.P_MU] = cg["traction_coefficient"]
+    p[kernels.P_VREF] = cg["traction_slip_m_s"]
+    p[kernels.P_KPOCK] = cg["pocket_stiffness_n_m"]
+    p[kernels.P_CPOCK] = cg["pocket_clearance_mm"] * 1e-3
+    p[kernels.P_DPOCK] = cg["pocket_damping_n_s_m"]
     m_cage = cg["mass_kg"] or 0.15 * z * m_b
-    p[K.P_IC] = m_cage * (b.pitch_diameter / 2) ** 2
-    p[K.P_RB] = b.ball_diameter / 2
-    p[K.P_CDRAG] = cg["drag_n_m_s"]
-    p[K.P_UNB] = d["shaft"]["unbalance_g_mm"] * 1e-6
-    p[K.P_IB] = 0.4 * m_b * (b.ball_diameter / 2) ** 2
-    p[K.P_NDEF] = n_defects
-    p[K.P_SPIN] = b.frequency_factors()["bsf"]
+    p[kernels.P_IC] = m_cage * (b.pitch_diameter / 2) ** 2
+    p[kernels.P_RB] = b.ball_diameter / 2
+    p[kernels.P_CDRAG] = cg["drag_n_m_s"]
+    p[kernels.P_UNB] = d["shaft"]["unbalance_g_mm"] * 1e-6
+    p[kernels.P_IB] = 0.4 * m_b * (b.ball_diameter / 2) ** 2
+    p[kernels.P_NDEF] = n_defects
+    p[kernels.P_SPIN] = b.frequency_factors()["bsf"]
     if "zi" in st:
         a_i, a_o = groove_offsets(b)
-        p[K.P_3D] = 1.0
-        p[K.P_AGI], p[K.P_AGO] = a_i, a_o
-        p[K.P_KZI], p[K.P_CZI] = axial_support(d["shaft"])
-        p[K.P_KZO], p[K.P_CZO] = axial_support(d["mount"])
-        p[K.P_ZIR], p[K.P_ZOR] = st["rest_zi"], st["rest_zo"]
-        p[K.P_FIZ], p[K.P_FOZ] = st["f_inz"], st["f_outz"]
-        p[K.P_ZSET] = _sc.SETTLE_AXIAL_RATE
-        p[K.P_TZSET] = max(scene.settle - _sc.SETTLE_FREE_S, 0.0)
+        p[kernels.P_3D] = 1.0
+        p[kernels.P_AGI], p[kernels.P_AGO] = a_i, a_o
+        p[kernels.P_KZI], p[kernels.P_CZI] = axial_support(d["shaft"])
+        p[kernels.P_KZO], p[kernels.P_CZO] = axial_support(d["mount"])
+        p[kernels.P_ZIR], p[kernels.P_ZOR] = st["rest_zi"], st["rest_zo"]
+        p[kernels.P_FIZ], p[kernels.P_FOZ] = st["f_inz"], st["f_outz"]
+        p[kernels.P_ZSET] = _sc.SETTLE_AXIAL_RATE
+        p[kernels.P_TZSET] = max(scene.settle - _sc.SETTLE_FREE_S, 0.0)
     return p, dyn
 
 
@@ -327,7 +327,7 @@ def _axial_states(scene, st, p, fid, y0, atol):
     each ball's axial position and rate; the balls' radial positions from the 3-D equilibrium."""
     z = scene.bearing.n_balls
     zb = y0.size
-    p[K.P_ZOFF] = zb
+    p[kernels.P_ZOFF] = zb
     extra = 4 + (2 * z if fid != "quasi-static" else 0)
     y = np.concatenate([y0, np.zeros(extra)])
     a = np.concatenate([atol, np.zeros(extra)])
@@ -417,7 +417,7 @@ def assemble(scene: Scene, *, fidelity: str | None = None, delta_top=None) -> As
         sp_th[1:] = np.cumsum(0.5 * (sp_w[1:] + sp_w[:-1]) * np.diff(sp_t))
     # shaft angle is measured from t = 0: shift so that theta(0) = 0
     # (the kernel's Python source: one call does not pay for compiling or loading it)
-    th0, _ = K.shaft_state.py_func(0.0, sp_t, sp_w, sp_th)
+    th0, _ = kernels.shaft_state.py_func(0.0, sp_t, sp_w, sp_th)
     sp_th = sp_th - th0
 
     # loads and their optional step

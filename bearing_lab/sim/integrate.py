@@ -30,7 +30,7 @@ import xarray as xr
 from .._docdict import fill_doc
 from .._version import __version__
 from ..errors import BearingLabError, SolverError
-from . import _kernels as K
+from . import _kernels as kernels
 from . import _stepper as S
 from . import _variants as V
 from .assembly import assemble
@@ -131,8 +131,8 @@ def _run(asm, method, rtol, *, progress, t_end_override=None, step=None, max_ste
     n_fine = m_pad + (n_out - 1) * R + m_pad + 1
     n = asm.y0.size
     z = asm.n_balls
-    three_d = asm.p[K.P_3D] > 0.5
-    zb = int(asm.p[K.P_ZOFF])
+    three_d = asm.p[kernels.P_3D] > 0.5
+    zb = int(asm.p[kernels.P_ZOFF])
     vel_idx = np.full((3 if three_d else 2, 2), -1, dtype=np.int64)
     vel_sign = np.ones((3 if three_d else 2, 2))
     vel_idx[0, 0], vel_idx[1, 0] = 6, 7
@@ -278,7 +278,7 @@ TABLE_EXTENSIONS = 2
 def _tables_exceeded(asm) -> set:
     """Table entries (tabulated contact laws) whose forces were taken above the table's top."""
     return {k for k, t in enumerate(asm.tables)
-            if asm.dint[k, K.D_KIND] == 1 and asm.dflt[k, K.F_REACH] > t.delta_max * (1 + 1e-9)}
+            if asm.dint[k, kernels.D_KIND] == 1 and asm.dflt[k, kernels.F_REACH] > t.delta_max * (1 + 1e-9)}
 
 
 def _assemble(sc, delta_top=None):
@@ -378,7 +378,7 @@ def simulate(scene, *, fidelity: str | None = None, duration: float | None = Non
         if not over:
             break
         # a force was taken above a table's top (extrapolated): extend those tables, run again
-        top = [max(1.25 * float(asm.dflt[k, K.F_REACH]), t.delta_max) if k in over else None
+        top = [max(1.25 * float(asm.dflt[k, kernels.F_REACH]), t.delta_max) if k in over else None
                for k, t in enumerate(asm.tables)]
         table_s = asm.table_time_s
         asm = _assemble(sc, delta_top=top)
@@ -389,8 +389,8 @@ def simulate(scene, *, fidelity: str | None = None, duration: float | None = Non
     if over:
         raise SolverError(f"scene {sc.name!r}: the balls' approach on defect table(s) {sorted(over)} "
                           f"kept rising above the table after {TABLE_EXTENSIONS} extensions (reached "
-                          + ", ".join(f"{1e6 * asm.dflt[k, K.F_REACH]:.3g} um over a {1e6 * asm.tables[k].delta_max:.3g}"
-                                      " um table" for k in sorted(over))
+                          + ", ".join(f"{1e6 * asm.dflt[k, kernels.F_REACH]:.3g} um over a "
+                                      f"{1e6 * asm.tables[k].delta_max:.3g} um table" for k in sorted(over))
                           + "); the defect is deeper or the load larger than the contact law covers")
     acc = res["acc"]
     if d["sensor"]["enabled"]:
@@ -462,7 +462,7 @@ def simulate(scene, *, fidelity: str | None = None, duration: float | None = Non
         "bearing_model": _bearing_model(d, asm.static) if res["angles"] is not None else "planar (no axial load)",
         **({"axial_force_n": float(asm.static["axial_force_n"])} if res["angles"] is not None else {}),
         "defect_table_top_um": ",".join(f"{1e6 * t.delta_max:.4g}" for t in asm.tables) if asm.tables else "none",
-        "defect_table_reach_um": (",".join(f"{1e6 * asm.dflt[k, K.F_REACH]:.4g}" for k in range(len(asm.tables)))
+        "defect_table_reach_um": (",".join(f"{1e6 * asm.dflt[k, kernels.F_REACH]:.4g}" for k in range(len(asm.tables)))
                                   if asm.tables else "none"),
         "solver_steps": int(stats[0]),
         "solver_rejected_steps": int(stats[1]),

@@ -15,7 +15,7 @@ import numpy as np
 
 from ..analysis import excitation_period, impulses
 from ..errors import AnalysisError
-from ..sim import _kernels as K
+from ..sim import _kernels as kernels
 from ..sim import load_scene
 from ..sim.integrate import _decimate_acc, anti_alias_taps
 
@@ -77,7 +77,7 @@ def scipy_acc(asm, method, rtol, max_step=2.5e-5):
 
     def f(t, y):
         dy = np.empty_like(y)
-        K.rhs(t, y, *args, dy, fi, fo)
+        kernels.rhs(t, y, *args, dy, fi, fo)
         return dy
     t_end = fine_t[-1] + 1e-9
     tic = time.process_time()

@@ -100,7 +100,7 @@ VARIES = {"size": "the defect's length", "offset": "its axial offset H", "skew":
 PAPER_OFFSET_RATIOS = (1.0, 22.48 / 28.82, 15.64 / 28.82)
 
 
-def _passage(ds, scene):
+def _last_defect_passage(ds, scene):
     """(centre time in the record, window half-width, ball index) of the last full passage."""
     b = scene.bearing
     rpm = ds.attrs["shaft_speed_rpm"]
@@ -127,10 +127,10 @@ def _passage(ds, scene):
     return float(t_c[ok][-1]), half, ball, (s1 - s0) / v
 
 
-def _one(scene_name, overrides):
+def _measure_study_point(scene_name, overrides):
     sc = load_scene(scene_name, **overrides)
     ds = simulate(sc, duration=0.1, fs=STUDY_FS, progress=False, **{"output.oversample": 4})
-    tc, half, ball, t_cross = _passage(ds, sc)
+    tc, half, ball, t_cross = _last_defect_passage(ds, sc)
     w = (ds.time.values >= tc - half) & (ds.time.values <= tc + half)
     t = ds.time.values[w] - tc
     disp = ds.outer_ring_disp_y.values[w]
@@ -209,7 +209,7 @@ def run_paper_studies(out_dir="reports/studies", *, progress=True, studies=None)
     results = {}
     t0 = time.perf_counter()
     for s, lab, ov in tqdm(jobs, desc="paper studies", disable=not progress):
-        results[(s, lab)] = _one(STUDIES[s][0], ov)
+        results[(s, lab)] = _measure_study_point(STUDIES[s][0], ov)
     rows = [dict(study=s, label=lab, **{k: v for k, v in results[(s, lab)].items()
                                         if not isinstance(v, np.ndarray) and k != "scene"})
             for s, lab, _ in jobs]

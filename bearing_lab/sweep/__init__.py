@@ -326,18 +326,22 @@ def _open_cache_dir(cache_dir) -> Path | None:
     return cdir
 
 
-def _compute(todo, tomls, digests, cdir, acc, scheduler, n_workers, bar, failed) -> str:
-    """Simulate the scenes ``todo`` (serially or on Dask) into ``acc``; return the scheduler used."""
-    if not todo:
+def _simulate_missing(missing, scene_tomls, digests, cache_dir, results, scheduler, n_workers, bar, failure) -> str:
+    """Simulate the scenes whose indices are ``missing`` (serially or on Dask) into ``results``.
+
+    ``scene_tomls[i]`` and ``digests[i]`` are scene i's resolved TOML and cache key; ``cache_dir`` (or None)
+    receives each result; ``failure(i, exc)`` makes the error naming scene i's values.  Returns the
+    scheduler used, described."""
+    if not missing:
         return "serial (in process)"
     if scheduler == "serial":
-        for i in todo:
-            path = str(cdir / f"{digests[i]}.nc") if cdir is not None else None
+        for i in missing:
+            path = str(cache_dir / f"{digests[i]}.nc") if cache_dir is not None else None
             try:
-                ds = _simulate_scene(tomls[i], digests[i], path)
+                ds = _simulate_scene(scene_tomls[i], digests[i], path)
             except Exception as exc:  # noqa: BLE001 - re-raised with the scene's values
-                raise failed(i, exc) from exc
-            acc.put(i, ds, cached=False)
+                raise failure(i, exc) from exc
+            results.put(i, ds, cached=False)
             if bar is not None:
                 bar.update(1)
         return "serial (in process)"
@@ -346,10 +350,10 @@ def _compute(todo, tomls, digests, cdir, acc, scheduler, n_workers, bar, failed)
     try:
         from dask.distributed import as_completed  # dask once a sweep uses it (_xarray reads sys.modules)
         futures = {}
-        for i in todo:
+        for i in missing:
             # workers of a local cluster share our disk and write the cache themselves
-            path = str(cdir / f"{digests[i]}.nc") if (cdir is not None and not remote) else None
-            fut = client.submit(_simulate_scene, tomls[i], digests[i], path,
+            path = str(cache_dir / f"{digests[i]}.nc") if (cache_dir is not None and not remote) else None
+            fut = client.submit(_simulate_scene, scene_tomls[i], digests[i], path,
                                 key=f"bearing_lab-scene-{digests[i][:16]}-{uuid.uuid4().hex[:8]}",
                                 pure=False)
             futures[fut] = i
@@ -360,11 +364,11 @@ def _compute(todo, tomls, digests, cdir, acc, scheduler, n_workers, bar, failed)
             except Exception as exc:  # noqa: BLE001
                 for other in futures:
                     other.cancel()
-                raise failed(i, exc) from exc
+                raise failure(i, exc) from exc
             del fut
-            if remote and cdir is not None:
-                _write_cache(ds, cdir / f"{digests[i]}.nc")
-            acc.put(i, ds, cached=False)
+            if remote and cache_dir is not None:
+                _write_cache(ds, cache_dir / f"{digests[i]}.nc")
+            results.put(i, ds, cached=False)
             if bar is not None:
                 bar.update(1)
     finally:
@@ -479,7 +483,7 @@ def run_sweep(scene, params: dict, *, scheduler=None, n_workers: int | None = No
         return BearingLabError(f"sweep scene {label(i)}: {type(exc).__name__}: {exc}")
 
     try:
-        desc = _compute(todo, tomls, digests, cdir, acc, scheduler, n_workers, bar, failed)
+        desc = _simulate_missing(todo, tomls, digests, cdir, acc, scheduler, n_workers, bar, failed)
     finally:
         if bar is not None:
             bar.close()

@@ -1,8 +1,8 @@
 """The table of validation quantities: what is compared, on which signal and span, how close by default.
 
 Why a table: which quantity is measured on the full record and which on the compared
-segment, on the bare model or after the structural path, used to be decided by which
-loop of the runner it sat in.  Here each quantity says it, once, and the runner only
+segment, on the bare model or after the structural path, is a property of the quantity, not
+of the code that happens to compute it.  Here each quantity says it, once, and the runner only
 looks it up.  Adding a quantity is one entry here (and one test).
 
 Signals (simulation side):

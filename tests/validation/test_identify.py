@@ -80,8 +80,8 @@ def test_identify_recovers_the_length_within_15_percent(found):
 def test_only_optimised_profile_values_exclude(found):
     """A scene simulated on the way (the simplex's, the polish's) scores a geometry with the other parameters
     where the search happened to put them: it bounds the profile from above and may accept its value, never
-    exclude it.  Break it: count every simulated scene as a profile value (the naive profile) and the offset
-    and skew intervals shrink to the scenes next to the best; a value just outside such a naive interval,
+    exclude it.  Break it: count every simulated scene as a profile value (the naive profile) and intervals
+    shrink to the scenes next to the best; a value just outside such a naive interval (any parameter, either side),
     with the other parameters minimised there, still explains the recording within the threshold, so the
     naive interval excludes an answer.  The intervals reported must hold every such value."""
     from bearing_lab.validation import load_case
@@ -97,10 +97,15 @@ def test_only_optimised_profile_values_exclude(found):
     journal = Journal(shared_folder() / "journal.jsonl", comparison_fingerprint(st, base))
     score = _scorer(st, base, r.grid, points, dict(scheduler="serial", cache_dir=False, bar=None, out=points,
                                                     keep={}, journal=journal))
-    shown = []
-    for k in ("defect.offset_mm", "defect.skew_deg"):
-        lo = _profile(r.points, k, r.threshold_db)["interval"][0]
-        x = round(lo - 0.5 * (best[k] - lo), 4)            # outside the naive interval, below it
+    shown, probes = [], []
+    for k in r.grid:                                       # every parameter, each side of its naive interval
+        lo, hi = _profile(r.points, k, r.threshold_db)["interval"]
+        span = (min(GRID[k]), max(GRID[k]))
+        for edge, x in ((lo, lo - 0.5 * (best[k] - lo)), (hi, hi + 0.5 * (hi - best[k]))):
+            x = round(x, 4)
+            if span[0] < edge < span[1] and span[0] <= x <= span[1] and x != best[k]:
+                probes.append((k, edge, x))
+    for k, edge, x in probes:
         tried = []
 
         def f(point):
@@ -112,8 +117,9 @@ def test_only_optimised_profile_values_exclude(found):
         if min(tried) <= best["score_db"] + r.threshold_db:
             lo_r, hi_r = r.parameters[k]["interval"]
             assert lo_r <= x <= hi_r, (k, x, min(tried), r.parameters[k])
-            shown.append((k, lo, x))
-    assert shown, "no value outside a naive interval was shown to explain the recording: the check cannot fail"
+            shown.append((k, edge, x))
+    assert shown, ("no value outside a naive interval was shown to explain the recording: the check cannot fail "
+                   f"(probed {probes})")
 
 
 def test_a_flat_profile_is_called_not_identifiable(found):
