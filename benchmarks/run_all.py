@@ -2,7 +2,7 @@
 
     .venv/bin/python benchmarks/run_all.py              # everything (`make bench`; hours)
     .venv/bin/python benchmarks/run_all.py --list       # what would run, and its rough cost
-    .venv/bin/python benchmarks/run_all.py --only sim_speed defect_tables-slot
+    .venv/bin/python benchmarks/run_all.py --only sim_speed defect_tables-slot   # names as --list prints
     .venv/bin/python benchmarks/run_all.py --quick      # smallest modes, to check the runner
                                                         # (`make bench-quick`; not for quoting)
 
@@ -76,7 +76,7 @@ REGISTRY: tuple[Entry, ...] = (
     Entry("sim_speed.py", ("--startup", "--first", "1", "--warm", "5"), variant="startup",
           quick=("--startup", "--first", "1", "--warm", "1"), cost="1 min", quick_cost="40 s",
           quoted_in=("README.md", B)),
-    Entry("analysis_speed.py", ("--repeat", "5"), quick=("--repeat", "1", "--seconds", "1"),
+    Entry("analysis_speed.py", ("--repeat", "5"), quick=("--repeat", "1", "--seconds", "2"),
           cost="1 min", quick_cost="15 s", quoted_in=("benchmarks/README_analysis.md",)),
     Entry("analysis_speed.py", ("--seconds", "60"), variant="60s", quick=("--repeat", "1", "--seconds", "2"),
           cost="2 min", quick_cost="15 s", quoted_in=("README.md",)),
@@ -210,18 +210,17 @@ def run_entry(entry: Entry, quick: bool, mirror: str | None, results: Path) -> t
 def select(names: list[str] | None) -> list[Entry]:
     if not names:
         return list(REGISTRY)
-    known = {e.name: e for e in REGISTRY}
-    scripts = {Path(e.script).stem for e in REGISTRY}
-    bad = [n for n in names if n not in known and n not in scripts]
+    known = [e.name for e in REGISTRY]
+    bad = [n for n in names if n not in known]
     if bad:
         raise SystemExit(f"run_all.py: --only: unknown benchmark {', '.join(bad)} (known: {', '.join(known)})")
-    return [e for e in REGISTRY if e.name in names or Path(e.script).stem in names]
+    return [e for e in REGISTRY if e.name in names]
 
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--list", action="store_true", help="print what would run and its rough cost, run nothing")
-    ap.add_argument("--only", nargs="+", metavar="NAME", help="these entries (or every entry of these scripts)")
+    ap.add_argument("--only", nargs="+", metavar="NAME", help="these entries (names as --list prints them)")
     ap.add_argument("--quick", action="store_true", help="each script's smallest mode (figures not for quoting)")
     ap.add_argument("--mirror", default=os.environ.get("BEARING_LAB_MIRROR"),
                     help="the public recordings' folder (default: $BEARING_LAB_MIRROR)")

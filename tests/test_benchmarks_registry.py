@@ -19,8 +19,9 @@ spec.loader.exec_module(run_all)
 
 FIELDS = ("benchmark", "date", "git revision", "machine", "load average before", "load average after",
           "versions", "command", "mirror (BEARING_LAB_MIRROR)", "child CPU time", "wall time", "exit status")
-#: the cheapest registered entry in its quick mode (about 10 s of CPU)
-CHEAPEST = "identify_cost"
+#: a cheap registered entry in its quick mode (about 5 s of CPU; the analysis_speed entries cost less
+#: but their script's 1 s record fails, so the cheapest one is not trusted to stay runnable)
+CHEAPEST = "sim_speed"
 
 
 def test_every_script_registered_or_excluded():
