@@ -13,9 +13,9 @@ stdout goes to ``benchmarks/results/<name>.txt`` (``<name>`` is the script's nam
 whether the tree had uncommitted changes), machine (CPU model, cores, RAM), load average before
 and after, Python and the key library versions, the command line, the child's CPU time (user +
 system, ``resource.getrusage(RUSAGE_CHILDREN)``, which includes the processes the child waited
-for) and its wall time.  A failing entry is reported at the end with its stderr tail and the exit
-status is 1; the other entries still run.  ``--quick`` writes the same files with "quick: figures
-not for quoting" in the header: do not commit those.
+for) and its wall time.  A failing entry is reported at the end with its stderr tail (also written
+below its output) and the exit status is 1; the other entries still run.  ``--quick`` writes the
+same files with "quick: figures not for quoting" in the header: do not commit those.
 """
 from __future__ import annotations
 
@@ -44,7 +44,7 @@ class Entry:
     args: tuple[str, ...] = ()
     variant: str = ""
     quick: tuple[str, ...] | None = None
-    cost: str = "?"            # rough CPU time of the full run on the project machine
+    cost: str = "?"            # rough CPU time of the full run (see REGISTRY)
     quick_cost: str = "?"
     mirror_arg: bool = False   # the script takes --mirror (all children also get BEARING_LAB_MIRROR)
     quoted_in: tuple[str, ...] = field(default=())
@@ -61,55 +61,56 @@ class Entry:
 
 
 B, D = "benchmarks/README.md", "docs/"
+# cost: rough CPU time of the full run, quick_cost of the quick one, measured with warm numba and table
+# caches on the shared 2-core project machine ("~" where a full run was not timed: a guess from its size)
+WP_QUICK = ("--scene", "paper-slot", "--no-scipy", "--no-rates", "--duration", "0.05")
 REGISTRY: tuple[Entry, ...] = (
-    Entry("work_precision.py", (), quick=("--scene", "paper-slot", "--no-scipy", "--no-rates", "--duration", "0.05"),
-          cost="1-2 h", quick_cost="1 min", quoted_in=("README.md", B, D + "architecture.md")),
+    Entry("work_precision.py", (), quick=WP_QUICK, cost="~1-2 h", quick_cost="40 s",
+          quoted_in=("README.md", B, D + "architecture.md")),
     # its own output folder, so that the full study's reports/performance/ stays
     Entry("work_precision.py", ("--scene", "paper-slot", "--no-scipy", "--duration", "0.3", "--no-rates",
                                 "-o", "reports/performance-slot"),
-          variant="slot", quick=("--scene", "paper-slot", "--no-scipy", "--no-rates", "--duration", "0.05",
-                                 "-o", "reports/performance-slot"),
-          cost="5 min", quick_cost="1 min", quoted_in=(B,)),
+          variant="slot", quick=(*WP_QUICK, "-o", "reports/performance-slot"), cost="~5 min", quick_cost="3 s",
+          quoted_in=(B,)),
     Entry("sim_speed.py", (), quick=("--duration", "0.02", "--default-duration", "0.1", "--scene", "paper-slot",
                                      "--no-scipy"),
-          cost="30 min", quick_cost="1 min", quoted_in=("README.md", B)),
+          cost="~30 min", quick_cost="5 s", quoted_in=("README.md", B)),
     Entry("sim_speed.py", ("--startup", "--first", "1", "--warm", "5"), variant="startup",
-          quick=("--startup", "--first", "1", "--warm", "1"), cost="1 min", quick_cost="40 s",
+          quick=("--startup", "--first", "1", "--warm", "1"), cost="~30 s", quick_cost="11 s",
           quoted_in=("README.md", B)),
     Entry("analysis_speed.py", ("--repeat", "5"), quick=("--repeat", "1", "--seconds", "2"),
-          cost="1 min", quick_cost="15 s", quoted_in=("benchmarks/README_analysis.md",)),
+          cost="~1 min", quick_cost="2 s", quoted_in=("benchmarks/README_analysis.md",)),
     Entry("analysis_speed.py", ("--seconds", "60"), variant="60s", quick=("--repeat", "1", "--seconds", "2"),
-          cost="2 min", quick_cost="15 s", quoted_in=("README.md",)),
-    Entry("defect_models.py", ("1.0",), quick=("0.05",), cost="10 min", quick_cost="2 min",
+          cost="~2 min", quick_cost="2 s", quoted_in=("README.md",)),
+    Entry("defect_models.py", ("1.0",), quick=("0.05",), cost="~3 min", quick_cost="12 s",
           quoted_in=(B, D + "contact-model.md")),
-    Entry("defect_tables.py", (), quick=("--quick",), cost="1 h", quick_cost="15 min",
+    Entry("defect_tables.py", (), quick=("--quick",), cost="~5 min", quick_cost="42 s",
           quoted_in=(B, D + "contact-model.md", "README.md")),
-    Entry("defect_tables.py", ("--slot",), variant="slot", cost="10 min",
+    Entry("defect_tables.py", ("--slot",), variant="slot", cost="7 s",
           quoted_in=(B, D + "contact-model.md", "README.md")),
-    Entry("defect_tables.py", ("--range",), variant="range", cost="5 min", quoted_in=(B,)),
-    Entry("defect_tables.py", ("--before", "70e2388"), variant="before-70e2388", cost="10 min",
+    Entry("defect_tables.py", ("--range",), variant="range", cost="14 s", quoted_in=(B,)),
+    Entry("defect_tables.py", ("--before", "70e2388"), variant="before-70e2388", cost="51 s",
           quoted_in=(B, D + "contact-model.md")),
-    Entry("defect_tables.py", ("--before", "fdecbe8"), variant="before-fdecbe8", cost="15 min",
-          quoted_in=(B,)),
-    Entry("cwru_or021_amplitude.py", (), cost="10 min", quoted_in=(D + "validation.md",)),
-    Entry("cwru_ir007_amplitude.py", (), cost="10 min", quoted_in=(D + "validation.md",)),
-    Entry("cwru_preload.py", (), quick=("0",), cost="10 min", quick_cost="3 min",
+    Entry("defect_tables.py", ("--before", "fdecbe8"), variant="before-fdecbe8", cost="41 s", quoted_in=(B,)),
+    Entry("cwru_or021_amplitude.py", (), cost="8 s", quoted_in=(D + "validation.md",)),
+    Entry("cwru_ir007_amplitude.py", (), cost="28 s", quoted_in=(D + "validation.md",)),
+    Entry("cwru_preload.py", (), quick=("0",), cost="~1 min", quick_cost="15 s",
           quoted_in=(B, D + "validation.md")),
-    Entry("bearing3d_cost.py", (), cost="2 min", quoted_in=(B, D + "model.md")),
+    Entry("bearing3d_cost.py", (), cost="24 s", quoted_in=(B, D + "model.md")),
     Entry("diagnosis_eval.py", ("--repeat", "7"), quick=("--quick", "--repeat", "1"), mirror_arg=True,
-          cost="10 min", quick_cost="1 min", quoted_in=("benchmarks/README_diagnosis.md", D + "analysis.md")),
+          cost="~10 min", quick_cost="13 s", quoted_in=("benchmarks/README_diagnosis.md", D + "analysis.md")),
     Entry("io_throughput.py", ("--repeat", "7"), quick=("--repeat", "1", "--big-mb", "4"), mirror_arg=True,
-          cost="5 min", quick_cost="30 s", quoted_in=("benchmarks/README_io.md",)),
-    Entry("fuzz_readers.py", (), quick=("--total", "200", "--jobs", "1"), cost="30 min", quick_cost="1 min",
+          cost="~2 min", quick_cost="1 s", quoted_in=("benchmarks/README_io.md",)),
+    Entry("fuzz_readers.py", (), quick=("--total", "200", "--jobs", "1"), cost="~15 min", quick_cost="8 s",
           quoted_in=("README.md", D + "reliability.md")),
     Entry("hostile_inputs.py", (), quick=("--kills", "2", "--structured", "10", "--truncations", "1"),
-          cost="15 min", quick_cost="3 min", quoted_in=("README.md", D + "reliability.md")),
-    Entry("identify_cost.py", (), quick=("--repeat", "1"), cost="3 min", quick_cost="2 min",
+          cost="~5 min", quick_cost="20 s", quoted_in=("README.md", D + "reliability.md")),
+    Entry("identify_cost.py", (), quick=("--repeat", "1"), cost="~15 s", quick_cost="6 s",
           quoted_in=(D + "identification.md",)),
-    Entry("identify_selfconsistency.py", (), quick=("--quick",), cost="20 min", quick_cost="8 min",
+    Entry("identify_selfconsistency.py", (), quick=("--quick",), cost="~1 min", quick_cost="13 s",
           quoted_in=(D + "identification.md",)),
     Entry("sweep_scaling.py", (), quick=("--scenes", "4", "--duration", "0.1", "--rounds", "1"),
-          cost="1 h", quick_cost="2 min", quoted_in=("benchmarks/README_sweep.md",)),
+          cost="~1 h", quick_cost="14 s", quoted_in=("benchmarks/README_sweep.md",)),
 )
 
 # benchmarks/*.py that are not benchmark runs of their own, and why
@@ -203,7 +204,11 @@ def run_entry(entry: Entry, quick: bool, mirror: str | None, results: Path) -> t
     }
     results.mkdir(parents=True, exist_ok=True)
     path = results / f"{entry.name}.txt"
-    path.write_text(header(fields, quick) + proc.stdout)
+    failed = ""
+    if proc.returncode:
+        tail = "".join(f"# {line}\n" for line in proc.stderr.strip().splitlines()[-20:]) or "# (stderr empty)\n"
+        failed = f"\n# FAILED (exit status {proc.returncode}); stderr, last lines:\n{tail}"
+    path.write_text(header(fields, quick) + proc.stdout + failed)
     return proc.returncode, proc.stderr, path
 
 
@@ -229,9 +234,9 @@ def main(argv: list[str] | None = None) -> int:
     entries = select(args.only)
     if args.list:
         for e in entries:
-            quick = "(no quick mode: runs in full)" if e.quick is None else f"quick ~{e.quick_cost}"
+            quick = "(no quick mode: runs in full)" if e.quick is None else f"quick {e.quick_cost}"
             cmd = " ".join(e.argv(args.quick, args.mirror)[1:]).replace(str(ROOT) + "/", "")
-            print(f"{e.name:32s} ~{e.cost:7s} {quick:30s} {cmd}")
+            print(f"{e.name:30s} {e.cost:8s} {quick:32s} {cmd}")
         return 0
     if args.mirror and not Path(args.mirror).is_dir():
         raise SystemExit(f"run_all.py: --mirror {args.mirror}: no such folder")
@@ -243,7 +248,7 @@ def main(argv: list[str] | None = None) -> int:
         if status:
             failed.append((e.name, status, stderr))
     for name, status, stderr in failed:
-        tail = "\n".join(stderr.strip().splitlines()[-15:])
+        tail = "\n".join(stderr.strip().splitlines()[-15:]) or "(stderr empty: see the script's output)"
         print(f"\nFAILED: {name} (exit status {status}); stderr tail:\n{tail}", file=sys.stderr)
     if failed:
         print(f"\n{len(failed)} of {len(entries)} benchmarks failed: {', '.join(f[0] for f in failed)}",

@@ -115,7 +115,9 @@ def test_header_has_every_field(tmp_path, monkeypatch):
         assert head["benchmark"] == name
         assert "cores" in head["machine"] and "GiB RAM" in head["machine"]
         assert head["date"].endswith("UTC")
-    assert "work_precision" not in (tmp_path / "run_all-bad.txt").read_text()
+    bad_text = (tmp_path / "run_all-bad.txt").read_text()
+    assert "work_precision" not in bad_text
+    assert "# FAILED" in bad_text and "unrecognized arguments: --no-such-flag" in bad_text   # stderr tail kept
     assert "work_precision" in (tmp_path / "run_all-ok.txt").read_text()   # the child's stdout follows
 
 
