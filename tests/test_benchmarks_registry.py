@@ -62,8 +62,14 @@ def _parse_with_script(script: Path, args, monkeypatch):
 
     monkeypatch.setattr(argparse.ArgumentParser, "parse_args", parse_and_stop)
     monkeypatch.setattr(sys, "argv", [str(script), *args])
-    with pytest.raises(_Parsed):
-        runpy.run_path(str(script), run_name="__main__")
+    monkeypatch.setattr(sys, "path", list(sys.path))
+    environ = dict(os.environ)           # a script may set thread limits before it parses
+    try:
+        with pytest.raises(_Parsed):
+            runpy.run_path(str(script), run_name="__main__")
+    finally:
+        os.environ.clear()
+        os.environ.update(environ)
 
 
 def _check_argv_script(script: Path, args):
