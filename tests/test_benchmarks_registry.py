@@ -141,3 +141,16 @@ def test_cheapest_entry_end_to_end(tmp_path):
     cpu = float(head.split("# child CPU time: ")[1].split(" s")[0])
     assert cpu > 0.1          # the child's CPU time was counted (it imports numpy and compiles)
     assert body.strip()       # the script's own output follows the header
+
+
+def test_no_quick_results_tracked():
+    """Quick-mode files (checking the runner only) are never the committed figures."""
+    import shutil
+    import subprocess
+    if not shutil.which("git") or not (BENCH.parent / ".git").exists():
+        pytest.skip("not a git checkout")
+    tracked = subprocess.run(["git", "ls-files", "benchmarks/results"], cwd=BENCH.parent,
+                             capture_output=True, text=True).stdout.split()
+    quick = [f for f in tracked if (BENCH.parent / f).is_file()
+             and "quick: figures not for quoting" in (BENCH.parent / f).read_text()[:200]]
+    assert not quick, f"quick-mode results in place of full ones: {quick} (git checkout benchmarks/results/)"
