@@ -5,7 +5,7 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 
-.PHONY: install lock validate test docs bench study verdicts clean
+.PHONY: install lock validate test docs bench bench-quick study verdicts clean
 
 install: $(STAMP)
 
@@ -39,8 +39,14 @@ docs: install
 	$(PY) -m sphinx -b html -W --keep-going -q docs docs/_build/html
 	@echo "open docs/_build/html/api/index.html"
 
+# every benchmark figure the docs quote, regenerated into benchmarks/results/ (hours; the work-precision
+# study, `bearing-lab bench`, is one entry); `bench-quick` runs each script's smallest mode, to check the
+# runner only (its files say "quick: figures not for quoting": do not commit them).  MIRROR: the data folder.
 bench: install
-	$(VENV)/bin/bearing-lab bench
+	$(PY) benchmarks/run_all.py $(if $(MIRROR),--mirror $(MIRROR))
+
+bench-quick: install
+	$(PY) benchmarks/run_all.py --quick $(if $(MIRROR),--mirror $(MIRROR))
 
 study: install
 	$(VENV)/bin/bearing-lab study paper
