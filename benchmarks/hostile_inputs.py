@@ -208,7 +208,7 @@ def inflate_bomb(tmp: Path) -> int:
     p.write_bytes(_mat5_file([_compressed(stream)]))
     code = ("import resource, time, sys\nfrom bearing_lab import open_recording\nt = time.perf_counter()\n"
             "try:\n    open_recording(sys.argv[1], fs=12000)\n    out = 'read'\n"
-            "except Exception as e:\n    out = str(e)[-120:]\n"
+            "except Exception as e:\n    out = str(e)\n"
             "print(f'{time.perf_counter() - t:.2f} s, peak {resource.getrusage(resource.RUSAGE_SELF)"
             ".ru_maxrss / 1024:.0f} MB: {out}')")
     r = subprocess.run([sys.executable, "-c", code, str(p)], capture_output=True, text=True, timeout=600)
