@@ -27,6 +27,8 @@ import time
 import numpy as np
 
 from ..errors import ValidationCaseError
+from .identify_run import (POLISH_MAX_SCENES, POLISH_STARTS, PROFILE_MAX_SCENES, REFINE_MAX_SCENES, Journal, Progress,
+                           comparison_fingerprint, estimate, estimate_text)
 
 __all__ = ["Identification", "IdentificationInterrupted", "default_grid", "identify", "PARAMS"]
 
@@ -106,9 +108,9 @@ def default_grid(case) -> dict:
             "defect.skew_deg": [-60.0, -30.0, 0.0, 30.0, 60.0]}
 
 
-#: the refinement stops at this many scenes, or when its simplex is smaller than REFINE_XTOL of the
-#: coarse step in every parameter and its scores differ by less than REFINE_FTOL_DB
-REFINE_MAX_SCENES = 40
+#: the refinement stops at REFINE_MAX_SCENES (identify_run.py, with the other budgets), or when its simplex
+#: is smaller than REFINE_XTOL of the coarse step in every parameter and its scores differ by less than
+#: REFINE_FTOL_DB
 REFINE_XTOL = 1.0 / 16.0
 REFINE_FTOL_DB = 0.01
 
@@ -157,8 +159,6 @@ def _minimise(grid, start, score, keys, max_scenes, first_step=0.5):
                       "maxfev": max_scenes})
 
 
-#: a profile value is the best score over the other parameters found in at most this many scenes
-PROFILE_MAX_SCENES = 12
 
 
 def _walk_profiles(grid, best_point, score, best_score, thr, points, max_scenes=PROFILE_MAX_SCENES) -> dict:
@@ -196,9 +196,6 @@ def _walk_profiles(grid, best_point, score, best_score, thr, points, max_scenes=
     return prof
 
 
-#: the polish: at most this many starts, each a simplex search of at most POLISH_MAX_SCENES scenes
-POLISH_STARTS = 2
-POLISH_MAX_SCENES = 30
 
 
 def _polish(grid, walked, points, score, thr):
@@ -404,7 +401,6 @@ def identify(case, *, grid=None, refine=True, scheduler="serial", n_workers=None
     bearing_lab.validation.load_case, bearing_lab.validation.make_standin_recording
     """
     from .load import load_case
-    from .identify_run import Progress
     t_cpu, t_wall = time.process_time(), time.perf_counter()
     case = case if hasattr(case, "section") else load_case(case)
     declared = _declared(case)
@@ -453,7 +449,6 @@ def _stamped(res, resumed, est, setup_cpu):
 def _prepare(case, grid, refine, mirror, level_weight, threshold_db, journal, notify, t_cpu):
     """Before any scene: the grid checked, the comparison setting and base scene, the threshold from the
     recording's noise, the journal of an earlier run and the cost estimate (said through ``notify``)."""
-    from .identify_run import Journal, comparison_fingerprint, estimate, estimate_text
     bad = [k for k in grid if k not in PARAMS]
     if bad or not grid or any(not v for v in grid.values()):
         raise ValidationCaseError(f"identify: grid keys must be among {', '.join(PARAMS)} with at least one value "

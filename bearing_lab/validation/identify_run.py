@@ -36,12 +36,19 @@ REFINE_FEWEST = 100
 TABLE_CPU_LIKELY_S = {"aligned": 0.17, "skewed": 0.9}
 SCENE_CPU_LIKELY_S_PER_S = 0.15
 REFINE_LIKELY = 230
+#: the search's budgets (identify.py runs the search; the estimate bounds it from these):
+#: the refinement's simplex stops at REFINE_MAX_SCENES scenes; a profile value is the best score over
+#: the other parameters found in at most PROFILE_MAX_SCENES scenes; the polish makes at most
+#: POLISH_STARTS starts, each a simplex search of at most POLISH_MAX_SCENES scenes
+REFINE_MAX_SCENES = 40
+PROFILE_MAX_SCENES = 12
+POLISH_STARTS = 2
+POLISH_MAX_SCENES = 30
 
 
 def refine_budget(grid) -> int:
     """The most scenes the refinement can add (simplex, probes, walked profiles, polish): a bound, not a guess.
     Nelder-Mead may pass its budget by one shrink step (one scene per parameter) per search."""
-    from .identify import POLISH_MAX_SCENES, POLISH_STARTS, PROFILE_MAX_SCENES, REFINE_MAX_SCENES
     searched = [v for v in grid.values() if len(v) > 1]
     n = len(searched)
     walked = sum(2 * len(v) - 2 for v in searched)          # coarse values and half steps, the best apart
