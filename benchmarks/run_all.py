@@ -119,6 +119,8 @@ EXCLUDED = {
     "run_all.py": "this runner",
     "verdicts.py": "the verdict table the tests compare against; `make verdicts` (and `verdicts.py study`) "
                    "rewrite benchmarks/verdicts.csv and verdicts.md",
+    "analysis_fingerprint.py": "a check, not a figure: `dump` saves analyze's whole result on every mirror "
+                               "recording and `compare` lists what changed between two trees",
 }
 
 
