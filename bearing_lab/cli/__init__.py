@@ -88,13 +88,22 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
     return parser
 
 
+_WARNED: set = set()
+
+
 def _warning_line(message, category, filename, lineno, file=None, line=None):
-    """Warnings as one line on stderr (no source file and line, no code)."""
-    print(f"bearing-lab: warning: {message}", file=sys.stderr if file is None else file)
+    """Warnings as one line on stderr (no source file and line, no code), each text once per command
+    (a study or a validation simulates one scene several times and would repeat it)."""
+    text = str(message)
+    if text in _WARNED:
+        return
+    _WARNED.add(text)
+    print(f"bearing-lab: warning: {text}", file=sys.stderr if file is None else file)
 
 
 def main(argv=None) -> int:
     warnings.showwarning = _warning_line
+    _WARNED.clear()
     for stream in (sys.stdout, sys.stderr):  # a file name in another locale's bytes is printed
         try:                                 # with escapes, never a UnicodeEncodeError
             stream.reconfigure(errors="backslashreplace")
