@@ -89,7 +89,7 @@ def scipy_pipeline(x, fs, shaft_hz, bearing="6308", n_harmonics=5, tol=0.02):
     f = np.fft.rfftfreq(se.size, 1 / fs)
     found = {}
     for key, fe in ff.items():
-        m = (f > fe * (1 - tol)) & (f < fe * (1 + tol))
+        m = np.abs(f - fe) <= max(tol * fe, f[1])      # at least the nearest bin on a short record
         found[key] = float(f[m][np.argmax(spec[m])])
     metrics = {"rms": np.sqrt(np.mean(x ** 2)), "kurtosis": scipy.stats.kurtosis(x, fisher=False),
                "peak": np.max(np.abs(x)), "crest_factor": np.max(np.abs(x)) / np.sqrt(np.mean(x ** 2))}
