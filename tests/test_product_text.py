@@ -26,7 +26,8 @@ def _product_files():
     files = [ROOT / "README.md"]
     for r in roots:
         files += [p for p in r.rglob("*") if p.is_file() and p.suffix in TEXT_SUFFIXES
-                  and "cache" not in p.parts and "__pycache__" not in p.parts]
+                  and "cache" not in p.parts and "__pycache__" not in p.parts
+                  and "_build" not in p.parts]     # the built API reference is generated from the sources
     return files
 
 
