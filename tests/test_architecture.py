@@ -2,6 +2,7 @@
 another module's private names, and the public face serves exactly what ``__all__`` says."""
 import ast
 import fnmatch
+import json
 import os
 import subprocess
 import sys
@@ -256,7 +257,6 @@ print(json.dumps(out))
 def _import_alone(modules: list) -> list:
     """``(module, exit code, last error line)`` for each module, each imported first and alone: in a
     child forked from a fresh interpreter that has loaded only the third-party :data:`PRELOAD`."""
-    import json
     r = subprocess.run([sys.executable, "-c", _SERVER, json.dumps(PRELOAD), json.dumps(modules)],
                        capture_output=True, text=True, cwd=ROOT, timeout=600,
                        env={**os.environ, "PYTHONWARNINGS": "ignore"})
@@ -275,9 +275,8 @@ def test_the_import_check_catches_a_circle_and_a_missing_submodule_import(tmp_pa
     (pkg / "b.py").write_text("from .a import f\ndef g():\n    return 2\n")
     (pkg / "c.py").write_text("import matplotlib\nmatplotlib.pyplot.figure\n")
     (pkg / "d.py").write_text("import numpy\n")
-    code = (f"import sys; sys.path.insert(0, {str(tmp_path)!r}); sys.argv[1:] = sys.argv[1:];"
+    code = (f"import sys; sys.path.insert(0, {str(tmp_path)!r});"
             + "exec(" + repr(_SERVER) + ")")
-    import json
     r = subprocess.run([sys.executable, "-c", code, json.dumps(PRELOAD),
                         json.dumps(["circ.a", "circ.b", "circ.c", "circ.d"])],
                        capture_output=True, text=True, timeout=300)
@@ -313,7 +312,6 @@ def test_the_public_face_serves_what_all_says():
     code = ("import json, bearing_lab as b; ns = {}; exec('from bearing_lab import *', ns);"
             "print(json.dumps([b.__all__, dir(b), sorted(k for k in ns if k != '__builtins__'),"
             " b.__doc__, b._SUBPACKAGES]))")
-    import json
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     all_, dir_, star, doc, subpackages = json.loads(out.stdout)
     assert len(set(all_)) == len(all_)
