@@ -27,7 +27,8 @@ def _cmd_new(args) -> int:
     if not out.parent.exists():
         raise ValidationCaseError(f"-o {out}: directory {out.parent} does not exist")
     text = new_case_text(args.recording, name=args.name, bearing=args.bearing, speed=args.speed,
-                         channel=args.channel, fmt=args.format, case_dir=out.parent)
+                         channel=args.channel, fmt=args.format, sensitivity=args.sensitivity,
+                         case_dir=out.parent)
     with atomic_open(out, "w", encoding="utf-8") as fh:
         fh.write(text)
     notes = [line[len("# NOTE: "):] for line in text.splitlines() if line.startswith("# NOTE: ")]
@@ -78,6 +79,8 @@ def register(subparsers) -> None:
     n.add_argument("--speed", type=float, default=None, help="shaft speed, r/min (else the stored one, or 'estimate')")
     n.add_argument("--channel", default=None, help="channel to compare (default: the file's default channel)")
     n.add_argument("--format", default=None, help="reader name (default: sniffed)")
+    n.add_argument("--sensitivity", default=None,
+                   help="sensor sensitivity for channels stored in volts, e.g. 9.91mV/g (written to the case)")
     n.add_argument("--force", action="store_true", help="overwrite an existing case file")
     n.add_argument("--json", action="store_true", help="print the case file written and the notes as JSON")
     n.add_argument("-q", "--quiet", action="store_true", help="print nothing but the notes and errors")

@@ -131,7 +131,8 @@ def _seconds(v: float) -> str:
     return repr(math.floor(v * 1e4) / 1e4)
 
 
-def new_case_text(recording, *, name=None, bearing=None, speed=None, channel=None, fmt=None, case_dir=None) -> str:
+def new_case_text(recording, *, name=None, bearing=None, speed=None, channel=None, fmt=None, sensitivity=None,
+                  case_dir=None) -> str:
     """The text of a starting case for ``recording`` (see the module docstring).
 
     What the file tells (rate, length, channels, speed) is filled in; what it cannot tell (bearing,
@@ -149,6 +150,9 @@ def new_case_text(recording, *, name=None, bearing=None, speed=None, channel=Non
         Shaft speed, r/min (default: the one the file stores).
     channel, fmt : str, optional
         Channel to compare and reader name (default: the file's default channel, sniffed format).
+    sensitivity : str, optional
+        Sensor sensitivity for channels stored in volts, e.g. ``"9.91mV/g"``; written to the case's
+        ``[recording]`` table so that ``validate`` reads the file the same way.
     case_dir : str or path, optional
         Where the case will be written; the recording is then named relative to it.
 
@@ -173,7 +177,8 @@ def new_case_text(recording, *, name=None, bearing=None, speed=None, channel=Non
     """
     from ..io import open_recording
     path = Path(recording)
-    ds = open_recording(path, **({"format": fmt} if fmt else {}))
+    opts = {k: v for k, v in (("format", fmt), ("sensitivity", sensitivity)) if v}
+    ds = open_recording(path, **opts)
     ch = channel or ds.attrs.get("default_channel") or next(iter(ds.data_vars))
     fs = float(ds.attrs["sampling_rate_hz"])
     dur = ds.sizes["time"] / fs
@@ -193,6 +198,8 @@ def new_case_text(recording, *, name=None, bearing=None, speed=None, channel=Non
              *_speed_lines(ds, speed), "", "[recording]",
              f"file = \"{_relative(path, case_dir)}\"",
              f"channel = \"{ch}\"", *( [f"format = \"{fmt}\""] if fmt else []),
+             *([f"sensitivity = \"{sensitivity}\"       # the sensor's, for the channels stored in volts"]
+               if sensitivity else []),
              "scale = 1.0                    # calibration factor on the SI values (1: the file is calibrated)",
              "start_s = 0.0                  # start of the compared segment, s",
              f"duration_s = {_seconds(compared)}{' ' * max(1, 17 - len(_seconds(compared)))}# compared and simulated "
