@@ -21,6 +21,11 @@ def _now() -> str:
     return _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M:%S UTC")
 
 
+def _head(title: str) -> str:
+    """The document head every page shares (``head.html``: title, the inline stylesheet)."""
+    return template("head.html").substitute(title=esc(title), css=css())
+
+
 def _anchor(title: str, used: set) -> str:
     a = re.sub(r"[^a-z0-9]+", "-", title.lower()).strip("-") or "section"
     base, i = a, 1
@@ -158,13 +163,13 @@ class Report:
             secs.append(template("section.html").substitute(anchor=a, title=esc(s["title"]), body=s["html"]))
         if not self.verdict:
             return template("page.html").substitute(
-                title=esc(self.title), subtitle=esc(self.subtitle), css=css(), toc=" ".join(toc),
+                head=_head(self.title), title=esc(self.title), subtitle=esc(self.subtitle), toc=" ".join(toc),
                 sections="\n".join(secs), date=_now(), version=__version__)
         n_pass = sum(bool(r.get("pass")) for r in self.rows)
         n_known = sum(bool(r.get("known_limitation")) and not r.get("pass") for r in self.rows)
         cls, text = self.status()
         return template("case.html").substitute(
-            title=esc(self.title), subtitle=esc(self.subtitle), css=css(), toc=" ".join(toc),
+            head=_head(self.title), title=esc(self.title), subtitle=esc(self.subtitle), toc=" ".join(toc),
             sections="\n".join(secs), n_pass=n_pass, n_rows=len(self.rows), status_class=cls, status_text=text,
             known=f" ({n_known} failing as limitations the case declares)" if n_known else "", date=_now(),
             version=__version__)
@@ -227,7 +232,7 @@ def write_index(path, entries: list, *, title="bearing_lab validation", notes=()
     True
     """
     notes_html = "".join(f'<p class="note">{esc(n)}</p>' for n in notes)
-    page = template("index.html").substitute(title=esc(title), css=css(), date=_now(), version=__version__,
+    page = template("index.html").substitute(head=_head(title), title=esc(title), date=_now(), version=__version__,
                                               rows=index_rows(entries), notes=notes_html,
                                               verdicts=opening)
     path = Path(path)
