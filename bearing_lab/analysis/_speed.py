@@ -242,14 +242,26 @@ def harmonic_family(x, fs, lo, hi, *, n_harmonics, method, mains_hz=(), rpm_give
     SNR_h * h**harmonic_weight (2 for noise-limited lines, the Cramer-Rao
     scaling; 0 where lines broaden with h, as for impacts with random slip).
     """
+    df = fs / x.size
+    nh = int(max(1, min(n_harmonics, np.floor(fs / 2 * 0.9 / hi))))
+    X, amp, snr, masked, score_spec = _family_spectrum(x, fs, method, nh * hi, mains_hz)
+    f0 = _family_search(score_spec, df, lo, hi, nh)
+    f0 = _octave_check(score_spec, df, f0, lo, nh, rpm_given, fmin)
+    fr, n_lines, best = _refine(X, amp, snr, masked, df, f0, nh, method, harmonic_weight)
+    return (fr, n_lines, best) if details else (fr, n_lines)
+
+
+def _family_spectrum(x, fs, method, f_top, mains_hz):
+    """The windowed DFT up to a little above ``f_top`` Hz, its amplitude, the line-to-floor ratio
+    (dB, capped at SNR_CAP_DB), the bins next to mains harmonics and the score spectrum (clear
+    lines only, mains masked)."""
     n = x.size
     df = fs / n
     xw = x - x.mean()
     if method == "hann":
         w = np.hanning(n + 1)[:-1]
         xw = xw * w
-    nh = int(max(1, min(n_harmonics, np.floor(fs / 2 * 0.9 / hi))))
-    top = min(int(np.ceil(nh * hi * 1.02 / df)) + 64, n // 2)
+    top = min(int(np.ceil(f_top * 1.02 / df)) + 64, n // 2)
     X = _fft.rfft(xw)[: top + 2]
     amp = np.abs(X)
     snr = line_floor_db(amp, width=max(31, int(round(10.0 / df))))
@@ -262,12 +274,17 @@ def harmonic_family(x, fs, lo, hi, *, n_harmonics, method, mains_hz=(), rpm_give
     # only clear lines count (>= LINE_SNR_DB): noise bins would otherwise add a
     # few dB per harmonic and a long family of noise could outscore one true line
     score_spec = np.where(masked | (snr < LINE_SNR_DB), 0.0, snr)
+    return X, amp, snr, masked, score_spec
+
+
+def _family_search(score_spec, df, lo, hi, nh):
+    """The candidate f0 in [lo, hi] whose first ``nh`` harmonics score best."""
     # candidates: step so that the highest harmonic moves by at most half a bin
     step = 0.5 * df / nh
     cand = np.arange(lo, hi + step, step)
     h = np.arange(1, nh + 1)
     pos = np.rint(cand[:, None] * h[None, :] / df).astype(int)
-    pos = np.clip(pos, 1, amp.size - 2)
+    pos = np.clip(pos, 1, score_spec.size - 2)
     vals = np.maximum(np.maximum(score_spec[pos - 1], score_spec[pos]), score_spec[pos + 1])
     # harmonic weights 0.9**(h-1) (Hermes' compression) break the tie between a
     # lone line and its sub-harmonics in favour of the line itself
@@ -278,11 +295,15 @@ def harmonic_family(x, fs, lo, hi, *, n_harmonics, method, mains_hz=(), rpm_give
     j = i_best
     while j + 1 < score.size and score[j + 1] >= score[i_best]:
         j += 1
-    f0 = float(0.5 * (cand[i_best] + cand[j]))
-    # octave check: a family of even harmonics (2 f_r next to mains, say) also
-    # scores well at 2 f_r; prefer f0/d when at least half (and 3) of the first
-    # n_harmonics harmonics of f0/d that are not harmonics of f0 are clear lines
-    # (a noise bin passes with chance ~3e-3; a true family passes nearly all).
+    return float(0.5 * (cand[i_best] + cand[j]))
+
+
+def _octave_check(score_spec, df, f0, lo, nh, rpm_given, fmin):
+    """``f0 / 2`` or ``f0 / 3`` when their own odd lines are present, else ``f0``."""
+    # a family of even harmonics (2 f_r next to mains, say) also scores well at 2 f_r;
+    # prefer f0/d when at least half (and 3) of the first n_harmonics harmonics of f0/d
+    # that are not harmonics of f0 are clear lines (a noise bin passes with chance ~3e-3;
+    # a true family passes nearly all).
     for d in (2, 3):
         sub = f0 / d
         if sub < lo * (1 - 1e-9) and rpm_given:
@@ -291,14 +312,18 @@ def harmonic_family(x, fs, lo, hi, *, n_harmonics, method, mains_hz=(), rpm_give
             continue
         hh = np.array([j for j in range(1, nh + 1) if j % d])
         kk = np.rint(hh * sub / df).astype(int)
-        kk = kk[(kk >= 1) & (kk < amp.size - 1)]
+        kk = kk[(kk >= 1) & (kk < score_spec.size - 1)]
         peak = np.maximum(np.maximum(score_spec[kk - 1], score_spec[kk]), score_spec[kk + 1])
         if np.count_nonzero(peak >= LINE_SNR_DB) >= max(3, 0.5 * hh.size):
-            f0 = sub
-            break
-    # refinement
+            return sub
+    return f0
+
+
+def _refine(X, amp, snr, masked, df, f0, nh, method, harmonic_weight):
+    """(f_r, lines used, best line SNR dB): every clear harmonic of ``f0`` interpolated, then the
+    weighted least squares of ``f_h = h f_r`` (``f0`` and 0 lines when none stands clear)."""
     est, wts, hs, snrs = [], [], [], []
-    for hh in h:
+    for hh in range(1, nh + 1):
         k0 = int(round(hh * f0 / df))
         if k0 + 2 >= amp.size or k0 < 2:
             continue
@@ -314,7 +339,7 @@ def harmonic_family(x, fs, lo, hi, *, n_harmonics, method, mains_hz=(), rpm_give
         snrs.append(float(snr[k]))
         hs.append(hh)
     if not est:
-        return (f0, 0, 0.0) if details else (f0, 0)
+        return f0, 0, 0.0
     est, wts, hs = np.array(est), np.array(wts), np.array(hs)
     good = np.ones(est.size, bool)
     for _ in range(3):
@@ -326,6 +351,4 @@ def harmonic_family(x, fs, lo, hi, *, n_harmonics, method, mains_hz=(), rpm_give
     # weighted LS of f_h = h f_r with weights SNR_h: the mean of f_h/h weighted by SNR_h h**2
     # (with harmonic_weight=2; see the docstring)
     fr = float(np.sum(wts[good] * est[good] / hs[good]) / np.sum(wts[good]))
-    if details:
-        return fr, int(good.sum()), float(max(snrs))
-    return fr, int(good.sum())
+    return fr, int(good.sum()), float(max(snrs))
