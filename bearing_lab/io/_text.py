@@ -6,9 +6,13 @@ first bad cell by row and column instead of a bare ``ValueError``.
 """
 from __future__ import annotations
 
+from pathlib import Path
 import re
 
 import numpy as np
+
+from .. import units as _units
+from ..errors import RecordingError
 
 _NUM = re.compile(r"^\s*[-+]?(?:\d+(?:[.,]\d*)?|[.,]\d+)(?:[eEdD][-+]?\d+)?\s*$")
 
@@ -29,6 +33,49 @@ def looks_binary(raw: bytes) -> bool:
         return True
     ctrl = sum(1 for c in raw[:4096] if c < 32 and c not in (9, 10, 13))
     return ctrl > 0.01 * max(len(raw[:4096]), 1)
+
+
+def read_text(path, fail, not_what: str) -> tuple[bytes, str, str]:
+    """Return (bytes, text, encoding) of a text file; ``fail("binary content: " + not_what)``
+    when its first 64 KiB are not text."""
+    raw = Path(path).read_bytes()
+    if looks_binary(raw[:65536]):
+        fail(f"binary content: {not_what}")
+    text, enc = decode(raw)
+    return raw, text, enc
+
+
+def known_unit(label):
+    """The :class:`bearing_lab.units.Unit` of a unit label, or None (no label, or an unknown one)."""
+    if not label:
+        return None
+    try:
+        return _units.lookup_unit(label)
+    except RecordingError:
+        return None
+
+
+def first_non_increasing(t) -> int | None:
+    """Index ``k`` of the first step ``t[k + 1] - t[k]`` that is not positive (0 when ``t`` has
+    fewer than two values), or None when the times strictly increase."""
+    dt = np.diff(t)
+    if dt.size and np.all(dt > 0):
+        return None
+    return int(np.flatnonzero(~(dt > 0))[0]) if dt.size else 0
+
+
+def is_uniform(dt) -> bool:
+    """True when every time step is within 0.1 % of the median step."""
+    med = float(np.median(dt))
+    return not np.max(np.abs(dt - med)) > 1e-3 * med + 1e-12
+
+
+def column_rate(t) -> float:
+    """The rate of a uniform time column, Hz, snapped to a whole number within 1 ppm."""
+    rate = (t.size - 1) / (t[-1] - t[0])
+    if abs(rate - round(rate)) < 1e-6 * rate:
+        rate = float(round(rate))
+    return rate
 
 
 def is_number(s: str) -> bool:

@@ -17,7 +17,8 @@ import numpy as np
 from .. import units as _units
 from ..errors import RecordingError
 from ._base import ENGINES, RecordingBuilder, RecordingReader, clean_name
-from ._text import decode, is_number, looks_binary, parse_table
+from ._text import (column_rate, decode, first_non_increasing, is_number, is_uniform, known_unit,
+                    looks_binary, parse_table, read_text)
 
 _UNIT_IN_NAME = re.compile(r"^(.*?)\s*[\[(]\s*([^\])]+?)\s*[\])]\s*$")
 _TIME_NAMES = {"time", "t", "zeit", "x", "time_s", "timestamp", "seconds", "sec", "s"}
@@ -88,104 +89,19 @@ class CsvReader(RecordingReader):
         """
         path = Path(path)
         b = RecordingBuilder(path, self, units=units, sensitivity=sensitivity, checksum=checksum)
-        raw = path.read_bytes()
-        if looks_binary(raw[:65536]):
-            b.fail("binary content: not a delimited text file (pass format= if you know it)")
-        text, enc = decode(raw)
+        raw, text, enc = read_text(path, b.fail, "not a delimited text file (pass format= if you know it)")
         if not raw.endswith((b"\n", b"\r")):
             b.warn("the last line has no line break: if the file was cut short, its last row is "
                    "incomplete (a CSV declares no length, so this cannot be checked)")
         lines = [ln for ln in text.splitlines()]
-        nonblank = [(i, ln) for i, ln in enumerate(lines) if ln.strip()]
-        if not nonblank:
-            b.fail("no text lines")
-        delim = _delimiter([ln for _, ln in nonblank[:50]])
-        header_rows = []
-        first = None
-        for i, ln in nonblank:
-            cells = [c.strip().strip('"') for c in _split(ln, delim)]
-            if all(is_number(c) or (delim != "," and is_number(c.replace(",", "."))) for c in cells
-                   if c) and any(cells):
-                first = i
-                break
-            header_rows.append(cells)
-            if len(header_rows) > 3:
-                b.fail("more than 3 non-numeric lines before the data: not a plain CSV/TSV "
-                       "(a header of names and an optional units row are understood)")
-        if first is None:
-            b.fail("no numeric data rows")
+        delim, header_rows, first = _header_and_first_row(lines, b)
         rows = [[c.strip().strip('"') for c in _split(ln, delim)] for ln in lines[first:] if ln.strip()]
         ncol = len(rows[0])
         decimal_comma = delim != "," and any("," in c for c in rows[0])
         vals = parse_table(rows, first + 1, b.fail, decimal_comma)
-        names = header_rows[0] if header_rows else [f"ch{j + 1}" for j in range(ncol)]
-        if len(names) != ncol:
-            b.fail(f"header has {len(names)} names for {ncol} data columns")
-        col_units = [""] * ncol
-        for j, nm in enumerate(names):
-            m = _UNIT_IN_NAME.match(nm)
-            if m:
-                names[j], col_units[j] = m.group(1).strip(), m.group(2)
-        if len(header_rows) >= 2:
-            row = header_rows[1]
-            if len(row) != ncol:
-                b.fail(f"units row has {len(row)} entries for {ncol} data columns")
-            col_units = [u or cu for u, cu in zip(row, col_units)]
-        # time column
-        tcol = None
-        if time_column is not None:
-            if isinstance(time_column, int) or str(time_column).isdigit():
-                tcol = int(time_column)
-            elif time_column in names:
-                tcol = names.index(time_column)
-            else:
-                b.fail(f"time_column={time_column!r} not among the columns {names}")
-        else:
-            for j, nm in enumerate(names):
-                unit_is_time = False
-                if col_units[j]:
-                    try:
-                        unit_is_time = _units.lookup_unit(col_units[j]).quantity == "time"
-                    except RecordingError:
-                        pass
-                if nm.lower() in _TIME_NAMES or unit_is_time:
-                    tcol = j
-                    break
-        time = None
-        t0 = 0.0
-        if tcol is not None:
-            tu = col_units[tcol] or "s"
-            try:
-                tu = _units.lookup_unit(tu)
-            except RecordingError as exc:
-                b.fail(f"time column {names[tcol]!r}: {exc}")
-            t = vals[:, tcol] * tu.factor
-            if fs is None:
-                dt = np.diff(t)
-                if dt.size == 0 or not np.all(dt > 0):
-                    bad = int(np.flatnonzero(~(dt > 0))[0]) if dt.size else 0
-                    b.fail(f"time column {names[tcol]!r} is not strictly increasing (line "
-                           f"{first + bad + 2}); repair it, or pass fs= to ignore it")
-                med = float(np.median(dt))
-                if np.max(np.abs(dt - med)) > 1e-3 * med + 1e-12:
-                    if not allow_uneven:
-                        b.fail(f"time column {names[tcol]!r} is not uniformly sampled (steps "
-                               f"{dt.min():.6g} to {dt.max():.6g} s); pass fs=<Hz> to use a "
-                               "nominal rate, or allow_uneven=True to keep the times")
-                    b.warn("uneven time column kept as the time coordinate")
-                    b.attrs["uneven_time"] = 1
-                    time = t
-                else:
-                    fs = (t.size - 1) / (t[-1] - t[0])
-                    if abs(fs - round(fs)) < 1e-6 * fs:
-                        fs = float(round(fs))
-                    t0 = float(t[0])
-            else:
-                t0 = float(t[0])
-                b.attrs["time_column_ignored"] = names[tcol]
-        elif fs is None:
-            b.fail("no time column (time, t, or a column in s) and no rate; pass fs=<Hz> "
-                   "(CLI --fs)")
+        names, col_units = _names_and_units(header_rows, ncol, b)
+        tcol = _time_column(names, col_units, time_column, b)
+        fs, t0, time = _time_base(b, vals, names, col_units, tcol, first, fs, allow_uneven)
         for j in range(ncol):
             if j == tcol:
                 continue
@@ -194,6 +110,98 @@ class CsvReader(RecordingReader):
         b.attrs["text_encoding"] = enc
         b.attrs["csv_delimiter"] = {None: "blank", "\t": "tab"}.get(delim, delim)
         return b.build(fs=fs if time is None else None, t0=t0, time=time, channels=channels)
+
+
+def _header_and_first_row(lines, b):
+    """The delimiter, the header rows (cells) and the index of the first numeric line."""
+    nonblank = [(i, ln) for i, ln in enumerate(lines) if ln.strip()]
+    if not nonblank:
+        b.fail("no text lines")
+    delim = _delimiter([ln for _, ln in nonblank[:50]])
+    header_rows = []
+    first = None
+    for i, ln in nonblank:
+        cells = [c.strip().strip('"') for c in _split(ln, delim)]
+        if all(is_number(c) or (delim != "," and is_number(c.replace(",", "."))) for c in cells
+               if c) and any(cells):
+            first = i
+            break
+        header_rows.append(cells)
+        if len(header_rows) > 3:
+            b.fail("more than 3 non-numeric lines before the data: not a plain CSV/TSV "
+                   "(a header of names and an optional units row are understood)")
+    if first is None:
+        b.fail("no numeric data rows")
+    return delim, header_rows, first
+
+
+def _names_and_units(header_rows, ncol, b):
+    """Column names and units: ``name [unit]`` / ``name (unit)`` headers, then a units row."""
+    names = header_rows[0] if header_rows else [f"ch{j + 1}" for j in range(ncol)]
+    if len(names) != ncol:
+        b.fail(f"header has {len(names)} names for {ncol} data columns")
+    col_units = [""] * ncol
+    for j, nm in enumerate(names):
+        m = _UNIT_IN_NAME.match(nm)
+        if m:
+            names[j], col_units[j] = m.group(1).strip(), m.group(2)
+    if len(header_rows) >= 2:
+        row = header_rows[1]
+        if len(row) != ncol:
+            b.fail(f"units row has {len(row)} entries for {ncol} data columns")
+        col_units = [u or cu for u, cu in zip(row, col_units)]
+    return names, col_units
+
+
+def _time_column(names, col_units, time_column, b):
+    """Index of the time column: the one asked for, else the first named like time or in a
+    time unit, else None."""
+    if time_column is not None:
+        if isinstance(time_column, int) or str(time_column).isdigit():
+            return int(time_column)
+        if time_column in names:
+            return names.index(time_column)
+        b.fail(f"time_column={time_column!r} not among the columns {names}")
+    for j, nm in enumerate(names):
+        unit = known_unit(col_units[j])
+        if nm.lower() in _TIME_NAMES or (unit is not None and unit.quantity == "time"):
+            return j
+    return None
+
+
+def _time_base(b, vals, names, col_units, tcol, first, fs, allow_uneven):
+    """(fs, t0, time): the rate from ``fs`` or a uniform time column, or an uneven time column
+    kept as the time coordinate (``allow_uneven``)."""
+    time = None
+    t0 = 0.0
+    if tcol is None:
+        if fs is None:
+            b.fail("no time column (time, t, or a column in s) and no rate; pass fs=<Hz> "
+                   "(CLI --fs)")
+        return fs, t0, time
+    tu = col_units[tcol] or "s"
+    try:
+        tu = _units.lookup_unit(tu)
+    except RecordingError as exc:
+        b.fail(f"time column {names[tcol]!r}: {exc}")
+    t = vals[:, tcol] * tu.factor
+    if fs is not None:
+        b.attrs["time_column_ignored"] = names[tcol]
+        return fs, float(t[0]), time
+    bad = first_non_increasing(t)
+    if bad is not None:
+        b.fail(f"time column {names[tcol]!r} is not strictly increasing (line "
+               f"{first + bad + 2}); repair it, or pass fs= to ignore it")
+    dt = np.diff(t)
+    if not is_uniform(dt):
+        if not allow_uneven:
+            b.fail(f"time column {names[tcol]!r} is not uniformly sampled (steps "
+                   f"{dt.min():.6g} to {dt.max():.6g} s); pass fs=<Hz> to use a "
+                   "nominal rate, or allow_uneven=True to keep the times")
+        b.warn("uneven time column kept as the time coordinate")
+        b.attrs["uneven_time"] = 1
+        return fs, t0, t
+    return column_rate(t), float(t[0]), time
 
 
 ENGINES["csv"] = CsvReader

@@ -16,10 +16,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import units as _units
-from ..errors import RecordingError
 from ._base import ENGINES, RecordingBuilder, RecordingReader, clean_name
-from ._text import decode, is_number, looks_binary, parse_table
+from ._text import (column_rate, decode, first_non_increasing, is_number, is_uniform, known_unit,
+                    looks_binary, parse_table, read_text)
 
 _INC_KEYS = ("increment", "x increment", "delta t", "dt", "time increment", "abscissa increment",
              "sampling interval")
@@ -74,103 +73,14 @@ class TestlabTextReader(RecordingReader):
         """
         path = Path(path)
         b = RecordingBuilder(path, self, units=units, sensitivity=sensitivity, checksum=checksum)
-        raw = path.read_bytes()
-        if looks_binary(raw[:65536]):
-            b.fail("binary content: not a Testlab text export")
-        text, enc = decode(raw)
-        lines = text.splitlines()
-        start = None
-        for i, ln in enumerate(lines):
-            f = [c for c in ln.split("\t")]
-            if ln.strip() and all(is_number(c) for c in f if c.strip()) and \
-                    sum(1 for c in f if c.strip()) >= 1 and i > 0:
-                start = i
-                break
-        if start is None:
-            b.fail("no numeric data rows after the header")
-        data_rows = [ln.split("\t") for ln in lines[start:] if ln.strip()]
+        _, text, enc = read_text(path, b.fail, "not a Testlab text export")
+        start, data_rows, meta, table = _split(text.splitlines(), b)
         ncol = len(data_rows[0])
-        while ncol > 1 and all(not r[-1].strip() for r in data_rows[:5]):
-            data_rows = [r[:-1] if len(r) == ncol else r for r in data_rows]
-            ncol -= 1
-        hdr = []
-        for ln in lines[:start]:
-            f = [c.strip() for c in ln.split("\t")]
-            while f and not f[-1]:
-                f.pop()
-            if f:
-                hdr.append(f)
-        # the rows right above the numbers with as many fields as the data: names/units/format
-        k, table = len(hdr), []
-        while k > 0 and len(hdr[k - 1]) == ncol and len(table) < 3:
-            table.insert(0, hdr[k - 1])
-            k -= 1
-        meta = {}
-        for f in hdr[:k]:
-            meta[f[0].rstrip(":").lower()] = "\t".join(f[1:])
         decimal_comma = any("," in c for c in data_rows[0]) and not any(
             "." in c for c in data_rows[0])
         vals = parse_table(data_rows, start + 1, b.fail, decimal_comma)
-        names, unit_row = None, None
-        for row in table:
-            low = {c.lower() for c in row if c}
-            if low and low <= _FORMAT_WORDS:
-                continue
-            known = 0
-            for c in row:
-                try:
-                    _units.lookup_unit(c)
-                    known += 1
-                except RecordingError:
-                    pass
-            if known >= max(1, (ncol + 1) // 2) and unit_row is None:
-                unit_row = row
-            elif names is None:
-                names = row
-        if names is None:
-            names = [f"ch{j + 1}" for j in range(ncol)]
-        if unit_row is None:
-            unit_row = [""] * ncol
-        # time base
-        t = None
-        tcol = None
-        try:
-            u0 = _units.lookup_unit(unit_row[0]) if unit_row[0] else None
-        except RecordingError:
-            u0 = None
-        if (u0 is not None and u0.quantity == "time") or names[0].lower() in ("time", "x", "t"):
-            tcol = 0
-            t = vals[:, 0] * (u0.factor if u0 is not None else 1.0)
-        def _meta_float(keys):
-            for k in keys:
-                if k in meta:
-                    m = re.search(r"[-+]?\d+(?:[.,]\d*)?(?:[eE][-+]?\d+)?", meta[k])
-                    if m:
-                        return float(m.group(0).replace(",", "."))
-            return None
-        inc, mfs, t0 = _meta_float(_INC_KEYS), _meta_float(_FS_KEYS), _meta_float(_START_KEYS)
-        if fs is not None:
-            rate, start_t = float(fs), (t[0] if t is not None else (t0 or 0.0))
-        elif t is not None:
-            dt = np.diff(t)
-            if dt.size == 0 or not np.all(dt > 0):
-                b.fail("the time column is not strictly increasing; repair it or pass fs=")
-            med = float(np.median(dt))
-            if np.max(np.abs(dt - med)) > 1e-3 * med + 1e-12:
-                b.fail(f"the time column is not uniformly sampled (steps from {dt.min():.6g} to "
-                       f"{dt.max():.6g} s); pass fs=<Hz> to use the nominal rate")
-            rate = (t.size - 1) / (t[-1] - t[0])
-            if inc:
-                rate = 1.0 / inc
-            elif abs(rate - round(rate)) < 1e-6 * rate:
-                rate = float(round(rate))
-            start_t = float(t[0])
-        elif inc or mfs:
-            rate = 1.0 / inc if inc else mfs
-            start_t = t0 or 0.0
-        else:
-            b.fail("no time column and no increment/sampling frequency in the header; pass "
-                   "fs=<Hz>")
+        names, unit_row = _names_and_units(table, ncol)
+        rate, start_t, tcol = _time_base(b, vals, names, unit_row, meta, fs)
         for j in range(ncol):
             if j == tcol:
                 continue
@@ -182,6 +92,95 @@ class TestlabTextReader(RecordingReader):
         if decimal_comma:
             b.attrs["decimal_comma"] = 1
         return b.build(fs=rate, t0=start_t, channels=channels)
+
+
+def _split(lines, b):
+    """(index of the first numeric line, the data rows' cells, the header's key -> value, the
+    rows right above the numbers with as many fields as the data: names, units, format)."""
+    start = None
+    for i, ln in enumerate(lines):
+        f = [c for c in ln.split("\t")]
+        if ln.strip() and all(is_number(c) for c in f if c.strip()) and \
+                sum(1 for c in f if c.strip()) >= 1 and i > 0:
+            start = i
+            break
+    if start is None:
+        b.fail("no numeric data rows after the header")
+    data_rows = [ln.split("\t") for ln in lines[start:] if ln.strip()]
+    ncol = len(data_rows[0])
+    while ncol > 1 and all(not r[-1].strip() for r in data_rows[:5]):
+        data_rows = [r[:-1] if len(r) == ncol else r for r in data_rows]
+        ncol -= 1
+    hdr = []
+    for ln in lines[:start]:
+        f = [c.strip() for c in ln.split("\t")]
+        while f and not f[-1]:
+            f.pop()
+        if f:
+            hdr.append(f)
+    k, table = len(hdr), []
+    while k > 0 and len(hdr[k - 1]) == ncol and len(table) < 3:
+        table.insert(0, hdr[k - 1])
+        k -= 1
+    meta = {}
+    for f in hdr[:k]:
+        meta[f[0].rstrip(":").lower()] = "\t".join(f[1:])
+    return start, data_rows, meta, table
+
+
+def _names_and_units(table, ncol):
+    """The names row and the units row among the rows above the numbers (a format row skipped)."""
+    names, unit_row = None, None
+    for row in table:
+        low = {c.lower() for c in row if c}
+        if low and low <= _FORMAT_WORDS:
+            continue
+        known = sum(1 for c in row if known_unit(c) is not None)
+        if known >= max(1, (ncol + 1) // 2) and unit_row is None:
+            unit_row = row
+        elif names is None:
+            names = row
+    if names is None:
+        names = [f"ch{j + 1}" for j in range(ncol)]
+    if unit_row is None:
+        unit_row = [""] * ncol
+    return names, unit_row
+
+
+def _meta_float(meta, keys):
+    for k in keys:
+        if k in meta:
+            m = re.search(r"[-+]?\d+(?:[.,]\d*)?(?:[eE][-+]?\d+)?", meta[k])
+            if m:
+                return float(m.group(0).replace(",", "."))
+    return None
+
+
+def _time_base(b, vals, names, unit_row, meta, fs):
+    """(rate, start time, index of the time column or None), in order: ``fs``; a uniform time
+    column; the header's increment or sampling frequency."""
+    t = None
+    tcol = None
+    u0 = known_unit(unit_row[0])
+    if (u0 is not None and u0.quantity == "time") or names[0].lower() in ("time", "x", "t"):
+        tcol = 0
+        t = vals[:, 0] * (u0.factor if u0 is not None else 1.0)
+    inc, mfs, t0 = _meta_float(meta, _INC_KEYS), _meta_float(meta, _FS_KEYS), _meta_float(meta, _START_KEYS)
+    if fs is not None:
+        return float(fs), (t[0] if t is not None else (t0 or 0.0)), tcol
+    if t is not None:
+        if first_non_increasing(t) is not None:
+            b.fail("the time column is not strictly increasing; repair it or pass fs=")
+        dt = np.diff(t)
+        if not is_uniform(dt):
+            b.fail(f"the time column is not uniformly sampled (steps from {dt.min():.6g} to "
+                   f"{dt.max():.6g} s); pass fs=<Hz> to use the nominal rate")
+        rate = 1.0 / inc if inc else column_rate(t)
+        return rate, float(t[0]), tcol
+    if inc or mfs:
+        return (1.0 / inc if inc else mfs), t0 or 0.0, tcol
+    b.fail("no time column and no increment/sampling frequency in the header; pass "
+           "fs=<Hz>")
 
 
 ENGINES["testlab_text"] = TestlabTextReader
