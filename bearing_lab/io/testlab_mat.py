@@ -88,80 +88,97 @@ class TestlabMatReader(RecordingReader):
         m = load_mat(path, variable_names=sigs)
         chan_rt = {}
         for var in sigs:
-            s = m.get(var)
-            if not isinstance(s, dict) or "y_values" not in s or "x_values" not in s:
-                b.fail(f"variable {var!r} is not a Testlab Signal struct (needs fields x_values "
-                       f"and y_values; has {', '.join(s) if isinstance(s, dict) else type(s).__name__})")
-            xv, yv, fr = s["x_values"], s["y_values"], s.get("function_record", {}) or {}
-            try:
-                start = float(_get(xv, "start_value", default=0.0))
-                inc = float(_get(xv, "increment"))
-                nval = int(_get(xv, "number_of_values", default=-1))
-            except (TypeError, ValueError):
-                b.fail(f"{var}.x_values has no usable start_value/increment/number_of_values")
-            if not (np.isfinite(inc) and inc > 0):
-                b.fail(f"{var}.x_values.increment is {inc!r}; expected a positive time step")
-            vals = np.asarray(_get(yv, "values"))
-            if vals.dtype.kind not in "iuf" or vals.size == 0:
-                b.fail(f"{var}.y_values.values is missing or not numeric")
-            if vals.ndim == 1:
-                vals = vals[:, None]
-            if vals.ndim != 2:
-                b.fail(f"{var}.y_values.values has shape {vals.shape}; expected N or N×C")
-            if nval >= 0 and vals.shape[0] != nval:
-                if vals.shape[1] == nval:
-                    vals = vals.T
-                else:
-                    b.fail(f"{var}: x_values.number_of_values is {nval} but y_values.values has "
-                           f"{vals.shape[0]} rows: truncated or corrupt export")
-            label = _get(yv, "quantity", "label", default="")
-            factor = float(_get(yv, "quantity", "unit_transformation", "factor", default=1.0))
-            offset = float(_get(yv, "quantity", "unit_transformation", "offset", default=0.0))
-            point = _get(fr, "name", default="") or var
-            point = point if isinstance(point, str) else ", ".join(map(str, point))
-            base = clean_name(point.split(":", 1)[-1] if ":" in point else point, var)
-            attrs = {"testlab_variable": var, "testlab_name": point,
-                     "testlab_creation_time": _get(fr, "creation_time"),
-                     "testlab_primary_channel": _get(fr, "primary_channel", "label"),
-                     "testlab_unit_factor": factor, "testlab_unit_offset": offset}
-            ann = _get(fr, "TL_export_properties_annotation", default={}) or {}
-            for k in ("project_name", "section_name", "run_name", "absolute_time", "channel_group"):
-                if isinstance(ann, dict) and isinstance(ann.get(k), str):
-                    attrs[f"testlab_{k}"] = ann[k]
-            ncol = vals.shape[1]
-            for j in range(ncol):
-                cname = base if ncol == 1 else f"{base}_{j + 1}"
-                y = vals[:, j].astype(np.float64)
-                stored_si = True
-                try:
-                    u = _units.lookup_unit(units if isinstance(units, str) else
-                                           (units or {}).get(cname, label), what="")
-                    stored_si = offset == 0.0 and abs(factor * u.factor - 1.0) < 1e-9
-                except RecordingError:
-                    u = None  # add_channel reports the unknown label
-                if not stored_si and u is not None:
-                    b.warn(f"{var}: unit_transformation (factor {factor:g}, offset {offset:g}) "
-                           f"does not match the label {label!r}: values converted through it")
-                    y = y * factor + offset
-                got = b.add_channel(cname, y, label, already_si=stored_si, attrs=attrs,
-                                    file_name=cname)
-                chan_rt[got] = (1.0 / inc, start, var)
-        sel = list(chan_rt) if channels is None else \
-            [c for c in ([channels] if isinstance(channels, str) else channels) if c in chan_rt]
-        if len({(round(chan_rt[c][0], 9), chan_rt[c][1]) for c in sel}) > 1:
-            desc = ", ".join(f"{c} ({chan_rt[c][2]}): {chan_rt[c][0]:g} Hz from {chan_rt[c][1]:g} s"
-                             for c in sel)
-            b.fail(f"signals differ in rate or start ({desc}); read them one at a time with "
-                   "channels=[...]")
-        fs, t0 = chan_rt[sel[0]][:2] if sel else (1.0, 0.0)
-        if abs(fs - round(fs)) < 1e-6 * fs:
-            fs = float(round(fs))
+            _add_signal(b, var, m.get(var), units, chan_rt)
+        fs, t0 = _common_rate(b, chan_rt, channels)
         ann = _get(m[sigs[0]], "function_record", "TL_export_properties_annotation", default={})
         if isinstance(ann, dict):
             for k in ("project_name", "section_name", "run_name", "absolute_time"):
                 if isinstance(ann.get(k), str):
                     b.attrs[f"testlab_{k}"] = ann[k]
         return b.build(fs=fs, t0=t0, channels=channels)
+
+
+def _signal_values(b, var, s):
+    """(start s, increment s, values N x C) of one ``Signal`` struct, checked."""
+    if not isinstance(s, dict) or "y_values" not in s or "x_values" not in s:
+        b.fail(f"variable {var!r} is not a Testlab Signal struct (needs fields x_values "
+               f"and y_values; has {', '.join(s) if isinstance(s, dict) else type(s).__name__})")
+    xv, yv = s["x_values"], s["y_values"]
+    try:
+        start = float(_get(xv, "start_value", default=0.0))
+        inc = float(_get(xv, "increment"))
+        nval = int(_get(xv, "number_of_values", default=-1))
+    except (TypeError, ValueError):
+        b.fail(f"{var}.x_values has no usable start_value/increment/number_of_values")
+    if not (np.isfinite(inc) and inc > 0):
+        b.fail(f"{var}.x_values.increment is {inc!r}; expected a positive time step")
+    vals = np.asarray(_get(yv, "values"))
+    if vals.dtype.kind not in "iuf" or vals.size == 0:
+        b.fail(f"{var}.y_values.values is missing or not numeric")
+    if vals.ndim == 1:
+        vals = vals[:, None]
+    if vals.ndim != 2:
+        b.fail(f"{var}.y_values.values has shape {vals.shape}; expected N or N×C")
+    if nval >= 0 and vals.shape[0] != nval:
+        if vals.shape[1] == nval:
+            vals = vals.T
+        else:
+            b.fail(f"{var}: x_values.number_of_values is {nval} but y_values.values has "
+                   f"{vals.shape[0]} rows: truncated or corrupt export")
+    return start, inc, vals
+
+
+def _add_signal(b, var, s, units, chan_rt):
+    """Add the channels of one ``Signal`` struct; ``chan_rt[name] = (rate, start, var)``."""
+    start, inc, vals = _signal_values(b, var, s)
+    yv, fr = s["y_values"], s.get("function_record", {}) or {}
+    label = _get(yv, "quantity", "label", default="")
+    factor = float(_get(yv, "quantity", "unit_transformation", "factor", default=1.0))
+    offset = float(_get(yv, "quantity", "unit_transformation", "offset", default=0.0))
+    point = _get(fr, "name", default="") or var
+    point = point if isinstance(point, str) else ", ".join(map(str, point))
+    base = clean_name(point.split(":", 1)[-1] if ":" in point else point, var)
+    attrs = {"testlab_variable": var, "testlab_name": point,
+             "testlab_creation_time": _get(fr, "creation_time"),
+             "testlab_primary_channel": _get(fr, "primary_channel", "label"),
+             "testlab_unit_factor": factor, "testlab_unit_offset": offset}
+    ann = _get(fr, "TL_export_properties_annotation", default={}) or {}
+    for k in ("project_name", "section_name", "run_name", "absolute_time", "channel_group"):
+        if isinstance(ann, dict) and isinstance(ann.get(k), str):
+            attrs[f"testlab_{k}"] = ann[k]
+    ncol = vals.shape[1]
+    for j in range(ncol):
+        cname = base if ncol == 1 else f"{base}_{j + 1}"
+        y = vals[:, j].astype(np.float64)
+        stored_si = True
+        try:
+            u = _units.lookup_unit(units if isinstance(units, str) else
+                                   (units or {}).get(cname, label), what="")
+            stored_si = offset == 0.0 and abs(factor * u.factor - 1.0) < 1e-9
+        except RecordingError:
+            u = None  # add_channel reports the unknown label
+        if not stored_si and u is not None:
+            b.warn(f"{var}: unit_transformation (factor {factor:g}, offset {offset:g}) "
+                   f"does not match the label {label!r}: values converted through it")
+            y = y * factor + offset
+        got = b.add_channel(cname, y, label, already_si=stored_si, attrs=attrs,
+                            file_name=cname)
+        chan_rt[got] = (1.0 / inc, start, var)
+
+
+def _common_rate(b, chan_rt, channels):
+    """(fs, t0) shared by the selected channels (refused when they differ)."""
+    sel = list(chan_rt) if channels is None else \
+        [c for c in ([channels] if isinstance(channels, str) else channels) if c in chan_rt]
+    if len({(round(chan_rt[c][0], 9), chan_rt[c][1]) for c in sel}) > 1:
+        desc = ", ".join(f"{c} ({chan_rt[c][2]}): {chan_rt[c][0]:g} Hz from {chan_rt[c][1]:g} s"
+                         for c in sel)
+        b.fail(f"signals differ in rate or start ({desc}); read them one at a time with "
+               "channels=[...]")
+    fs, t0 = chan_rt[sel[0]][:2] if sel else (1.0, 0.0)
+    if abs(fs - round(fs)) < 1e-6 * fs:
+        fs = float(round(fs))
+    return fs, t0
 
 
 ENGINES["testlab_mat"] = TestlabMatReader
