@@ -89,78 +89,23 @@ class CwruReader(RecordingReader):
         if mat_version(open(path, "rb").read(1024)) is None:
             b.fail("not a MATLAB file (no 'MATLAB' header)")
         names = mat_variables(path)
-        found = {}
-        for n in names:
-            m = _CHAN.match(n)
-            if m:
-                found.setdefault(int(m.group(1)), {})[m.group(2)] = n
-        if not found:
-            b.fail(f"no CWRU channel variables X###_DE_time/_FE_time/_BA_time (variables: "
-                   f"{', '.join(names) or 'none'})")
-        mnum = re.match(r"^(\d+)", path.name)
-        file_no = int(mnum.group(1)) if mnum else None
-        if record is not None:
-            if int(record) not in found:
-                b.fail(f"record={record} has no variables in the file; it holds records "
-                       f"{', '.join(map(str, sorted(found)))}")
-            rec = int(record)
-        elif len(found) == 1:
-            rec = next(iter(found))
-        elif file_no in found:
-            rec = file_no
-        else:
-            b.fail(f"the file holds variables of records {', '.join(map(str, sorted(found)))}; "
-                   "pass record=<number> to pick one")
+        found, rec, file_no = _pick_record(b, path, names, record)
         if "DE" not in found[rec]:
             b.warn(f"record {rec} has no drive-end (DE) channel")
-        wanted = [v for k, v in found[rec].items()]
         rpm_vars = [n for n in names if _RPM.match(n)]
         rpm_var = f"X{rec:03d}RPM" if f"X{rec:03d}RPM" in names else (
             f"X{rec}RPM" if f"X{rec}RPM" in names else (rpm_vars[0] if len(rpm_vars) == 1 else None))
         m = load_mat(path)
         if channels is None and record is None:
             self._check_unclaimed(b, m, found, rec, rpm_var)
-        # sampling rate: the registry entry with this file's sha256 first (renamed files, and
-        # files whose variables carry another record's number), then the file name's record,
-        # then the variables' record
-        cands = [n for n in dict.fromkeys([file_no, rec]) if n is not None]
-        by_sha = _registered_by_content(path)
-        from .. import datasets  # the registry (csv, importlib.resources) for a CWRU file only
-        regs = {n: datasets.cwru_record(n) for n in cands}
-        rates = {r.fs_hz for r in regs.values() if r is not None and r.fs_hz}
-        reg = regs.get(file_no) or regs.get(rec)
-        if by_sha is not None and by_sha.fs_hz:
-            reg, rates = by_sha, {by_sha.fs_hz}
-        if fs is None:
-            if len(rates) == 1:
-                fs = rates.pop()
-            elif not rates:
-                b.fail(f"CWRU record {rec} is not in the registry (bearing_lab/data/recordings.csv), and CWRU "
-                       "files do not store their sampling rate; pass fs=12000 or fs=48000 (CLI "
-                       "--fs) as the data centre lists it")
-            else:
-                b.fail(f"records {cands} have different registered rates {sorted(rates)}; pass fs=")
-            b.attrs["sampling_rate_source"] = "registry bearing_lab/data/recordings.csv" + (
-                f" (file content, sha256, of {by_sha.name})" if reg is by_sha else "")
-        else:
-            b.attrs["sampling_rate_source"] = "user"
+        fs, reg = _rate(b, path, rec, file_no, fs)
         order = [c for c in ("DE", "FE", "BA") if c in found[rec]]
         for c in order:
             v = signal_vector(b, m[found[rec][c]], found[rec][c])
             b.add_channel(c, v, None, file_name=found[rec][c], inplace=True,
                           attrs={"location": {"DE": "drive end", "FE": "fan end",
                                               "BA": "base"}[c]})
-        rpm = None
-        if rpm_var and np.size(m.get(rpm_var, [])) >= 1:
-            value = np.ravel(m[rpm_var])[0] if not isinstance(m[rpm_var], str) else m[rpm_var]
-            if isinstance(value, (str, bytes)) or np.iscomplexobj(value):
-                b.warn(f"variable {rpm_var} holds {value!r}, not a speed: shaft_speed_rpm unknown")
-            else:
-                rpm = float(value)
-                b.attrs["shaft_speed_source"] = f"file variable {rpm_var}"
-        elif reg is not None and reg.rpm:
-            rpm = reg.rpm
-            b.attrs["shaft_speed_source"] = "registry bearing_lab/data/recordings.csv"
+        rpm = _speed(b, m, rpm_var, reg)
         b.attrs["cwru_record"] = rec
         if file_no is not None and file_no != rec:
             b.attrs["cwru_file_number"] = file_no
@@ -170,6 +115,77 @@ class CwruReader(RecordingReader):
                             "cwru_defect_position": reg.defect_position or None,
                             "bearing": reg.bearing, "registry_name": reg.name})
         return b.build(fs=fs, shaft_speed_rpm=rpm, default_channel="DE", channels=channels)
+
+
+def _pick_record(b, path, names, record):
+    """({record: {"DE": variable, ...}}, the record read, the file name's record number or None)."""
+    found = {}
+    for n in names:
+        m = _CHAN.match(n)
+        if m:
+            found.setdefault(int(m.group(1)), {})[m.group(2)] = n
+    if not found:
+        b.fail(f"no CWRU channel variables X###_DE_time/_FE_time/_BA_time (variables: "
+               f"{', '.join(names) or 'none'})")
+    mnum = re.match(r"^(\d+)", path.name)
+    file_no = int(mnum.group(1)) if mnum else None
+    if record is not None:
+        if int(record) not in found:
+            b.fail(f"record={record} has no variables in the file; it holds records "
+                   f"{', '.join(map(str, sorted(found)))}")
+        rec = int(record)
+    elif len(found) == 1:
+        rec = next(iter(found))
+    elif file_no in found:
+        rec = file_no
+    else:
+        b.fail(f"the file holds variables of records {', '.join(map(str, sorted(found)))}; "
+               "pass record=<number> to pick one")
+    return found, rec, file_no
+
+
+def _rate(b, path, rec, file_no, fs):
+    """(fs, the registry entry or None).  The rate: ``fs``, else the registry entry with this
+    file's sha256 (renamed files, and files whose variables carry another record's number), then
+    the file name's record, then the variables' record."""
+    cands = [n for n in dict.fromkeys([file_no, rec]) if n is not None]
+    by_sha = _registered_by_content(path)
+    from .. import datasets  # the registry (csv, importlib.resources) for a CWRU file only
+    regs = {n: datasets.cwru_record(n) for n in cands}
+    rates = {r.fs_hz for r in regs.values() if r is not None and r.fs_hz}
+    reg = regs.get(file_no) or regs.get(rec)
+    if by_sha is not None and by_sha.fs_hz:
+        reg, rates = by_sha, {by_sha.fs_hz}
+    if fs is None:
+        if len(rates) == 1:
+            fs = rates.pop()
+        elif not rates:
+            b.fail(f"CWRU record {rec} is not in the registry (bearing_lab/data/recordings.csv), and CWRU "
+                   "files do not store their sampling rate; pass fs=12000 or fs=48000 (CLI "
+                   "--fs) as the data centre lists it")
+        else:
+            b.fail(f"records {cands} have different registered rates {sorted(rates)}; pass fs=")
+        b.attrs["sampling_rate_source"] = "registry bearing_lab/data/recordings.csv" + (
+            f" (file content, sha256, of {by_sha.name})" if reg is by_sha else "")
+    else:
+        b.attrs["sampling_rate_source"] = "user"
+    return fs, reg
+
+
+def _speed(b, m, rpm_var, reg):
+    """The shaft speed, r/min: the file's ``X###RPM`` variable, else the registry's, else None."""
+    if rpm_var and np.size(m.get(rpm_var, [])) >= 1:
+        value = np.ravel(m[rpm_var])[0] if not isinstance(m[rpm_var], str) else m[rpm_var]
+        if isinstance(value, (str, bytes)) or np.iscomplexobj(value):
+            b.warn(f"variable {rpm_var} holds {value!r}, not a speed: shaft_speed_rpm unknown")
+            return None
+        rpm = float(value)
+        b.attrs["shaft_speed_source"] = f"file variable {rpm_var}"
+        return rpm
+    if reg is not None and reg.rpm:
+        b.attrs["shaft_speed_source"] = "registry bearing_lab/data/recordings.csv"
+        return reg.rpm
+    return None
 
 
 def _registered_by_content(path):
