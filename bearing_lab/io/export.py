@@ -185,6 +185,38 @@ def to_uff58b(ds, path, *, channels=None, units: str = "si", id1=None, id2=None,
     the response entity name (10 characters) and ``id1``.
     """
     path = Path(path)
+    t, dt, channels = _uff_time_and_channels(ds, path, channels)
+    check_choice(units, ("si", "original"), f"{path}: units", RecordingError)
+    bo_code, bo_char = (1, "<") if byte_order == "little" else (2, ">")
+    date = datetime.now().strftime("%d-%b-%y %H:%M:%S")
+    src = Path(str(ds.attrs.get("source_file", ""))).name or "bearing_lab"
+    out = []
+    out.append(b"%6i\n%6i%74s\n" % (-1, 164, b" "))
+    out.append(b"%10i%20s%10i\n" % (1, b"SI - mks (Newton)".rjust(20), 2))
+    out.append(b"%25.16e%25.16e%25.16e\n%25.16e\n" % (1.0, 1.0, 1.0, 273.15))
+    out.append(b"%6i\n" % -1)
+    for k, name in enumerate(channels):
+        var = ds[name]
+        y, label, quantity = _uff_values(path, name, var, units)
+        i1 = (id1 if id1 is not None else str(var.attrs.get("id1", name)))[:80]
+        i2 = (id2 if id2 is not None else f"bearing_lab {ds.attrs.get('bearing_lab_version', '')} "
+              f"from {src}")[:80]
+        i4 = (id4 if id4 is not None else str(ds.attrs.get("reader", "simulation")))[:80]
+        out.extend(_uff58b_set(name, k, var.attrs, y, label, quantity, (i1, i2, date, i4), float(t[0]), dt,
+                               bo_code, bo_char))
+    try:
+        with atomic_open(path, "wb") as fh:  # an existing file survives any failure
+            for chunk in out:
+                fh.write(chunk)
+    except OSError as exc:
+        raise RecordingError(f"{path}: cannot write ({exc.strerror or exc}); an existing file of "
+                             "that name is left as it was") from exc
+    return path
+
+
+def _uff_time_and_channels(ds, path, channels):
+    """(time values, increment s, channel names) of a UFF 58b export, checked: an even time
+    base of at least 2 samples and named variables of the Dataset."""
     if "time" not in ds.coords:
         raise RecordingError(f"{path}: the Dataset has no 'time' coordinate to export")
     t = np.asarray(ds["time"].values, dtype=np.float64)
@@ -205,70 +237,55 @@ def to_uff58b(ds, path, *, channels=None, units: str = "si", id1=None, id2=None,
                              f"{', '.join(ds.data_vars)}")
     if not channels:
         raise RecordingError(f"{path}: no time-series variables to export")
-    check_choice(units, ("si", "original"), f"{path}: units", RecordingError)
-    bo_code, bo_char = (1, "<") if byte_order == "little" else (2, ">")
-    date = datetime.now().strftime("%d-%b-%y %H:%M:%S")
-    src = Path(str(ds.attrs.get("source_file", ""))).name or "bearing_lab"
-    out = []
-    out.append(b"%6i\n%6i%74s\n" % (-1, 164, b" "))
-    out.append(b"%10i%20s%10i\n" % (1, b"SI - mks (Newton)".rjust(20), 2))
-    out.append(b"%25.16e%25.16e%25.16e\n%25.16e\n" % (1.0, 1.0, 1.0, 273.15))
-    out.append(b"%6i\n" % -1)
-    for k, name in enumerate(channels):
-        var = ds[name]
-        if var.dims != ("time",):
-            raise RecordingError(f"{path}: variable {name!r} has dims {var.dims}; only (time,) "
-                                 "variables can be exported")
-        y = np.asarray(var.values, dtype=np.float64)
-        if not np.all(np.isfinite(y)):
-            raise RecordingError(f"{path}: variable {name!r} holds NaN/Inf; UFF cannot carry them")
-        si = str(var.attrs.get("units", "1"))
-        quantity = str(var.attrs.get("quantity", "")) or {"m s-2": "acceleration", "m": "displacement",
-                                                          "Pa": "pressure", "N": "force",
-                                                          "V": "voltage"}.get(si, "")
-        label = _label_for(si, quantity)
-        if units == "original" and var.attrs.get("original_units"):
-            try:
-                u = _units.lookup_unit(var.attrs["original_units"])
-                if u.si == si and (u.factor != 1.0 or u.offset != 0.0):
-                    y = (y - u.offset) / u.factor
-                    label = u.label
-            except RecordingError:
-                pass
-        spec, lexp, fexp = _SPEC.get(quantity, (1, 0, 0))
-        node = int(var.attrs.get("uff_rsp_node", k + 1))
-        rdir = int(var.attrs.get("uff_rsp_dir", 0))
-        ent = str(var.attrs.get("rsp_ent_name", name))[:10]
-        i1 = (id1 if id1 is not None else str(var.attrs.get("id1", name)))[:80]
-        i2 = (id2 if id2 is not None else f"bearing_lab {ds.attrs.get('bearing_lab_version', '')} "
-              f"from {src}")[:80]
-        i4 = (id4 if id4 is not None else str(ds.attrs.get("reader", "simulation")))[:80]
-        n = y.size
-        nbytes = n * 8
-        head = [
-            b"%6i\n" % -1,
-            b"%6i%c%6i%6i%12i%12i%6i%6i%12i%12i\n" % (58, ord("b"), bo_code, 2, 11, nbytes,
-                                                    0, 0, 0, 0),
-        ]
-        text = [
-            "%-80s\n" % i1, "%-80s\n" % i2, "%-80s\n" % date, "%-80s\n" % i4, "%-80s\n" % "NONE",
-            "%5i%10i%5i%10i %10s%10i%4i %10s%10i%4i\n" % (1, 0, 0, 0, ent, node, rdir, "NONE", 0, 0),
-            "%10i%10i%10i%13.5e%13.5e%13.5e\n" % (4, n, 1, float(t[0]), dt, 0.0),
-            "%10i%5i%5i%5i %-20s %-20s\n" % (17, 0, 0, 0, "Time", "s"),
-            "%10i%5i%5i%5i %-20s %-20s\n" % (spec, lexp, fexp, 0, (quantity or name)[:20],
-                                            label[:20]),
-            "%10i%5i%5i%5i %-20s %-20s\n" % (0, 0, 0, 0, "NONE", "NONE"),
-            "%10i%5i%5i%5i %-20s %-20s\n" % (0, 0, 0, 0, "NONE", "NONE"),
-        ]
-        out.extend(head)
-        out.append("".join(text).encode("utf-8"))
-        out.append(y.astype(bo_char + "f8").tobytes())
-        out.append(b"%6i\n" % -1)
-    try:
-        with atomic_open(path, "wb") as fh:  # an existing file survives any failure
-            for chunk in out:
-                fh.write(chunk)
-    except OSError as exc:
-        raise RecordingError(f"{path}: cannot write ({exc.strerror or exc}); an existing file of "
-                             "that name is left as it was") from exc
-    return path
+    return t, dt, channels
+
+
+def _uff_values(path, name, var, units):
+    """(values, unit label, quantity) of one exported variable: SI, or its original unit."""
+    if var.dims != ("time",):
+        raise RecordingError(f"{path}: variable {name!r} has dims {var.dims}; only (time,) "
+                             "variables can be exported")
+    y = np.asarray(var.values, dtype=np.float64)
+    if not np.all(np.isfinite(y)):
+        raise RecordingError(f"{path}: variable {name!r} holds NaN/Inf; UFF cannot carry them")
+    si = str(var.attrs.get("units", "1"))
+    quantity = str(var.attrs.get("quantity", "")) or {"m s-2": "acceleration", "m": "displacement",
+                                                      "Pa": "pressure", "N": "force",
+                                                      "V": "voltage"}.get(si, "")
+    label = _label_for(si, quantity)
+    if units == "original" and var.attrs.get("original_units"):
+        try:
+            u = _units.lookup_unit(var.attrs["original_units"])
+            if u.si == si and (u.factor != 1.0 or u.offset != 0.0):
+                y = (y - u.offset) / u.factor
+                label = u.label
+        except RecordingError:
+            pass
+    return y, label, quantity
+
+
+def _uff58b_set(name, k, attrs, y, label, quantity, ids, t0, dt, bo_code, bo_char):
+    """The byte chunks of one dataset 58b: delimiter, binary header line, the 11 header records
+    (``ids``: records 1-4), the float64 payload and the closing delimiter."""
+    spec, lexp, fexp = _SPEC.get(quantity, (1, 0, 0))
+    node = int(attrs.get("uff_rsp_node", k + 1))
+    rdir = int(attrs.get("uff_rsp_dir", 0))
+    ent = str(attrs.get("rsp_ent_name", name))[:10]
+    n = y.size
+    nbytes = n * 8
+    head = [
+        b"%6i\n" % -1,
+        b"%6i%c%6i%6i%12i%12i%6i%6i%12i%12i\n" % (58, ord("b"), bo_code, 2, 11, nbytes,
+                                                0, 0, 0, 0),
+    ]
+    text = [
+        *("%-80s\n" % i for i in ids), "%-80s\n" % "NONE",
+        "%5i%10i%5i%10i %10s%10i%4i %10s%10i%4i\n" % (1, 0, 0, 0, ent, node, rdir, "NONE", 0, 0),
+        "%10i%10i%10i%13.5e%13.5e%13.5e\n" % (4, n, 1, t0, dt, 0.0),
+        "%10i%5i%5i%5i %-20s %-20s\n" % (17, 0, 0, 0, "Time", "s"),
+        "%10i%5i%5i%5i %-20s %-20s\n" % (spec, lexp, fexp, 0, (quantity or name)[:20],
+                                        label[:20]),
+        "%10i%5i%5i%5i %-20s %-20s\n" % (0, 0, 0, 0, "NONE", "NONE"),
+        "%10i%5i%5i%5i %-20s %-20s\n" % (0, 0, 0, 0, "NONE", "NONE"),
+    ]
+    return [*head, "".join(text).encode("utf-8"), y.astype(bo_char + "f8").tobytes(), b"%6i\n" % -1]
