@@ -5,7 +5,8 @@ truncated last set silently, returns 42 values for a header that promises
 2 508 876, lets NaN tokens through, reports 0 from ``get_set_formats()`` for
 binary sets and reads the whole file twice (once to find the blocks, once to
 parse them) with a per-value ``struct.unpack``.  This module reads the fixed
-headers itself (the same field widths as pyuff), reads the file once (a plain read, not a
+headers itself (the same field widths as pyuff; the sets and their headers are found by
+:mod:`._uff_sets`, the data blocks decoded here), reads the file once (a plain read, not a
 memory map: a map of a file truncated while it is read kills the process), seeks past
 each binary payload while scanning (so a 1 GB 58b is scanned header by header)
 and converts each payload with one ``numpy.frombuffer``.  pyuff stays the
@@ -32,11 +33,10 @@ import numpy as np
 
 from ..errors import RecordingError, check_choice
 from ._base import ENGINES, MAX_RATE_HZ, MIN_RATE_HZ, RecordingBuilder, RecordingReader, clean_name, read_file
+from ._uff_sets import decode_text, scan_sets
 
-_DELIM = re.compile(rb"^[ \t]*-1[ \t]*\r?$", re.M)
-_MAX_PAD = 64  # bytes of blanks/NULs a writer may leave after a binary payload
-# Universal File dataset numbers seen in test and modal files (others are refused as damage)
 _MIN_164_FACTOR = 1e-12   # dataset 164 factors scale by 1e±3 (mm), 39.37 (in): 1e±12 is no unit
+# Universal File dataset numbers seen in test and modal files (others are refused as damage)
 _KNOWN_DATASETS = {15, 18, 55, 58, 82, 151, 164, 773, 780, 781, 1710, 1858, 2400, 2411, 2412,
                    2414, 2420, 2429, 2430, 2431, 2432, 2435, 2437, 2467, 2477}
 _DIRS = {1: "+X", 2: "+Y", 3: "+Z", -1: "-X", -2: "-Y", -3: "-Z", 4: "+RX", 5: "+RY", 6: "+RZ",
@@ -46,37 +46,6 @@ _SPEC_QUANTITY = {8: "displacement", 11: "velocity", 12: "acceleration", 15: "pr
                   13: "force", 9: "force", 17: "time"}
 _SPEC_SI = {"displacement": ("m", 1, 0), "velocity": ("m/s", 1, 0), "acceleration": ("m/s2", 1, 0),
             "pressure": ("Pa", -1, 1), "force": ("N", 0, 1)}
-
-
-def _dec(b: bytes) -> str:
-    try:
-        return b.decode("utf-8")
-    except UnicodeDecodeError:
-        return b.decode("latin-1")
-
-
-def _float(tok: str) -> float:
-    return float(tok.strip().replace("D", "E").replace("d", "e"))
-
-
-def _fields(line: bytes, widths):
-    s = _dec(line.rstrip(b"\r\n")).ljust(sum(widths))
-    out, i = [], 0
-    for w in widths:
-        out.append(s[i:i + w])
-        i += w
-    return out
-
-
-class _Set:
-    """One block of the file: type, byte range, header and (for 58) where the data are."""
-
-    def __init__(self, index, typ, binary, start):
-        self.index, self.type, self.binary, self.start = index, typ, binary, start
-        self.header = {}
-        self.data_start = self.data_end = None
-        self.truncated = False
-        self.unclosed = False  # no closing '-1': the file ends inside or right after the set
 
 
 class Uff58Reader(RecordingReader):
@@ -133,212 +102,9 @@ class Uff58Reader(RecordingReader):
         return self._read(data, b, channels, allow_truncated, fs, snap_rate)
 
     # -- scanning -------------------------------------------------------------------
-    def _line(self, mm, pos):
-        if pos >= len(mm):
-            return None, pos
-        end = mm.find(b"\n", pos)
-        if end < 0:
-            return mm[pos:], len(mm)
-        return mm[pos:end + 1], end + 1
-
     def _scan(self, mm, b, allow_truncated):
-        sets, pos, n = [], 0, len(mm)
-        if mm[:3] == b"\xef\xbb\xbf":
-            pos = 3
-        while True:
-            line, nxt = self._line(mm, pos)
-            if line is None:
-                break
-            if not line.strip():
-                pos = nxt
-                continue
-            if line.strip() != b"-1":
-                where = f"set {len(sets) + 1}" if sets else "the start"
-                b.fail(f"expected a '    -1' block delimiter at byte {pos} ({where}), got "
-                       f"{bytes(line[:40])!r}: not a Universal File, or a corrupt one")
-            start = pos
-            tline, pos = self._line(mm, nxt)
-            if tline is None or not tline.strip():
-                b.fail(f"file ends after a '-1' delimiter at byte {start}: truncated")
-            m = re.fullmatch(rb"\s*(\d+)(b?)(.*?)\s*", tline, re.S)
-            if not m:
-                b.fail(f"dataset type line at byte {nxt} is {bytes(tline[:40])!r}, not a number")
-            st = _Set(len(sets) + 1, int(m.group(1)), bool(m.group(2)), start)
-            if st.binary:
-                parts = m.group(3).split()
-                try:
-                    bo, fp, nasc, nbytes = (int(x) for x in parts[:4])
-                except ValueError:
-                    b.fail(f"set {st.index} (dataset {st.type}b): binary header line "
-                           f"{bytes(tline[:60])!r} is unreadable")
-                if bo not in (1, 2) or fp not in (1, 2) or not 0 < nasc < 1000 or nbytes < 0:
-                    b.fail(f"set {st.index}: binary header says byte order {bo}, float format "
-                           f"{fp}, {nasc} header lines, {nbytes} bytes; expected byte order 1 "
-                           "(little) or 2 (big) and IEEE floats")
-                hl = []
-                for _ in range(nasc):
-                    ln, pos = self._line(mm, pos)
-                    if ln is None:
-                        b.fail(f"set {st.index} (dataset {st.type}b) ends inside its header: "
-                               "truncated")
-                    hl.append(ln)
-                st.header_lines, st.nbytes = hl, nbytes
-                st.bo = self._force_bo or bo
-                st.data_start = pos
-                if st.type == 58:
-                    self._parse_header58(st, b)
-                    need = st.n_values * st.itemsize
-                    if nbytes < need:
-                        b.fail(f"set {st.index}: the binary header declares {nbytes} data bytes "
-                               f"but {st.header['num_pts']} points need {need}: corrupt header")
-                else:
-                    need = nbytes
-                shift = self._leading_break(mm, pos, need)
-                if shift:
-                    b.warn(f"set {st.index}: {shift} line-break byte(s) before the binary data "
-                           "skipped (a writer quirk)")
-                    pos += shift
-                    st.data_start = pos
-                avail = n - pos
-                if need > avail:
-                    st.truncated = True
-                    st.data_end = pos + (avail // max(getattr(st, "itemsize", 1), 1)) * \
-                        max(getattr(st, "itemsize", 1), 1)
-                    sets.append(st)
-                    break
-                st.data_end = pos + need
-                pos = self._after_binary(mm, b, st, st.data_end)
-                sets.append(st)
-            else:
-                m2 = _DELIM.search(mm, pos)
-                if m2 is None:
-                    st.unclosed = True
-                    end = len(mm)
-                    pos = len(mm)
-                else:
-                    end = m2.start()
-                    pos = m2.end()
-                st.block = (nxt + len(tline), end)
-                if b"\x00" in mm[st.block[0]:min(end, st.block[0] + (1 << 20))]:
-                    b.fail(f"set {st.index} (dataset {st.type}) is declared as text but holds binary "
-                           "bytes: a damaged 58b header?")
-                if st.type == 58:
-                    hdr_lines = []
-                    p = st.block[0]
-                    for _ in range(11):
-                        ln, p = self._line(mm, p)
-                        if ln is None or p > end + 1:
-                            b.fail(f"set {st.index} (dataset 58) ends inside its 11-line header: "
-                                   "truncated or corrupt")
-                        hdr_lines.append(ln)
-                    st.header_lines = hdr_lines
-                    st.data_start, st.data_end = p, end
-                    self._parse_header58(st, b)
-                sets.append(st)
-        return sets
-
-    @staticmethod
-    def _closes_at(mm, pos):
-        """True if the bytes at ``pos`` are blanks/line breaks then a '-1' line (or EOF)."""
-        tail = bytes(mm[pos:pos + 16])
-        stripped = tail.lstrip(b"\r\n")
-        return stripped.lstrip(b" ").startswith(b"-1") or (not stripped and pos >= len(mm) - 2)
-
-    def _leading_break(self, mm, pos, need):
-        """Bytes of stray CR/LF before a binary payload (some writers add them), else 0."""
-        if self._closes_at(mm, pos + need):
-            return 0
-        for k in (1, 2):
-            if bytes(mm[pos:pos + k]) in (b"\n", b"\r\n", b"\r") and self._closes_at(mm, pos + k + need):
-                return k
-        return 0
-
-    def _after_binary(self, mm, b, st, pos):
-        """Return the position after the closing delimiter of a binary set.
-
-        Between the declared payload and the closing ``-1`` only line breaks, blanks and
-        NUL bytes (writers' padding) are accepted; anything else means the point count
-        or the payload is damaged, and reading on would swallow the next set as padding.
-        """
-        line, nxt = self._line(mm, pos)
-        if line is None:
-            st.unclosed = True
-            return len(mm)
-        if line.strip() == b"-1":
-            return nxt
-        if not line.strip():
-            line2, nxt2 = self._line(mm, nxt)
-            if line2 is not None and line2.strip() == b"-1":
-                return nxt2
-        m = _DELIM.search(mm, pos)
-        end = m.start() if m is not None else len(mm)
-        pad = bytes(mm[pos:end])
-        junk = pad.translate(None, b" \r\n\t\x00")
-        if junk or len(pad) > max(_MAX_PAD, st.nbytes - st.n_values * st.itemsize):
-            b.fail(f"set {st.index}: {len(pad)} bytes that are not padding ({pad[:16]!r}...) "
-                   f"follow the {st.n_values * st.itemsize} data bytes the header declares "
-                   f"({st.header['num_pts']} points) before the closing '-1': the point count "
-                   "or the data are damaged")
-        if m is None:
-            st.unclosed = True
-            return len(mm)
-        b.warn(f"set {st.index}: {len(pad)} bytes of padding after the binary data ignored")
-        return m.end()
-
-    def _parse_header58(self, st, b):
-        hl = st.header_lines
-        if len(hl) < 11:
-            b.fail(f"set {st.index} (dataset 58): header has {len(hl)} lines, expected 11")
-        h = st.header
-        for i in range(5):
-            h[f"id{i + 1}"] = _dec(hl[i].rstrip(b"\r\n")).strip()
-        try:
-            f = _fields(hl[5], [5, 10, 5, 10, 11, 10, 4, 11, 10, 4])
-            h["func_type"] = int(f[0])
-            h["func_id"], h["ver_num"], h["load_case_id"] = int(f[1] or 0), int(f[2] or 0), \
-                int(f[3] or 0)
-            h["rsp_ent_name"] = f[4].strip()
-            h["rsp_node"], h["rsp_dir"] = int(f[5]), int(f[6])
-            h["ref_ent_name"] = f[7].strip()
-            h["ref_node"] = int(f[8]) if f[8].strip() else 0
-            h["ref_dir"] = int(f[9]) if f[9].strip() else 0
-        except ValueError:
-            b.fail(f"set {st.index} (dataset 58): record 6 {bytes(hl[5][:60])!r} is unreadable "
-                   "(function type, node, direction)")
-        try:
-            toks = _dec(hl[6]).split()
-            if len(toks) != 6:
-                toks = _fields(hl[6], [10, 10, 10, 13, 13, 13])
-            h["ord_data_type"], h["num_pts"], h["abscissa_spacing"] = (int(t) for t in toks[:3])
-            h["abscissa_min_text"], h["abscissa_inc_text"] = toks[3].strip(), toks[4].strip()
-            h["abscissa_min"], h["abscissa_inc"] = _float(toks[3]), _float(toks[4])
-            h["z_axis_value"] = _float(toks[5])
-        except (ValueError, IndexError):
-            b.fail(f"set {st.index} (dataset 58): record 7 {bytes(hl[6][:80])!r} is unreadable "
-                   "(data type, number of points, increment)")
-        for rec, axis in zip(hl[7:11], ("abscissa", "ordinate", "orddenom", "z_axis")):
-            f = _fields(rec, [10, 5, 5, 5, 21, 21])
-            try:
-                h[f"{axis}_spec_data_type"] = int(f[0])
-                h[f"{axis}_len_unit_exp"] = int(f[1] or 0)
-                h[f"{axis}_force_unit_exp"] = int(f[2] or 0)
-                h[f"{axis}_temp_unit_exp"] = int(f[3] or 0)
-            except ValueError:
-                b.fail(f"set {st.index} (dataset 58): {axis} record {bytes(rec[:60])!r} is unreadable")
-            h[f"{axis}_axis_lab"] = f[4].strip()
-            h[f"{axis}_axis_units_lab"] = f[5].strip()
-        odt, npts, spacing = h["ord_data_type"], h["num_pts"], h["abscissa_spacing"]
-        if odt not in (2, 4, 5, 6):
-            b.fail(f"set {st.index}: ordinate data type {odt} is not 2/4 (real) or 5/6 (complex)")
-        if npts <= 0:
-            b.fail(f"set {st.index}: header promises {npts} points")
-        if spacing not in (0, 1):
-            b.fail(f"set {st.index}: abscissa spacing {spacing} is not 0 (uneven) or 1 (even)")
-        st.complex = odt in (5, 6)
-        st.double = odt in (4, 6)
-        st.per_point = (2 if st.complex else 1) + (1 if spacing == 0 else 0)
-        st.n_values = npts * st.per_point
-        st.itemsize = 8 if st.double else 4
+        """The file's sets (:func:`._uff_sets.scan_sets`), with the byte order the caller forced."""
+        return scan_sets(mm, b, self._force_bo)
 
     # -- data -----------------------------------------------------------------------
     def _values(self, mm, st, b, allow_truncated):
@@ -477,6 +243,22 @@ class Uff58Reader(RecordingReader):
         sets = self._scan(mm, b, allow_truncated)
         if not sets:
             b.fail("no datasets found between '-1' delimiters")
+        units164, times = self._sort_sets(mm, sets, b)
+        picked = self._pick(times, channels, b)
+        h0 = times[picked[0][0]].header
+        time = self._add_channels(mm, b, times, picked, units164, allow_truncated)
+        fs = self._rate(b, h0, time, fs_override, snap_rate)
+        for k in ("id1", "id2", "id3", "id4", "id5"):
+            if h0.get(k) and h0[k].upper() != "NONE":
+                b.attrs[f"uff_{k}"] = h0[k]
+        b.attrs["uff_n_sets"] = len(sets)
+        if units164 is not None:
+            b.attrs["uff_164_length_factor"], b.attrs["uff_164_force_factor"] = units164
+        return b.build(fs=fs, t0=h0["abscissa_min"], time=time, data=mm, channels=None)
+
+    def _sort_sets(self, mm, sets, b):
+        """(dataset 164's unit factors or None, the time-history sets): model and units sets
+        read, other known datasets dropped with a warning, unknown ones refused."""
         units164 = None
         others, nontime = [], []
         times = []
@@ -486,10 +268,10 @@ class Uff58Reader(RecordingReader):
             elif st.type == 151 and not st.binary:
                 lines = bytes(mm[st.block[0]:st.block[1]]).splitlines()
                 if len(lines) >= 2:
-                    b.attrs["uff_model_name"] = _dec(lines[0]).strip()
-                    b.attrs["uff_model_description"] = _dec(lines[1]).strip()
+                    b.attrs["uff_model_name"] = decode_text(lines[0]).strip()
+                    b.attrs["uff_model_description"] = decode_text(lines[1]).strip()
                 if len(lines) >= 6:
-                    b.attrs["uff_program"] = _dec(lines[5]).strip()
+                    b.attrs["uff_program"] = decode_text(lines[5]).strip()
             elif st.type == 58:
                 h = st.header
                 is_time = h["func_type"] == 1
@@ -518,7 +300,11 @@ class Uff58Reader(RecordingReader):
                    f"{', '.join(map(str, sorted(set(others))))})")
         if nontime:
             b.warn(f"dropped dataset-58 sets that are not time responses: {', '.join(nontime)}")
-        # names first (cheap), then selection, then data
+        return units164, times
+
+    def _pick(self, times, channels, b):
+        """[(index in ``times``, channel name)] of the channels read: names first (cheap), then
+        the selection; refused when the picked sets differ in rate, length or start."""
         names, used = [], {}
         for k, st in enumerate(times, 1):
             base = self._channel_name(st, k)
@@ -534,8 +320,7 @@ class Uff58Reader(RecordingReader):
             picked = list(enumerate(names))
         groups = {}
         for i, name in picked:
-            st = times[i]
-            h = st.header
+            h = times[i].header
             key = (h["num_pts"], h["abscissa_spacing"], h["abscissa_inc_text"],
                    h["abscissa_min_text"])
             groups.setdefault(key, []).append((i, name))
@@ -544,8 +329,10 @@ class Uff58Reader(RecordingReader):
                              for k, g in groups.items())
             b.fail(f"channels differ in rate, length or start ({desc}); read one group at a time "
                    "with channels=[...]")
-        first = times[picked[0][0]]
-        h0 = first.header
+        return picked
+
+    def _add_channels(self, mm, b, times, picked, units164, allow_truncated):
+        """Decode and add the picked channels; return the uneven time base (None when even)."""
         time = None
         for i, name in picked:
             st = times[i]
@@ -573,45 +360,49 @@ class Uff58Reader(RecordingReader):
                 label, factor164 = self._unit_from_164(st, units164, b)
                 if factor164 not in (None, 1.0):
                     vals = np.asarray(vals, dtype=np.float64) * factor164
-            attrs = {k: h[k] for k in ("id1", "id2", "id3", "id4", "id5", "rsp_ent_name")
-                     if h.get(k) and h[k].upper() != "NONE"}
-            attrs.update({"uff_set": st.index, "uff_rsp_node": h["rsp_node"],
-                          "uff_rsp_dir": h["rsp_dir"], "uff_func_type": h["func_type"],
-                          "uff_ord_data_type": h["ord_data_type"],
-                          "uff_ordinate_axis_lab": h["ordinate_axis_lab"],
-                          "uff_binary": int(st.binary)})
-            if factor164 not in (None, 1.0):
-                attrs["uff_164_factor"] = factor164
-            b.add_channel(name, vals, label, attrs=attrs, inplace=True,
+            b.add_channel(name, vals, label, attrs=self._channel_attrs(st, factor164), inplace=True,
                           quantity=_SPEC_QUANTITY.get(h["ordinate_spec_data_type"]))
-        # rate
-        inc, t0 = h0["abscissa_inc"], h0["abscissa_min"]
-        fs = None
+        return time
+
+    @staticmethod
+    def _channel_attrs(st, factor164):
+        """A channel's attributes: the set's ids and header fields (and a dataset 164 factor)."""
+        h = st.header
+        attrs = {k: h[k] for k in ("id1", "id2", "id3", "id4", "id5", "rsp_ent_name")
+                 if h.get(k) and h[k].upper() != "NONE"}
+        attrs.update({"uff_set": st.index, "uff_rsp_node": h["rsp_node"],
+                      "uff_rsp_dir": h["rsp_dir"], "uff_func_type": h["func_type"],
+                      "uff_ord_data_type": h["ord_data_type"],
+                      "uff_ordinate_axis_lab": h["ordinate_axis_lab"],
+                      "uff_binary": int(st.binary)})
+        if factor164 not in (None, 1.0):
+            attrs["uff_164_factor"] = factor164
+        return attrs
+
+    def _rate(self, b, h0, time, fs_override, snap_rate):
+        """The sampling rate: None for an uneven time base, else ``fs`` or the header's
+        increment (checked, snapped to whole Hz when the printed increment rounded it)."""
+        inc = h0["abscissa_inc"]
         if time is not None:
             b.warn("uneven abscissa: the file's time values are kept as the time coordinate "
                    "(sampling_rate_hz is the median rate)")
             b.attrs["uneven_time"] = 1
-        elif fs_override is not None:
+            return None
+        if fs_override is not None:
             fs = float(fs_override)
             b.attrs["file_sampling_rate_hz"] = 1.0 / inc if inc > 0 else 0.0
-        else:
-            if not inc > 0:
-                b.fail(f"abscissa increment {h0['abscissa_inc_text']!r} is not positive; pass fs=<Hz>")
-            with np.errstate(over="ignore"):
-                fs = float(np.float64(1.0) / np.float64(inc))
-            if not MIN_RATE_HZ <= fs <= MAX_RATE_HZ:
-                b.fail(f"abscissa increment {h0['abscissa_inc_text'].strip()!r} s means a sampling "
-                       f"rate of {fs:.6g} Hz, outside {MIN_RATE_HZ:g} Hz .. {MAX_RATE_HZ:.0e} Hz: a "
-                       "damaged header; pass fs=<Hz>")
-            if snap_rate:
-                fs = self._snap(fs, h0["abscissa_inc_text"], b)
-        for k in ("id1", "id2", "id3", "id4", "id5"):
-            if h0.get(k) and h0[k].upper() != "NONE":
-                b.attrs[f"uff_{k}"] = h0[k]
-        b.attrs["uff_n_sets"] = len(sets)
-        if units164 is not None:
-            b.attrs["uff_164_length_factor"], b.attrs["uff_164_force_factor"] = units164
-        return b.build(fs=fs, t0=t0, time=time, data=mm, channels=None)
+            return fs
+        if not inc > 0:
+            b.fail(f"abscissa increment {h0['abscissa_inc_text']!r} is not positive; pass fs=<Hz>")
+        with np.errstate(over="ignore"):
+            fs = float(np.float64(1.0) / np.float64(inc))
+        if not MIN_RATE_HZ <= fs <= MAX_RATE_HZ:
+            b.fail(f"abscissa increment {h0['abscissa_inc_text'].strip()!r} s means a sampling "
+                   f"rate of {fs:.6g} Hz, outside {MIN_RATE_HZ:g} Hz .. {MAX_RATE_HZ:.0e} Hz: a "
+                   "damaged header; pass fs=<Hz>")
+        if snap_rate:
+            fs = self._snap(fs, h0["abscissa_inc_text"], b)
+        return fs
 
     def _snap(self, fs, text, b):
         """Snap ``fs`` to the whole number of Hz whose increment prints as ``text``."""
@@ -638,7 +429,7 @@ class Uff58Reader(RecordingReader):
         try:
             toks = lines[1].replace(b"D", b"E").split()
             length, force = float(toks[0]), float(toks[1])
-            b.attrs["uff_units_system"] = _dec(lines[0][10:30]).strip()
+            b.attrs["uff_units_system"] = decode_text(lines[0][10:30]).strip()
         except (IndexError, ValueError):
             b.warn(f"set {st.index} (dataset 164, units) is unreadable and was ignored")
             return None
