@@ -103,7 +103,7 @@ def kill_import(tmp: Path, src: Path, kills: int, seed: int) -> dict:
 
 
 def killed_writers(tmp: Path, kills: int, mirror: Path, seed: int) -> int:
-    from bearing_lab.io._fuzz import kill_writes
+    from bearing_lab.io._fuzz_writes import kill_writes
     n_loop = kills // 4
     runs = {"netCDF writer (loop)": kill_writes(tmp / "loop.nc", kills - 2 * n_loop, kind="netcdf",
                                                 seed=seed, n=2_000_000),

@@ -270,7 +270,7 @@ def test_absurd_rate_given_by_the_user_refused(write):
 def test_killed_writers_leave_a_whole_file(tmp_path, kind, kills):
     """4 of 4 killed `-o` writes destroyed the existing file; now the file that stays is always
     one complete version (benchmarks/hostile_inputs.py kills 20 times)."""
-    from bearing_lab.io._fuzz import kill_writes
+    from bearing_lab.io._fuzz_writes import kill_writes
     res = kill_writes(tmp_path / f"out.{'nc' if kind == 'netcdf' else 'uff'}", kills, kind=kind,
                       seed=3, n=1_000_000, max_delay=2.5)
     assert res["destroyed"] == 0, res
