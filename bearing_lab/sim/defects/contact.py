@@ -60,7 +60,7 @@ in the dynamics, is measured by ``benchmarks/defect_tables.py`` and
 
 Discretisation of "area"
 ------------------------
-A lattice on the track, cells ``ds x dz``; ``ds = psi step * R / m`` with integer ``m`` so
+(:mod:`.lattice`) A lattice on the track, cells ``ds x dz``; ``ds = psi step * R / m`` with integer ``m`` so
 the ball-centred window slides by whole cells; each cell carries the fraction of it inside
 the outline (4 x 4 sub-samples), so G is smooth in psi.  The sum over the window is a
 correlation evaluated by FFT along the track.
@@ -85,12 +85,12 @@ from bearing_lab.errors import SceneError, check_choice
 
 from ...utils.figures import new_figure
 from . import _table_cache
-from .geometry import RaceGeometry, drop_profile_1d, drop_profile_2d, hertz_semi_axes
+from .geometry import RaceGeometry, drop_profile_1d, drop_profile_2d
 from .halfspace import TABLE_CELLS, ratio_curve
+from .lattice import track_lattice
 from .model import Defect
 
-# the table's FFT products and the half-space curves' interpolation: loaded when a table is built
-sfft = lazy.load("scipy.fft", suppress_warning=True)
+# the half-space curves' interpolation: loaded when a table is built
 _interpolate = lazy.load("scipy.interpolate", suppress_warning=True)
 
 # CONTACT_MODELS, the registry of models (one entry each), closes this module.
@@ -100,7 +100,6 @@ HALFSPACE_NODES = (0.05, 0.1, 0.16, 0.25, 0.35, 0.5, 0.7, 1.0)
 ABOVE_NODE_STEP = 0.1
 #: Young's modulus and Poisson ratio the tables assume unless told (52100 steel)
 DEFAULT_MATERIAL = (208e9, 0.3)
-_SUB = 4            # sub-samples per cell side for the outline coverage
 _CELLS_ALONG = 60   # lattice cells per along-track reach at delta_max ("area")
 _CELLS_ACROSS = 60  # lattice cells per across-track reach at delta_max ("area")
 _FRACTION_CELLS = 24  # lattice cells per reach for the intact fraction of the other models
@@ -239,49 +238,6 @@ def _interacting_s_extent(defect: Defect, a_w: float):
     if not cand:
         return None
     return float(min(cand)), float(max(cand))
-
-
-def _coverage(defect: Defect, s_cells: np.ndarray, z_cells: np.ndarray, ds: float, dz: float):
-    """Fraction of each cell (len(s_cells) x len(z_cells)) inside the outline."""
-    f = np.zeros((s_cells.size, z_cells.size))
-    s0, s1, z0, z1 = defect.track_extent()
-    ks = np.flatnonzero((s_cells + ds / 2 >= s0) & (s_cells - ds / 2 <= s1))
-    ls = np.flatnonzero((z_cells + dz / 2 >= z0) & (z_cells - dz / 2 <= z1))
-    if ks.size == 0 or ls.size == 0:
-        return f
-    off = (np.arange(_SUB) + 0.5) / _SUB - 0.5
-    S = (s_cells[ks][:, None] + off[None, :] * ds).ravel()
-    Z = (z_cells[ls][:, None] + off[None, :] * dz).ravel()
-    inside = defect.contains(S[:, None], Z[None, :])
-    cov = inside.reshape(ks.size, _SUB, ls.size, _SUB).mean(axis=(1, 3))
-    f[np.ix_(ks, ls)] = cov
-    return f
-
-
-def _correlate(f: np.ndarray, kern: np.ndarray, m: int, n_psi: int) -> np.ndarray:
-    """out[j, d] = sum_{k, l} f[j m + k, l] kern[k, l, d], by FFT along the track.
-
-    FFT rather than a loop of small matrix products: the products would go to a
-    multithreaded BLAS, which on a shared machine spends more time waiting than working.
-    """
-    n_glob = f.shape[0]
-    cols = np.flatnonzero(f.any(axis=0))          # only the axial cells the outline covers
-    n_fft = sfft.next_fast_len(n_glob, real=True)
-    Ff = sfft.rfft(f[:, cols], n=n_fft, axis=0)
-    Fk = sfft.rfft(kern[:, cols, :], n=n_fft, axis=0)
-    # sum_l Ff conj(Fk) = conj(sum_l conj(Ff) Fk): conjugate the small array only
-    C = np.einsum("wl,wld->wd", Ff.conj(), Fk).conj()
-    c = sfft.irfft(C, n=n_fft, axis=0)
-    out = c[0:(n_psi - 1) * m + 1:m]
-    # round-off: exact zeros where the window never meets the outline
-    touched = np.zeros(n_psi, dtype=bool)
-    rows_any = np.flatnonzero(f.any(axis=1))
-    if rows_any.size:
-        nk = kern.shape[0]
-        j = np.arange(n_psi) * m
-        touched = (j + nk - 1 >= rows_any[0]) & (j <= rows_any[-1])
-    out[~touched] = 0.0
-    return out
 
 
 def _arguments_and_key(defect, bearing, *, model, clearance=0.0, delta_max, n_psi=None, n_delta=41, against=None,
@@ -442,7 +398,7 @@ def _build(defect, bearing, *, model, clearance, delta_max, n_psi, n_delta, agai
     spec = CONTACT_MODELS[model]
     drop = drop_profile_1d(defect, geom, psi, psi_radius=R) if spec.along_track_drop else drop2
     cells = (_CELLS_ALONG, _CELLS_ACROSS) if spec.area_law else (_FRACTION_CELLS,) * 2
-    lat = _lattice(defect, geom, psi, R, delta, cells=cells, area_law=spec.area_law)
+    lat = track_lattice(defect, geom, psi, R, delta, cells=cells, area_law=spec.area_law)
     info = {"reach_along_m": b_reach, "reach_across_m": a_reach, "misses_track": misses,
             "drop_2d": drop2, "loaded_range_m": float(delta_max), "max_drop_m": float(np.max(drop2)),
             **lat["info"]}
@@ -456,63 +412,6 @@ def _build(defect, bearing, *, model, clearance, delta_max, n_psi, n_delta, agai
     return ContactTable(psi=psi, delta=delta, G=G, drop=drop, intact_fraction=lat["intact_fraction"],
                         model=model, race=label, psi_min=float(psi[0]), psi_max=float(psi[-1]),
                         track_radius=R, info=info)
-
-
-def _lattice(defect, geom, psi, R, delta, *, cells, area_law):
-    """Ball-centred lattice over the track: the intact share of the Hertz ellipse, the
-    interpenetration region's, and (``area_law``) the local law's G.  See the module
-    docstring."""
-    n_psi, n_delta = psi.size, delta.size
-    dpsi = psi[1] - psi[0]
-    Rg = geom.track_radius
-    b_reach, a_reach = geom.reach(delta[-1])
-    b_w, a_w = 1.05 * b_reach, 1.05 * a_reach
-    m = max(1, math.ceil(dpsi * R / (b_reach / cells[0])))
-    ds = dpsi * R / m
-    nb = math.ceil(b_w / ds)
-    dz = a_reach / cells[1]
-    nzh = math.ceil(a_w / dz)
-    z = (np.arange(2 * nzh) - nzh + 0.5) * dz
-    srel = np.arange(-nb, nb + 1) * ds
-    h0 = geom.approach(srel[:, None] / Rg, z[None, :])
-    n_glob = (n_psi - 1) * m + 2 * nb + 1
-    s_glob = psi[0] * R + (np.arange(n_glob) - nb) * ds
-    f = _coverage(defect, s_glob, z, ds, dz)
-    d = delta[None, None, :]
-    a_h, b_h = hertz_semi_axes(geom, delta)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        indh = ((srel[:, None, None] / b_h[None, None, :]) ** 2
-                + (z[None, :, None] / a_h[None, None, :]) ** 2 < 1.0).astype(float)
-    indh[:, :, delta <= 0] = 0.0
-    areah = indh.sum(axis=(0, 1))
-    kernels = [indh]
-    if area_law:
-        ind0 = (h0[:, :, None] < d).astype(float)              # (2nb+1, nz, n_delta)
-        hf = geom.approach(srel[:, None] / Rg, z[None, :], depth=defect.depth)
-        w0 = np.sqrt(np.maximum(d - h0[:, :, None], 0.0))
-        wf = np.sqrt(np.maximum(d - hf[:, :, None], 0.0))
-        I0 = w0.sum(axis=(0, 1))
-        kernels += [ind0, w0 - wf]
-    out = _correlate(f, np.concatenate(kernels, axis=2), m, n_psi)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        intact = np.where(areah > 0, 1.0 - out[:, :n_delta] / np.where(areah > 0, areah, 1.0), 1.0)
-    res = {"intact_fraction": np.clip(intact, 0.0, 1.0), "G": None,
-           "info": {"lattice_ds_m": ds, "lattice_dz_m": dz, "lattice_window": (2 * nb + 1, 2 * nzh),
-                    "psi_substeps": m, "hertz_semi_axes_m": (a_h, b_h)}}
-    if area_law:
-        area0 = ind0.sum(axis=(0, 1))
-        loss = out[:, 2 * n_delta:]
-        with np.errstate(invalid="ignore", divide="ignore"):
-            pen = np.where(area0 > 0, 1.0 - out[:, n_delta:2 * n_delta] / np.where(area0 > 0, area0, 1.0), 1.0)
-            ratio = np.where(I0 > 0, (I0 - loss) / np.where(I0 > 0, I0, 1.0), 1.0)
-        d15 = delta ** 1.5
-        res["G"] = np.clip(ratio, 0.0, None) * d15[None, :]
-        c = 3.0 / (4.0 * math.pi * math.sqrt(geom.rx * geom.ry))
-        with np.errstate(invalid="ignore", divide="ignore"):
-            law = np.where(d15 > 0, c * I0 * ds * dz / np.where(d15 > 0, d15, 1.0), np.nan)
-        res["info"]["intact_law_ratio"] = law
-        res["info"]["interpenetration_fraction"] = np.clip(pen, 0.0, 1.0)
-    return res
 
 
 def _halfspace_G(defect, geom, s_tab, delta, drop, *, e_star, misses, settings=None):
