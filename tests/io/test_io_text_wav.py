@@ -111,6 +111,23 @@ def test_csv_nan(write, sine):
         open_recording(p)
 
 
+
+def test_text_readers_time_column_steps():
+    """The time-column checks both text readers share: the first step that does not increase,
+    uniform within 0.1 % of the median step, and the rate snapped to whole Hz within 1 ppm."""
+    from bearing_lab.io._text import column_rate, first_non_increasing, is_uniform
+    assert first_non_increasing(np.array([0.0, 1.0, 2.0])) is None
+    assert first_non_increasing(np.array([0.0, 1.0, 1.0, 2.0])) == 1
+    assert first_non_increasing(np.array([0.0, np.nan, 2.0])) == 0
+    assert first_non_increasing(np.array([3.0])) == 0  # one value is no time column
+    steps = np.full(99, 1e-3)
+    assert is_uniform(steps)
+    steps[40] *= 1.002  # one step 0.2 % long
+    assert not is_uniform(steps)
+    rate = column_rate(np.arange(51201) / 51200.0 * (1 + 1e-9))  # 51199.99995 Hz: whole Hz
+    assert rate == 51200.0 and isinstance(rate, float)
+    assert column_rate(np.arange(1001) / 2999.7) == pytest.approx(2999.7, rel=1e-12)  # not snapped
+
 def test_flat_line_and_clipping_flagged(write, sine):
     clipped = np.clip(3 * sine, -2.0, 2.0)
     flat = np.zeros_like(sine)
