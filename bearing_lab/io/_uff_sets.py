@@ -209,11 +209,13 @@ def _after_binary(mm, b, st, pos):
     end = m.start() if m is not None else len(mm)
     pad = bytes(mm[pos:end])
     junk = pad.translate(None, b" \r\n\t\x00")
-    if junk or len(pad) > max(_MAX_PAD, st.nbytes - st.n_values * st.itemsize):
+    used = st.n_values * st.itemsize if st.type == 58 else st.nbytes   # other datasets: the declared bytes
+    if junk or len(pad) > max(_MAX_PAD, st.nbytes - used):
+        declared = (f"{used} data bytes the header declares ({st.header['num_pts']} points)" if st.type == 58
+                    else f"{used} bytes its binary header declares (dataset {st.type}b)")
         b.fail(f"set {st.index}: {len(pad)} bytes that are not padding ({pad[:16]!r}...) "
-               f"follow the {st.n_values * st.itemsize} data bytes the header declares "
-               f"({st.header['num_pts']} points) before the closing '-1': the point count "
-               "or the data are damaged")
+               f"follow the {declared} before the closing '-1': the "
+               f"{'point' if st.type == 58 else 'byte'} count or the data are damaged")
     if m is None:
         st.unclosed = True
         return len(mm)

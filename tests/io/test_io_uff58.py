@@ -325,3 +325,16 @@ def test_line_break_before_payload(write, sine):
     ds = open_recording(write("crlf.uff", raw[:i] + b"\r\n" + raw[i:]))
     np.testing.assert_array_equal(ds["acc"].values, sine)
     assert "line-break" in ds.attrs["warnings"]
+
+
+def test_junk_after_a_binary_set_of_another_dataset_is_a_clear_error(write, sine):
+    """A 2414b set (not dataset 58: the reader skips its payload) followed by bytes that are not padding:
+    the same clear refusal as for a 58b set, not an attribute missing from the skipped set."""
+    other = (b"    -1\n" + b"  2414b%6i%6i%12i%12i%6i%6i%12i%12i\n" % (1, 2, 2, 8, 0, 0, 0, 0)
+             + b"header line 1\nheader line 2\n" + bytes(range(8)) + b"JUNKJUNK\n    -1\n")
+    with pytest.raises(RecordingError, match=r"other.uff: set 1: 9 bytes that are not padding .* 8 bytes its "
+                                             r"binary header declares \(dataset 2414b\)"):
+        open_recording(write("other.uff", other + uff58_block(sine, ent="b", binary=True)))
+    clean = other.replace(b"JUNKJUNK\n", b"")                      # the same set without the junk reads
+    ds = open_recording(write("clean.uff", clean + uff58_block(sine, ent="b", binary=True)))
+    np.testing.assert_array_equal(ds["b"].values, sine)
