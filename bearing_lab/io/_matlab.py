@@ -31,6 +31,15 @@ def mat_version(head: bytes) -> str | None:
     return "5"
 
 
+def require_matlab(path, b) -> str:
+    """The file's MATLAB version (:func:`mat_version`), or ``b.fail`` naming a file that is not one."""
+    with open(path, "rb") as fh:
+        version = mat_version(fh.read(1024))
+    if version is None:
+        b.fail("not a MATLAB file (no 'MATLAB' header)")
+    return version
+
+
 def _h5_names(path: str) -> tuple[str, ...]:
     """Variable names of a v7.3 file (runs in the guarded child)."""
     import h5py  # loads when it reads (every reader is imported to sniff)

@@ -22,7 +22,7 @@ import numpy as np
 
 from ..utils._files import sha256_file
 from ._base import ENGINES, RecordingBuilder, RecordingReader
-from ._matlab import load_mat, mat_variables, mat_version, signal_vector
+from ._matlab import load_mat, mat_variables, mat_version, require_matlab, signal_vector
 
 _CHAN = re.compile(r"^X(\d+)_(DE|FE|BA)_time$")
 _RPM = re.compile(r"^X(\d+)RPM$")
@@ -86,8 +86,7 @@ class CwruReader(RecordingReader):
 
         path = Path(path)
         b = RecordingBuilder(path, self, units=units, checksum=checksum)
-        if mat_version(open(path, "rb").read(1024)) is None:
-            b.fail("not a MATLAB file (no 'MATLAB' header)")
+        require_matlab(path, b)
         names = mat_variables(path)
         found, rec, file_no = _pick_record(b, path, names, record)
         if "DE" not in found[rec]:

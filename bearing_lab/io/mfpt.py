@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from ._base import ENGINES, RecordingBuilder, RecordingReader
-from ._matlab import load_mat, mat_variables, mat_version, signal_vector
+from ._matlab import load_mat, mat_variables, mat_version, require_matlab, signal_vector
 
 
 class MfptReader(RecordingReader):
@@ -46,8 +46,7 @@ class MfptReader(RecordingReader):
         """
         path = Path(path)
         b = RecordingBuilder(path, self, units=units, checksum=checksum)
-        if mat_version(open(path, "rb").read(1024)) is None:
-            b.fail("not a MATLAB file (no 'MATLAB' header)")
+        require_matlab(path, b)
         m = load_mat(path)
         s = m.get("bearing")
         if not isinstance(s, dict) or "gs" not in s:

@@ -23,7 +23,7 @@ import numpy as np
 from .. import units as _units
 from ..errors import RecordingError
 from ._base import ENGINES, RecordingBuilder, RecordingReader, clean_name
-from ._matlab import load_mat, mat_variables, mat_version
+from ._matlab import load_mat, mat_variables, mat_version, require_matlab
 
 _SIGNAL = re.compile(r"^Signal(_\d+)?$")
 _OTHER = re.compile(r"^(FRF|PSD|Spectrum|Autopower|Crosspower|Order|Octave)\w*$", re.I)
@@ -73,8 +73,7 @@ class TestlabMatReader(RecordingReader):
         """
         path = Path(path)
         b = RecordingBuilder(path, self, units=units, sensitivity=sensitivity, checksum=checksum)
-        if mat_version(open(path, "rb").read(1024)) is None:
-            b.fail("not a MATLAB file (no 'MATLAB' header)")
+        require_matlab(path, b)
         names = mat_variables(path)
         sigs = sorted((n for n in names if _SIGNAL.match(n)),
                       key=lambda n: int(n[7:]) if "_" in n else -1)

@@ -1,4 +1,7 @@
 """Testlab MATLAB exports (v5 real file, v7.3 and grouped synthetic), CWRU and MFPT .mat files."""
+import gc
+import warnings
+
 import numpy as np
 import pytest
 
@@ -200,3 +203,16 @@ def test_mfpt(datafile, tmp_path, name):
     assert ds.attrs["sampling_rate_hz"] == 48828.0
     assert ds.attrs["shaft_speed_rpm"] == 1500.0
     assert list(ds.data_vars) == ["acc"] and ds.sizes["time"] == 146484
+
+
+@pytest.mark.filterwarnings("error::pytest.PytestUnraisableExceptionWarning")
+@pytest.mark.parametrize("reader", ["cwru", "mfpt", "testlab_mat"])
+def test_a_mat_reader_refuses_a_file_without_the_matlab_header_and_closes_it(tmp_path, reader):
+    """Forced onto a file that is not MATLAB, each .mat reader says so by name and leaves no file open."""
+    p = tmp_path / "text.mat"
+    p.write_bytes(b"time,acc\n" + b"0.0,1.0\n" * 200)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ResourceWarning)
+        with pytest.raises(RecordingError, match=r"text.mat: not a MATLAB file"):
+            open_recording(p, format=reader)
+        gc.collect()
