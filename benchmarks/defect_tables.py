@@ -184,6 +184,23 @@ def fine_solve() -> None:
         print()
 
 
+def _table_settings(nodes, cells, step) -> None:
+    """Set the half-space table settings the simulation's tables are built with (sections 7 and 10):
+    the approach nodes and the node step above the loaded range (read from ``contact`` at call time)
+    and the cells, on every ``sim/defects`` module that binds ``TABLE_CELLS`` (``contact``,
+    ``halfspace_skewed`` and the cache key's ``_table_cache`` import it by name: setting it on
+    ``halfspace`` alone builds the "converged" tables with the default cells); the memory cache
+    emptied."""
+    from bearing_lab.sim.defects import contact as C
+    for name, mod in list(sys.modules.items()):
+        if name.startswith("bearing_lab.sim.defects") and hasattr(mod, "TABLE_CELLS"):
+            mod.TABLE_CELLS = tuple(cells)
+    C.HALFSPACE_NODES, C.ABOVE_NODE_STEP = tuple(nodes), step
+    C._MEMORY.clear()
+    from bearing_lab.sim.defects import halfspace as H
+    assert C.TABLE_CELLS == H.TABLE_CELLS == tuple(cells)
+
+
 def dynamics_with_converged_table(fs_list=(20_000.0, 100_000.0)) -> None:
     """Peak acceleration (max |a| after 0.1 s of a 0.3 s record, as a user runs paper-O1 and
     the O2 skews) with the default tables and with converged ones (module settings patched,
@@ -192,20 +209,19 @@ def dynamics_with_converged_table(fs_list=(20_000.0, 100_000.0)) -> None:
     from bearing_lab.sim.defects import contact as C, halfspace as H
     print("\n## paper-O1 peak acceleration (g) with the default and the converged half-space table\n")
     print("| output | defect | default table | converged table | difference |\n|---|---|---|---|---|")
-    saved = (C.HALFSPACE_NODES, H.TABLE_CELLS)
+    saved = (C.HALFSPACE_NODES, H.TABLE_CELLS, C.ABOVE_NODE_STEP)
     for fs in fs_list:
         for label, ov in (("O1 H=0", {}), ("O1 H=B/3", {"defect.offset_mm": 1 / 3}),
                           ("O1 H=B/2", {"defect.offset_mm": 0.5}),
                           ("O2 θ=30°", {"defect.length_mm": 3.0, "defect.skew_deg": 30.0}),
                           ("O2 θ=60°", {"defect.length_mm": 3.0, "defect.skew_deg": 60.0})):
             peaks = []
-            for nodes, cells in (saved, (tuple(CONVERGED["nodes"]), CONVERGED["cells"])):
-                C.HALFSPACE_NODES, H.TABLE_CELLS = nodes, cells
-                C._MEMORY.clear()
+            for nodes, cells in (saved[:2], (tuple(CONVERGED["nodes"]), CONVERGED["cells"])):
+                _table_settings(nodes, cells, saved[2])
                 ds = simulate("paper-O1", duration=0.3, fs=fs, progress=False, **ov)
                 a = ds.outer_ring_acc_y.values[ds.time.values > 0.1]
                 peaks.append(float(np.max(np.abs(a))) / 9.80665)
-            C.HALFSPACE_NODES, H.TABLE_CELLS = saved
+            _table_settings(*saved)
             print(f"| {fs / 1e3:.0f} kHz | {label} | {peaks[0]:.3f} | {peaks[1]:.3f} | "
                   f"{peaks[0] / peaks[1] - 1:+.2%} |", flush=True)
 
@@ -273,12 +289,11 @@ def slot_with_converged_table(fs_list=(20_000.0, 100_000.0), duration=1.0) -> No
     for fs in fs_list:
         peaks, build = [], 0.0
         for nodes, cells, step in (saved, conv):
-            C.HALFSPACE_NODES, H.TABLE_CELLS, C.ABOVE_NODE_STEP = nodes, cells, step
-            C._MEMORY.clear()
+            _table_settings(nodes, cells, step)
             ds = simulate("paper-slot", duration=duration, fs=fs, progress=False)
             peaks.append(float(np.max(np.abs(ds.outer_ring_acc_y.values))) / 9.80665)
             build = ds.attrs["table_time_s"]
-        C.HALFSPACE_NODES, H.TABLE_CELLS, C.ABOVE_NODE_STEP = saved
+        _table_settings(*saved)
         print(f"| {fs / 1e3:.0f} kHz | {peaks[0]:.2f} | {peaks[1]:.2f} | {peaks[0] / peaks[1] - 1:+.1%} | "
               f"{build:.1f} |", flush=True)
 
