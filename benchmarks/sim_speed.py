@@ -20,8 +20,9 @@ Run:  .venv/bin/python benchmarks/sim_speed.py [--duration 0.1] [--scene paper-s
 ``getrusage(RUSAGE_CHILDREN)``): the first run after install (fresh numba and defect-table caches,
 ``NUMBA_CACHE_DIR`` and ``BEARING_LAB_CACHE`` in new temporary folders; minimum of ``--first``
 runs, each with its own) and runs with both caches warm (minimum and median of ``--warm`` runs);
-then where a warm run's second goes: the same steps in a fresh interpreter (``--warm`` runs, the
-median of each step, CPU s from ``time.process_time``): the interpreter's start, the imports (numpy,
+then where a warm run's second goes: the same steps as library calls in a fresh interpreter
+(``--warm`` runs, the median of each step, CPU s from ``time.process_time``; without the command
+line's ``gc.freeze``, so their sum is a little above the command's own time less its exit): the interpreter's start, the imports (numpy,
 xarray with pandas, numba, the rest of ``bearing_lab.sim``), the start equilibrium (with numba's
 set-up at the first call of a compiled function), the simulation (defect tables from their cache,
 the time loop, the Dataset), the netCDF file (with ``bearing_lab.io``), and which of scipy's
@@ -119,7 +120,8 @@ def phases(scene="paper-O1", runs=5):
             steps.append([rec["t"][0]] + [b - a for a, b in zip(rec["t"], rec["t"][1:])])
             heavy = rec["heavy"]
     med = [statistics.median(col) for col in zip(*steps)]
-    print(f"\n| a warm run's steps (fresh interpreter, {runs} runs) | CPU s, median |")
+    print(f"\n| a warm run's steps (the library's calls in a fresh interpreter, without the command line's "
+          f"gc.freeze; {runs} runs) | CPU s, median |")
     print("|---|---|")
     for name, v in zip(PHASE_NAMES, med):
         print(f"| {name} | {v:.3f} |")
