@@ -20,11 +20,18 @@ Run:  .venv/bin/python benchmarks/sim_speed.py [--duration 0.1] [--scene paper-s
 ``getrusage(RUSAGE_CHILDREN)``): the first run after install (fresh numba and defect-table caches,
 ``NUMBA_CACHE_DIR`` and ``BEARING_LAB_CACHE`` in new temporary folders; minimum of ``--first``
 runs, each with its own) and runs with both caches warm (minimum and median of ``--warm`` runs);
-then, the same way (``--warm`` runs each), ``bearing-lab --help`` and ``bearing-lab info FILE`` on
-each ``--info`` file (default: a CWRU .mat and a UFF 58 file of the mirror named by
-``BEARING_LAB_MIRROR``, when it has them).
+then where a warm run's second goes: the same steps as library calls in a fresh interpreter
+(``--warm`` runs, the median of each step, CPU s from ``time.process_time``; without the command
+line's ``gc.freeze``, so their sum is a little above the command's own time less its exit): the interpreter's start, the imports (numpy,
+xarray with pandas, numba, the rest of ``bearing_lab.sim``), the start equilibrium (with numba's
+set-up at the first call of a compiled function), the simulation (defect tables from their cache,
+the time loop, the Dataset), the netCDF file (with ``bearing_lab.io``), and which of scipy's
+heavy modules the run imported; then, the same way, ``bearing-lab --help`` and
+``bearing-lab info FILE`` on each ``--info`` file (default: a CWRU .mat and a UFF 58 file of the
+mirror named by ``BEARING_LAB_MIRROR``, when it has them).
 """
 import argparse
+import importlib.util
 import json
 import os
 from pathlib import Path
@@ -34,6 +41,7 @@ import subprocess
 import sys
 import tempfile
 
+import bearing_lab
 from bearing_lab.studies.bench_speed import SPEED_SCENES, all_rows_table, run_speed
 
 
@@ -62,7 +70,64 @@ def startup(scene="paper-O1", first=2, warm=5):
     print(f"| first run (fresh numba and table caches) | {min(firsts):.2f} | {statistics.median(firsts):.2f} | "
           f"{', '.join(f'{t:.2f}' for t in firsts)} |")
     print(f"| warm caches | {min(warms):.2f} | {statistics.median(warms):.2f} | {', '.join(f'{t:.2f}' for t in warms)} |")
+    print(f"\nPython's bytecode cache: {_bytecode_note()}")
     return min(firsts), min(warms)
+
+
+def _bytecode_note():
+    """Whether bearing_lab's modules run from .pyc files or are compiled from source in every process."""
+    sources = list(Path(bearing_lab.__file__).parent.rglob("*.py"))
+    cached = sum(Path(importlib.util.cache_from_source(str(p))).is_file() for p in sources)
+    flag = os.environ.get("PYTHONDONTWRITEBYTECODE")
+    return (f"{cached} of {len(sources)} bearing_lab modules have a .pyc; PYTHONDONTWRITEBYTECODE="
+            f"{flag or '(unset)'}" + (" (Python writes none: each run compiles the others from source)"
+                                      if flag and cached < len(sources) else ""))
+
+
+#: the steps of ``bearing-lab simulate SCENE --duration 1 -o OUT`` one by one, in a fresh interpreter
+_PHASES = r"""
+import json, sys, time
+T = time.process_time
+t = [T()]
+import numpy; t.append(T())
+import xarray; t.append(T())
+import numba; t.append(T())
+import bearing_lab.sim as sim; t.append(T())
+from bearing_lab.sim.assembly import scene_statics
+scene = sim.load_scene(sys.argv[1], **{"output.duration_s": 1.0})
+scene_statics(scene); t.append(T())
+ds = sim.simulate(scene, progress=False); t.append(T())
+from bearing_lab.io.export import to_netcdf
+to_netcdf(ds, sys.argv[2]); t.append(T())
+heavy = [m for m in ("scipy.linalg", "scipy.optimize", "scipy.fft", "scipy.interpolate", "pandas", "dask",
+                     "matplotlib") if type(sys.modules.get(m)).__name__ == "module"]
+print(json.dumps({"t": t, "heavy": heavy}))
+"""
+PHASE_NAMES = ("interpreter start", "import numpy", "import xarray (with pandas)", "import numba",
+               "import the rest of bearing_lab.sim", "start equilibrium (with numba's set-up)",
+               "simulation (tables from cache, time loop, Dataset)", "netCDF file (with bearing_lab.io)")
+
+
+def phases(scene="paper-O1", runs=5):
+    """Median CPU s of each step of a warm run (PHASE_NAMES), and the heavy modules it imported."""
+    env = {**os.environ, "BEARING_LAB_PROGRESS": "0"}
+    steps, heavy = [], None
+    with tempfile.TemporaryDirectory() as tmp:
+        for _ in range(runs):
+            out = subprocess.run([sys.executable, "-c", _PHASES, scene, str(Path(tmp) / "x.nc")], env=env,
+                                 check=True, capture_output=True, text=True).stdout
+            rec = json.loads(out.strip().splitlines()[-1])
+            steps.append([rec["t"][0]] + [b - a for a, b in zip(rec["t"], rec["t"][1:])])
+            heavy = rec["heavy"]
+    med = [statistics.median(col) for col in zip(*steps)]
+    print(f"\n| a warm run's steps (the library's calls in a fresh interpreter, without the command line's "
+          f"gc.freeze; {runs} runs) | CPU s, median |")
+    print("|---|---|")
+    for name, v in zip(PHASE_NAMES, med):
+        print(f"| {name} | {v:.3f} |")
+    print(f"| sum (the process's exit not included) | {sum(med):.3f} |")
+    print(f"\nheavy modules imported: {', '.join(heavy) or 'none'}")
+    return dict(zip(PHASE_NAMES, med)), heavy
 
 
 #: files ``--startup`` reads with ``bearing-lab info`` (under BEARING_LAB_MIRROR)
@@ -101,6 +166,7 @@ if __name__ == "__main__":
     args = ap.parse_args()
     if args.startup:
         startup(args.startup, first=args.first, warm=args.warm)
+        phases(args.startup, runs=args.warm)
         mirror = Path(os.environ.get("BEARING_LAB_MIRROR", "../shared/data"))
         files = args.info if args.info is not None else [mirror / f for f in INFO_FILES if (mirror / f).is_file()]
         commands(files, runs=args.warm)

@@ -155,3 +155,21 @@ def test_analyze_states_evidence_in_lines_and_db_not_summed_db(datafile, capsys)
     text = capsys.readouterr().out
     assert "runner-up: inner_race (envelope-spectrum lines over the floor:" in text
     assert max(float(v) for v in re.findall(r"([\d.]+) dB", text)) <= 60.0, text   # a line SNR is capped at 60 dB
+
+
+def test_the_collector_is_left_alone_inside_another_program_and_set_aside_in_the_own_process(tmp_path):
+    """main(argv) called by a program (a test, a notebook) leaves the garbage collector as it was; the
+    process's own command line (the console script) sets its long-lived objects aside (gc.freeze), and
+    the file it writes is whole."""
+    import gc
+    before = gc.get_freeze_count()
+    assert main(["scenes", "-q"]) == 0
+    assert gc.get_freeze_count() == before
+    out = tmp_path / "a.nc"
+    code = ("import gc, sys\nfrom bearing_lab.cli import main\n"
+            f"sys.argv = ['bearing-lab', 'simulate', 'paper-healthy', '--duration', '0.01', '-q', '-o', {str(out)!r}]\n"
+            "status = main()\nprint(status, gc.get_freeze_count() > 10000)")
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert res.stdout.split() == ["0", "True"]
+    ds = xr.load_dataset(out)
+    assert ds.sizes["time"] > 0 and np.all(np.isfinite(ds["outer_ring_acc_y"].values))

@@ -73,6 +73,27 @@ def test_the_simulator_imports_scipys_root_finders_only_when_it_solves():
     assert out.stdout.strip().splitlines()[-1] == "[]"
 
 
+def test_a_planar_simulation_imports_no_scipy_linalg_and_it_still_works_after(tmp_path):
+    """A planar run imports neither scipy.optimize (its start is Newton's method) nor scipy.linalg,
+    which numba's start asks for its BLAS (bearing_lab.sim._numba answers with the extension
+    module alone); afterwards scipy.linalg imports whole, with that module as its cython_blas,
+    and numba's np.dot (BLAS) gives the product."""
+    probe = ("import sys\nimport bearing_lab\nfrom bearing_lab.io import to_netcdf\n"
+             "ds = bearing_lab.simulate('paper-healthy', duration=0.005, progress=False)\n"
+             f"to_netcdf(ds, {str(tmp_path / 'a.nc')!r})\n"
+             "print([m for m in ('scipy.optimize._optimize', 'scipy.linalg', 'numpy.f2py') if m in sys.modules])\n"
+             "blas = sys.modules.get('scipy.linalg.cython_blas')\n"
+             "import numpy as np, numba, scipy.linalg, scipy.linalg.cython_blas\n"
+             "assert blas is None or scipy.linalg.cython_blas is blas\n"
+             "f = numba.njit(lambda a, b: np.dot(a, b))\n"
+             "a = np.arange(12.0).reshape(3, 4)\n"
+             "assert np.allclose(f(a, a.T), [[14, 38, 62], [38, 126, 214], [62, 214, 366]])\n"
+             "assert np.allclose(scipy.linalg.solve(np.diag([2.0, 4.0]), [1.0, 1.0]), [0.5, 0.25])\n"
+             "print('ok')")
+    out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, check=True)
+    assert out.stdout.strip().splitlines()[-2:] == ["[]", "ok"]
+
+
 def test_dask_still_works_through_xarray_after_the_hooks(tmp_path):
     pytest.importorskip("dask.array")
     import numpy as np

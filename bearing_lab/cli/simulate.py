@@ -4,7 +4,7 @@ from __future__ import annotations
 import sys
 import math
 
-from . import check_output_path
+from . import check_output_path, imports_loaded
 from ..errors import BearingLabError, SceneError
 from ..utils._json import dumps
 
@@ -27,6 +27,8 @@ def _simulate(args) -> int:
     from ..sim import simulate  # the command's imports load when it runs
     from ..sim.noise import add_measurement_noise
     from ..sim.scene import merge_overrides, parse_set
+    from ..io.export import to_netcdf
+    imports_loaded()
     overrides = merge_overrides(parse_set(args.set), **{"output.duration_s": args.duration,
                                                         "output.sample_rate_hz": args.fs})
     out = check_output_path(args.output, force=args.force)
@@ -35,7 +37,6 @@ def _simulate(args) -> int:
     ds = simulate(args.scene, progress=not (args.quiet or args.json), **overrides)
     if args.noise_g:
         ds = add_measurement_noise(ds, args.noise_g, seed=args.seed, color=args.noise_color)
-    from ..io.export import to_netcdf
     to_netcdf(ds, out, error=BearingLabError)
     info = {"file": str(out), "samples": int(ds.sizes["time"]), "sampling_rate_hz": float(ds.attrs["sampling_rate_hz"]),
             "fidelity": ds.attrs["fidelity"], "defect_contact_models": ds.attrs["defect_contact_models"],

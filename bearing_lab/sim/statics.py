@@ -1,6 +1,7 @@
 """The planar bearing's static equilibrium that starts every run: ball loads from the rings'
 relative displacement (Hertz, with each ball's centrifugal force and weight), and the rings'
-positions where their supports balance the load (no numba here).
+positions where their supports balance the load (no numba here, no scipy: every solve is
+Newton's method or Brent's, :mod:`.numerics`).
 
 Public API
 ----------
@@ -12,7 +13,6 @@ from __future__ import annotations
 
 import math
 
-import lazy_loader as lazy
 import numpy as np
 
 from ..errors import SceneError, SolverError
@@ -20,9 +20,6 @@ from .hertz import series_stiffness
 from ._equilibrium_kernel import split_contacts
 from .numerics import brentq
 from .scene import Scene
-
-#: scipy.optimize for the final 2-D solve (Powell's hybrid method): imported at its first use
-_optimize = lazy.load("scipy.optimize", suppress_warning=True)
 
 __all__ = ["unit_vector", "bearing_force", "ball_contact_loads", "static_equilibrium"]
 
@@ -90,10 +87,11 @@ def _solve_relative(target, force_of, scale, where):
     return _newton_2d(lambda e: force_of(e) - target, a * direction, max(w, 1.0), abs(scale), where)
 
 
-def _newton_2d(residual, e, norm, scale, where, *, tol=1e-10, iterations=60):
-    """Newton's method with a backtracking line search on a 2-D force balance ``residual(e) = 0`` (N),
-    from ``e`` (m; the solution along the load direction).  The Jacobian by central differences.
-    Converged when the unbalanced force is below ``tol`` x ``norm``; otherwise a SceneError names
+def _newton_2d(residual, e, norm, scale, where, *, tol=1e-10, accept=1e-6, iterations=60):
+    """Newton's method with a backtracking line search on a 2-D balance ``residual(e) = 0`` (N, or
+    any unit of ``norm``), from ``e`` (m).  The Jacobian by central differences.
+    Converged when the residual is below ``tol`` x ``norm``; when the line search stalls first
+    (rounding), a residual below ``accept`` x ``norm`` is taken; otherwise a SceneError names
     the unbalance: the start is never taken from an unbalanced solution."""
     r = residual(e)
     h = 1e-7 * max(scale, 1e-9)
@@ -114,7 +112,7 @@ def _newton_2d(residual, e, norm, scale, where, *, tol=1e-10, iterations=60):
             t *= 0.5
         else:
             break
-    if np.max(np.abs(r)) <= 1e-6 * norm:       # a float's worth from the balance: as good as it gets
+    if np.max(np.abs(r)) <= accept * norm:     # a float's worth from the balance: as good as it gets
         return e
     raise SceneError(f"{where}: static equilibrium not found (unbalanced force {np.max(np.abs(r)):.3g} N of "
                      f"{norm:.3g} N after Newton's method)")
@@ -194,18 +192,20 @@ def static_equilibrium(scene: Scene, phi_c0: float, k_in: float, k_out: float, *
         fi, fo, _, _ = forces(e)
         return rest_i + (fi + f_in) / ks, rest_o + (fo + f_out) / km
 
+    w = max(float(np.hypot(*load)), 1.0)
+
     def resid(e):
+        # the rings' positions against e, as a force: the load times the mismatch in units of scale
         xi, xo = rings(e)
-        return (xi - xo - e) / scale
+        return (xi - xo - e) / scale * w
     e0 = x0[:2] - x0[2:]
-    sol = _optimize.root(resid, e0, method="hybr", options={"xtol": 1e-15})
-    xi, xo = rings(sol.x)
-    fi, fo, _, _ = forces(xi - xo)
-    unbalanced = max(np.max(np.abs(fi + f_in - ks * (xi - rest_i))),
-                     np.max(np.abs(fo + f_out - km * (xo - rest_o))))
-    if not np.all(np.isfinite(sol.x)) or np.max(np.abs(resid(sol.x))) > 1e-9:
-        raise SolverError(f"scene {scene.name!r}: static equilibrium not found ({sol.message}; "
-                          f"unbalanced force {unbalanced:.3g} N)")
+    # the balance to rounding (1e-15 of the load; 2-3 Newton steps from e0): the root Powell's
+    # hybrid method (scipy.optimize.root, used before) found, to one ulp of e
+    try:
+        e = _newton_2d(resid, e0, w, scale, f"scene {scene.name!r}", tol=1e-15, accept=1e-9)
+    except SceneError as exc:
+        raise SolverError(str(exc)) from None
+    xi, xo = rings(e)
     _, _, q_in, q_out = forces(xi - xo)
     return {"xi": xi, "xo": xo, "rest_i": rest_i, "rest_o": rest_o, "f_in": f_in, "f_out": f_out,
             "ball_loads": q_out, "ball_loads_inner": q_in, "ball_loads_outer": q_out,
