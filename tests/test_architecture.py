@@ -165,20 +165,21 @@ def test_the_layer_checks_can_fail():
 #: the function-level imports left in each module (all others sit at the module top), each for the
 #: reason on its line (docs/architecture.md, "Imports"): an import circle, a CLI handler's command
 #: library (the parser imports no numpy), a library a light path must not pay for, a registry read
-#: at call time.  A module not listed has none.  analysis/ and validation/ are not counted yet.
+#: at call time.  A module not listed has none.  validation/identify*.py are not converted yet (another
+#: change to them is under way); their counts hold them where they are.
 FUNCTION_LEVEL_IMPORTS = {
     "_accessor.py": 3, "_xarray.py": 3, "compare.py": 1,
     "cli/analyze.py": 5, "cli/bench.py": 2, "cli/case.py": 4, "cli/identify.py": 6, "cli/recording.py": 13,
-    "cli/simulate.py": 5, "cli/study.py": 1, "cli/sweep.py": 5, "cli/validate.py": 3,
-    "io/__init__.py": 1, "io/_base.py": 2, "io/_fuzz.py": 3, "io/_fuzz_struct.py": 1, "io/_guard.py": 2,
+    "cli/simulate.py": 5, "cli/study.py": 1, "cli/sweep.py": 5, "cli/validate.py": 4,
+    "io/__init__.py": 1, "io/_base.py": 2, "io/_fuzz.py": 2, "io/_fuzz_struct.py": 1, "io/_guard.py": 2,
     "io/_matlab.py": 8, "io/cwru.py": 2, "io/export.py": 1, "io/mdf.py": 1, "io/netcdf.py": 3, "io/tdms.py": 1,
     "io/wav.py": 1,
     "sim/auto.py": 1, "sim/defects/halfspace.py": 2, "sim/defects/halfspace_skewed.py": 1, "sim/defects/model.py": 1,
     "sim/integrate.py": 1, "sim/limits.py": 1, "sim/scene.py": 4,
     "studies/bench.py": 2, "studies/paper.py": 1, "sweep/__init__.py": 5, "sweep/store.py": 1,
     "utils/figures.py": 2,
+    "validation/identify.py": 14, "validation/identify_report.py": 13, "validation/identify_run.py": 5,
 }
-NOT_COUNTED = ("analysis/", "validation/")
 
 
 def function_level_imports(source: str) -> list[int]:
@@ -198,8 +199,6 @@ def test_function_level_imports_do_not_creep_back():
     over = []
     for path in sorted(PKG.rglob("*.py")):
         rel = path.relative_to(PKG).as_posix()
-        if rel.startswith(NOT_COUNTED):
-            continue
         found = function_level_imports(path.read_text(encoding="utf-8"))
         if len(found) > FUNCTION_LEVEL_IMPORTS.get(rel, 0):
             over.append(f"{rel}: {len(found)} function-level imports (lines {found}), "
