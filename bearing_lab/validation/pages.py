@@ -14,7 +14,7 @@ import json
 
 import numpy as np
 
-from ..report import Report, esc, fmt, table_html, write_index
+from ..report import Report, esc, fmt, table_html
 from ..utils._files import atomic_open
 from .rows import EXIT_STATUS, ROW_KEYS, VERDICTS, case_verdict
 
