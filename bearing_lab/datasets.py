@@ -20,6 +20,8 @@ fetch(name, mirror=None, dest=None) -- Path of a hash-checked local copy (never 
 locate(name, mirror=None)           -- Path in a mirror or the cache, without copying, or None
 pooch_registry()                    -- {name: "sha256:..."} for pooch.create
 data_dir()                          -- where fetch puts files by default
+SAMPLE                              -- how the shipped sample recording (bearing_lab/data/sample_recording.uff)
+                                       is made (:func:`bearing_lab.validation.standin.make_sample_recording`)
 """
 from __future__ import annotations
 
@@ -42,6 +44,10 @@ from .utils._files import atomic_path, sha256_file
 pooch = lazy.load("pooch")
 
 # package data: present in a wheel install as in a checkout (data/README.md documents it)
+#: the sample recording shipped as package data (``bearing-lab data sample``): how it is made, here so that
+#: ``data sample --json`` says it without importing the simulator that makes it
+SAMPLE = {"scene": "paper-O2", "overrides": {"load.radial_n": 320.0}, "rpm": 1800.0, "duration": 1.0,
+          "fs": 12800.0, "seed": 7, "sensitivity_v_per_g": 9.91e-3, "channel": "Acc"}
 REGISTRY_FILE = importlib.resources.files("bearing_lab") / "data" / "recordings.csv"
 # a checkout's git-ignored download folder (absent in a wheel install)
 _CHECKOUT_DATA = Path(__file__).resolve().parents[1] / "data"

@@ -58,9 +58,9 @@ from bearing_lab.bearings import get_bearing
 from bearing_lab.sim import load_scene
 from bearing_lab.sim.assembly import assemble
 from bearing_lab.sim.defects import RaceGeometry, rigid_drop
+from bearing_lab.sim.defects.compare_law import compare_local_law
 from bearing_lab.sim.defects.contact import _MEMORY, _build, contact_table
 from bearing_lab.sim.defects.geometry import hertz_semi_axes
-from bearing_lab.sim.defects.halfspace import compare_local_law
 from bearing_lab.sim.defects._halfspace_kernels import warm_up
 from bearing_lab.sim.hertz import race_contact
 

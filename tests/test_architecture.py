@@ -157,6 +157,49 @@ def test_validation_modules_import_only_their_layer_or_earlier():
     assert not wrong, "validation imports a later layer:\n" + "\n".join(wrong)
 
 
+def import_circles(graph: dict) -> list:
+    """The strongly connected components of more than one module of ``graph`` (module -> the modules it
+    imports), each sorted: the import circles, whether their imports sit at a module's top or in a function."""
+    index, low, stack, on_stack, out = {}, {}, [], set(), []
+
+    def visit(v):
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on_stack.add(v)
+        for w in graph.get(v, ()):
+            if w not in graph:
+                continue
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on_stack:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            comp = []
+            while not comp or comp[-1] != v:
+                comp.append(stack.pop())
+                on_stack.discard(comp[-1])
+            if len(comp) > 1:
+                out.append(sorted(comp))
+    for m in sorted(graph):
+        if m not in index:
+            visit(m)
+    return out
+
+
+def test_no_import_circle_even_through_function_level_imports():
+    """A circle closed by an import inside a function imports alone (the check below cannot see it), so
+    the module graph itself, every import counted, must have none."""
+    circles = import_circles({m: imported_modules(m) for m in MODULES})
+    assert not circles, "import circles:\n" + "\n".join(" <-> ".join(c) for c in circles)
+
+
+def test_the_circle_check_can_fail():
+    graph = {"a": {"b"}, "b": {"c"}, "c": {"a", "d"}, "d": set(), "e": {"e2"}, "e2": {"e"}}
+    assert import_circles(graph) == [["a", "b", "c"], ["e", "e2"]]
+    assert import_circles({"a": {"b"}, "b": set()}) == []
+
+
 def test_the_layer_checks_can_fail():
     assert "bearing_lab.validation.recording_case" in imported_modules("bearing_lab.validation.rig")
     assert "bearing_lab.validation.rig" in imported_modules("bearing_lab.validation.recording_run")
@@ -165,20 +208,21 @@ def test_the_layer_checks_can_fail():
 #: the function-level imports left in each module (all others sit at the module top), each for the
 #: reason on its line (docs/architecture.md, "Imports"): an import circle, a CLI handler's command
 #: library (the parser imports no numpy), a library a light path must not pay for, a registry read
-#: at call time.  A module not listed has none.  analysis/ and validation/ are not counted yet.
+#: at call time.  A module not listed has none.  validation/identify*.py are not converted yet (another
+#: change to them is under way); their counts hold them where they are.
 FUNCTION_LEVEL_IMPORTS = {
     "_accessor.py": 3, "_xarray.py": 3, "compare.py": 1,
     "cli/analyze.py": 5, "cli/bench.py": 2, "cli/case.py": 4, "cli/identify.py": 6, "cli/recording.py": 13,
-    "cli/simulate.py": 5, "cli/study.py": 1, "cli/sweep.py": 5, "cli/validate.py": 3,
-    "io/__init__.py": 1, "io/_base.py": 2, "io/_fuzz.py": 3, "io/_fuzz_struct.py": 1, "io/_guard.py": 2,
+    "cli/simulate.py": 5, "cli/study.py": 1, "cli/sweep.py": 5, "cli/validate.py": 4,
+    "io/__init__.py": 1, "io/_base.py": 2, "io/_fuzz.py": 2, "io/_fuzz_struct.py": 1, "io/_guard.py": 2,
     "io/_matlab.py": 8, "io/cwru.py": 2, "io/export.py": 1, "io/mdf.py": 1, "io/netcdf.py": 3, "io/tdms.py": 1,
     "io/wav.py": 1,
-    "sim/auto.py": 1, "sim/defects/halfspace.py": 2, "sim/defects/halfspace_skewed.py": 1, "sim/defects/model.py": 1,
-    "sim/integrate.py": 1, "sim/limits.py": 1, "sim/scene.py": 4,
+    "sim/defects/halfspace.py": 1, "sim/defects/halfspace_skewed.py": 1,
+    "sim/integrate.py": 1,
     "studies/bench.py": 2, "studies/paper.py": 1, "sweep/__init__.py": 5, "sweep/store.py": 1,
     "utils/figures.py": 2,
+    "validation/identify.py": 14, "validation/identify_report.py": 13, "validation/identify_run.py": 5,
 }
-NOT_COUNTED = ("analysis/", "validation/")
 
 
 def function_level_imports(source: str) -> list[int]:
@@ -198,8 +242,6 @@ def test_function_level_imports_do_not_creep_back():
     over = []
     for path in sorted(PKG.rglob("*.py")):
         rel = path.relative_to(PKG).as_posix()
-        if rel.startswith(NOT_COUNTED):
-            continue
         found = function_level_imports(path.read_text(encoding="utf-8"))
         if len(found) > FUNCTION_LEVEL_IMPORTS.get(rel, 0):
             over.append(f"{rel}: {len(found)} function-level imports (lines {found}), "

@@ -56,7 +56,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import AnalysisError
-from ._faults import FUNDAMENTAL_SNR_DB, HARMONIC_SNR_DB, MIN_HARMONICS, shaft_mask
+from ._fault_rule import FUNDAMENTAL_SNR_DB, HARMONIC_SNR_DB, MIN_HARMONICS, shaft_mask
 from ._speed import line_floor_db
 
 __all__ = ["CyclicSpectrum", "family_evidence", "route_verdict", "search_families", "decoy_ratios",

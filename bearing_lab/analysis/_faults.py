@@ -36,13 +36,11 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import AnalysisError
+from ._fault_rule import FUNDAMENTAL_SNR_DB, HARMONIC_SNR_DB, MIN_HARMONICS, shaft_mask
+from ._families import CyclicSpectrum, route_verdict, search_families
 from ._speed import line_floor_db
 
 __all__ = ["fault_line", "diagnose_ses", "FUNDAMENTAL_SNR_DB", "HARMONIC_SNR_DB", "MIN_HARMONICS"]
-
-FUNDAMENTAL_SNR_DB = 12.0
-HARMONIC_SNR_DB = 10.0
-MIN_HARMONICS = 3
 
 FAULT_KEYS = ("bpfo", "bpfi", "bsf", "ftf")
 DIAGNOSES = {"bpfo": "outer_race", "bpfi": "inner_race", "bsf": "ball"}
@@ -53,14 +51,6 @@ def _parabolic(y, k):
     a, b, c = np.log(np.maximum(y[k - 1: k + 2], 1e-300))
     den = a - 2 * b + c
     return 0.0 if den >= 0 else float(np.clip(0.5 * (a - c) / den, -0.5, 0.5))
-
-
-def shaft_mask(f, shaft_hz, df):
-    if not shaft_hz:
-        return np.zeros(f.shape, bool)
-    h = np.rint(f / shaft_hz)
-    tol = np.maximum(1.5 * df, 1e-3 * f)
-    return (h >= 1) & (np.abs(f - h * shaft_hz) <= tol)
 
 
 def _best_peak(snr, lo_k, hi_k, usable):
@@ -220,8 +210,6 @@ def diagnose_ses(f, ses, fault_hz, *, shaft_hz=None, tolerance=0.02, n_harmonics
     >>> diagnose_ses(f, ses, ff, shaft_hz=fr)[0]
     'outer_race'
     """
-    from ._families import CyclicSpectrum, route_verdict, search_families
-
     missing = [k for k in FAULT_KEYS if k not in fault_hz]
     if missing:
         raise AnalysisError(f"diagnose_ses: fault_hz lacks {missing}; give bpfo, bpfi, bsf and ftf in Hz")

@@ -33,7 +33,7 @@ import numpy as np
 
 from .._docdict import fill_doc
 from ..errors import AnalysisError, check_choice
-from ._spectral import envelope_band, fast_kurtogram, squared_envelope
+from ._spectral import bandpass, envelope_band, fast_kurtogram, squared_envelope
 from ._speed import harmonic_family
 from ._util import check_fs, check_signal
 
@@ -225,7 +225,6 @@ def impulses(x, fs, *, band=None, threshold=None, min_separation=1e-3, level=0.1
         raise AnalysisError(f"impulses: x must be 1-D, got shape {x.shape}")
     band = _band_arg(x, fs, band, "impulses")
     if band is not None:
-        from ._spectral import bandpass
         y = bandpass(x, fs, band=band)
     else:
         y = x - x.mean()

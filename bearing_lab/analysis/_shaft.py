@@ -60,7 +60,7 @@ from scipy.stats import binom
 
 from ..errors import AnalysisError
 from ._families import SK_MIN, search_families
-from ._faults import FUNDAMENTAL_SNR_DB, MIN_HARMONICS
+from ._fault_rule import FUNDAMENTAL_SNR_DB, MIN_HARMONICS
 from ._speed import LINE_SNR_DB, SNR_CAP_DB, interpolated_peak, line_floor_db
 
 __all__ = ["RawLines", "resolve_speed", "MIN_SHAFT_LINES", "PRIOR_TOLERANCE", "BLIND_RANGE_HZ"]

@@ -21,6 +21,7 @@ from __future__ import annotations
 import numpy as np
 from scipy import fft as _fft
 from scipy import signal as _sig
+from scipy.ndimage import median_filter
 
 from .._docdict import fill_doc
 from ..errors import AnalysisError
@@ -538,8 +539,6 @@ def envelope_band(x, fs, *, frequency_range, min_bandwidth=None, nlevel=None, n_
     >>> bool(band[0] <= 3000 <= band[1])
     True
     """
-    from scipy.ndimage import median_filter
-
     fs = check_fs(fs, func="envelope_band")
     x = check_signal(x, func="envelope_band", min_samples=256)
     if x.ndim != 1:

@@ -20,6 +20,7 @@ Fyfe & Munck 1997; Borghesani et al. 2013 for envelope analysis after it).
 from __future__ import annotations
 
 import numpy as np
+from scipy.interpolate import CubicSpline, PchipInterpolator
 
 from .._docdict import fill_doc
 from ..errors import AnalysisError
@@ -153,8 +154,6 @@ def order_track(x, fs, pulse_times, *, pulses_per_rev=1):
     .. [1] Fyfe & Munck, "Analysis of computed order tracking", MSSP 11 (1997) 187-205.
     .. [2] Borghesani, Pennacchi, Randall, Sawalhi & Ricci, MSSP 36 (2013) 370-384.
     """
-    from scipy.interpolate import CubicSpline, PchipInterpolator
-
     fs = check_fs(fs, func="order_track")
     x = check_signal(x, func="order_track", min_samples=16)
     p = np.asarray(pulse_times, float)

@@ -44,6 +44,8 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.ndimage import median_filter
+from scipy.signal import welch
 
 from .._docdict import fill_doc
 from ..errors import AnalysisError
@@ -137,7 +139,6 @@ def _fit_tones(x, fs, freqs, mask=None):
 
 
 def _find_tones(x, fs, *, exclude_hz, shaft_hz, snr_db, max_tones, mask=None):
-    from scipy.ndimage import median_filter
     n = x.size
     w = np.hanning(n)
     amp = np.abs(np.fft.rfft(x * w)) * 2 / w.sum()
@@ -245,7 +246,6 @@ def estimate_background(x, fs, *, times=None, period=None, exclude_hz=(), shaft_
     if gated:
         freq, psd = _gated_psd(resid, fs, mask)
     else:
-        from scipy.signal import welch
         freq, psd = welch(resid, fs, window="hann", nperseg=min(x.size, 2048))
     if model is not None:
         tones, psd = _without_model(model, fs, tones, freq, psd, times=model_times if model_times is not None
@@ -271,6 +271,5 @@ def _without_model(model, fs, tones, freq, psd, *, times, period):
         mask = between_impacts(y.size, fs, times, period)
         f_m, p_m = _gated_psd(y, fs, mask)
     else:
-        from scipy.signal import welch
         f_m, p_m = welch(y, fs, window="hann", nperseg=min(y.size, 2048))
     return kept, np.maximum(psd - np.interp(freq, f_m, p_m), 0.0)

@@ -19,17 +19,17 @@ between_impacts(n, fs, times, period, *, guard=0.45, end=0.85) -- boolean mask o
 from __future__ import annotations
 
 import numpy as np
+from scipy.signal import hilbert
 
 from .._docdict import fill_doc
 from ..errors import AnalysisError
+from ._spectral import bandpass
 
 __all__ = ["impact_times", "impulse_strength", "impact_peaks", "impact_segments", "mean_envelope",
            "segment_spectrum", "between_impacts"]
 
 
 def _envelope(x, fs, band=None):
-    from scipy.signal import hilbert
-    from ._spectral import bandpass
     x = np.asarray(x, float)
     y = bandpass(x, fs, band=band) if band is not None else x - np.mean(x)
     return np.abs(hilbert(y))

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import re
 
+from ..bearings import CATALOG
 from ..errors import AnalysisError
 
 __all__ = ["time_channels", "pick_channel", "pick_tacho", "bearing_name", "not_an_acceleration", "TACHO_NAME",
@@ -81,7 +82,6 @@ def bearing_name(ds, given=None, *, source="") -> str:
     Raises :class:`~bearing_lab.errors.AnalysisError` naming ``source`` and the catalog when the
     Dataset names none.
     """
-    from ..bearings import CATALOG
     if given is not None:
         return given
     attr = str(ds.attrs.get("bearing", ""))

@@ -20,7 +20,11 @@ import numpy as np
 
 from .._docdict import fill_doc
 from ..errors import AnalysisError
+from ._faults import fault_line
+from ._impulse import impulses
+from ._spectral import amplitude_spectrum, fast_kurtogram
 from .impacts import impact_times, impulse_strength
+from .pipeline import analyze
 
 __all__ = ["measure", "shaft_line", "MEASURED"]
 
@@ -36,15 +40,12 @@ def shaft_line(x, fs, expected_hz, *, tolerance=0.03):
     Returns ``(measured_hz, snr_db)``; ``measured_hz`` is None when no fundamental stands
     above the fault search's threshold (:data:`bearing_lab.analysis._faults.FUNDAMENTAL_SNR_DB`).
     """
-    from ._faults import fault_line
-    from ._spectral import amplitude_spectrum
     f, a = amplitude_spectrum(x, fs, window="hann")
     r = fault_line(f, a, expected_hz, tolerance=tolerance, n_harmonics=1)
     return r["measured_hz"], float(r["snr_db"])
 
 
 def _band_for(x, fs, fmax_line):
-    from ._spectral import fast_kurtogram
     try:
         return fast_kurtogram(x, fs, min_bandwidth=min(fmax_line, 0.2 * fs)).band
     except AnalysisError:
@@ -72,7 +73,6 @@ def _duration_band(duration_band, fs):
 
 
 def _impact_quantities(x, fs, period, level, out, notes, duration_band="own"):
-    from ._impulse import impulses
     band = _band_for(x, fs, 4.0 / period)
     times = impact_times(x, fs, period, band=band)
     out["impulse_strength"] = impulse_strength(x, fs, period, band=band)
@@ -168,7 +168,6 @@ def measure(x, fs, *, bearing, rpm=None, shaft_hz=None, fault=None, duration_lev
     >>> round(m["bpfo"], 1), bool(np.isnan(m["bpfi"]))
     (107.4, True)
     """
-    from .pipeline import analyze
     x = np.asarray(x, dtype=float)
     res = analyze(x, fs, bearing=bearing, rpm=rpm, shaft_hz=shaft_hz)
     duration_band = _duration_band(duration_band, fs)

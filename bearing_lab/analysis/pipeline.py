@@ -40,6 +40,8 @@ import numpy as np
 from .._docdict import fill_doc
 from ..bearings import BearingGeometry, get_bearing
 from ..errors import AnalysisError, BearingLabError, check_choice
+from ..utils._files import savefig
+from ..utils.figures import new_figure  # detached from pyplot, shown inline as a cell's value
 from ._diagnosis import (coincidences, combine, deciding_route, interpretations, line_stats, route_summary,
                          run_routes, runner_up, spectrum_top)
 from ._families import LABELS, SK_MIN, CyclicSpectrum
@@ -489,7 +491,6 @@ def plot_analysis(x, fs, *, bearing, rpm=None, shaft_hz=None, channel="", units=
     3
     """
     if fig is None:
-        from ..utils.figures import new_figure   # detached from pyplot, shown inline as a cell's value
         fig = new_figure(figsize=(10, 9), layout="constrained")
     result, ex = _run(x, fs, bearing=bearing, rpm=rpm, shaft_hz=shaft_hz, units=units, **kwargs)
     result["channel"], result["units"] = str(channel), str(units)
@@ -512,7 +513,6 @@ def plot_analysis(x, fs, *, bearing, rpm=None, shaft_hz=None, channel="", units=
             xlim=(0, fs / 2))
     _plot_envelope(ax3, ex, result, units)
     if path is not None:
-        from ..utils._files import savefig
         savefig(fig, path, dpi=110)  # atomic: an existing figure survives a failed write
     return fig, result
 

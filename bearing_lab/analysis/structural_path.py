@@ -62,8 +62,11 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.optimize import least_squares
+from scipy.signal import hilbert
 
 from ..errors import AnalysisError, check_choice
+from ..utils._files import atomic_open
 from .impacts import between_impacts, impact_peaks, impact_times, mean_envelope, segment_spectrum
 
 __all__ = ["transmissibility", "Resonance", "StructuralPath", "fit_structural_path", "MIN_IMPACTS"]
@@ -206,7 +209,6 @@ class StructuralPath:
 
     def save(self, path):
         """Write the path as JSON (atomically); :meth:`load` reads it back."""
-        from ..utils._files import atomic_open
         with atomic_open(path, "w", encoding="utf-8") as fh:
             json.dump(_jsonable(self.to_dict()), fh, indent=1)
         return path
@@ -238,7 +240,6 @@ def _floor(x, fs, times, period) -> float:
     """The floor of a signal: its median Hilbert envelope between the impacts (0.45 to 0.85 of a period
     after each, :func:`between_impacts`), where the ringing has died out; the whole record's median
     where no such stretch fits."""
-    from scipy.signal import hilbert
     x = np.asarray(x, float)
     env = np.abs(hilbert(x - np.mean(x)))
     mask = between_impacts(env.size, fs, times, period)
@@ -490,7 +491,6 @@ def fit_structural_path(recording, simulation, fs, period, *, band=None, n_reson
     AnalysisError
         Fewer than :data:`MIN_IMPACTS` impacts in either signal, or invalid bounds.
     """
-    from scipy.optimize import least_squares
     recording, fs_r = _samples(recording, fs)
     simulation, fs_s = _samples(simulation, fs)
     if abs(fs_r - fs_s) > 1e-9 * fs_r:
@@ -532,7 +532,6 @@ FLAT_MARGIN_DB = 0.05
 
 def _flat_path(prob, bounds, notes, source):
     """The path without a resonance (the gain alone), fitted on the same residuals; None when it cannot be."""
-    from scipy.optimize import least_squares
     glo, ghi = (math.log(v) for v in bounds["gain"])
     peak_s = prob.impact_peak(prob.s, prob.ts)
     if not peak_s > 0:

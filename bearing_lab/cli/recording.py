@@ -165,7 +165,7 @@ def _cmd_sample(args) -> int:
     with resources.as_file(src) as p:
         shutil.copyfile(p, out)
     if args.json:
-        from ..validation.standin import SAMPLE
+        from ..datasets import SAMPLE
         print(dumps({"file": str(out), **SAMPLE}, indent=1))
     elif not args.quiet:
         print(f"{out}: the sample recording (made by bearing_lab: a simulated 6308 with an outer-race defect, "

@@ -82,7 +82,7 @@ def _json(outcomes, out_dir, status) -> dict:
 
 
 def run(args) -> int:
-    from ..validation import load_case, run_validation, shipped_cases  # the command's imports load when it runs
+    from ..validation import load_case, shipped_cases  # the command's imports load when it runs
     if args.list:
         if args.json:
             print(dumps([{"case": n, "default": load_case(n).default, "title": load_case(n).title}
@@ -92,6 +92,7 @@ def run(args) -> int:
             c = load_case(name)
             print(f"{name:12s} {'default' if c.default else '       '}  {c.title}")
         return 0
+    from ..validation import run_validation  # a run loads the simulator, the analysis and the pages; --list does not
     t0 = time.perf_counter()
     quiet = args.quiet or args.json
     progress = not (args.no_progress or quiet) and os.environ.get("BEARING_LAB_PROGRESS", "1") != "0"

@@ -530,9 +530,6 @@ def main(argv=None) -> int:
     w.add_argument("name")
     w.add_argument("seed", type=int)
     w.add_argument("mem_mb", type=int)
-    st = sub.add_parser("structured")
-    st.add_argument("kind")
-    st.add_argument("seed", type=int)
     r = sub.add_parser("repro", help="write one mutant and say what reading it gives")
     r.add_argument("name", choices=sorted(SOURCES))
     r.add_argument("seed", type=int)
@@ -541,10 +538,6 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     if args.cmd == "worker":
         worker(args.name, args.seed, args.mem_mb)
-        return 0
-    if args.cmd == "structured":
-        from ._fuzz_struct import structured_worker  # circle: _fuzz_struct imports _fuzz
-        structured_worker(args.kind, args.seed)
         return 0
     p = _save(args.name, args.seed, args.index, Path(args.out))
     print(f"{p}: {_describe(args.name, args.seed, args.index)}")

@@ -469,7 +469,7 @@ def fuzz_structured(kind: str, n: int, *, seed: int = 0, timeout: float = 30.0) 
     counts = {v: 0 for v in STRUCT_VERDICTS}
     examples: dict[str, list] = {}
     ops: dict[str, dict] = {}
-    cmd = [sys.executable, "-m", "bearing_lab.io._fuzz", "structured", kind, str(seed)]
+    cmd = [sys.executable, "-m", "bearing_lab.io._fuzz_struct", kind, str(seed)]
     fd, phase_file = tempfile.mkstemp(prefix="bearing_lab_fuzz_phase_")
     os.close(fd)
     os.environ["BEARING_LAB_FUZZ_PHASE"] = phase_file
@@ -539,3 +539,7 @@ def truncate_while_reading(target: Path, *, mb: float = 64.0, trials: int = 5, s
             out["examples"].append(f"exit {code}: {err.strip()[-160:]}")
     target.unlink()
     return out
+
+
+if __name__ == "__main__":  # the worker fuzz_structured starts: ``python -m bearing_lab.io._fuzz_struct KIND SEED``
+    structured_worker(sys.argv[1], int(sys.argv[2]))

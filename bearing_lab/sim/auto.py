@@ -35,9 +35,9 @@ import warnings
 import numpy as np
 
 from ..errors import BearingLabError, SolverError
-from .bearing3d import groove_offsets, needs_3d
+from .bearing3d import groove_offsets, load_zone_angle, needs_3d, static_3d, track_offset
 from .defects.geometry import RaceGeometry
-from .scene import SceneWarning
+from .limits import SceneWarning
 
 RULES_FILE = Path(__file__).with_name("auto_rules.toml")
 DEFAULT = {"fidelity": "multibody", "method": "dp54", "rtol": 1e-5, "max_step_s": 2.5e-5,
@@ -65,8 +65,7 @@ MISS_DELTA = 20e-6  # an approach no bench scene reaches: beyond it a defect can
 def _track_3d(scene, fid):
     """(each defect as the 3-D contact track meets it, what the track is): a race defect turned across
     the groove by the static contact angle at its position, as its contact table is built
-    (:func:`.assembly.track_offset`); a ball defect as it is."""
-    from .assembly import track_offset, load_zone_angle, static_3d  # circle: assembly imports auto
+    (:func:`.bearing3d.track_offset`); a ball defect as it is."""
     try:
         with np.errstate(all="ignore"):
             st = static_3d(scene, fid)
@@ -239,3 +238,24 @@ def _grazed(scene, defects) -> list:
         if GRAZE_MIN < gap < MISS_DELTA:
             out.append((k, gap))
     return out
+
+
+def warn_off_track(scene) -> None:
+    """A defect the balls never touch makes a healthy bearing: say so (a 5 for a 0.5?).  Judged on
+    the track the scene runs on (:func:`track_defects`: under an axial load, the 3-D track at
+    the static contact angle; a 3-D start that is not found is reported by the run, not here)."""
+    try:
+        defects, track = track_defects(scene)
+    except BearingLabError:
+        return
+    for i, defect in enumerate(defects):
+        if not defect.misses_track(scene.bearing, MISS_DELTA, clearance=scene.clearance):
+            continue
+        where = "defect" if len(scene.defects) == 1 else f"defect[{i}]"
+        raw = scene.data["defect"][i]
+        on = "" if track.startswith("planar") else " at the contact angle of the axial load"
+        warnings.warn(f"{where} misses the ball track{on}: no part of it comes within reach of the "
+                      f"balls (offset_mm={raw.get('offset_mm', 0)}, width_mm="
+                      f"{raw.get('width_mm', '-')}, skew_deg={raw.get('skew_deg', 0)}), so "
+                      "this simulates a healthy bearing; check defect.offset_mm",
+                      SceneWarning, stacklevel=4)

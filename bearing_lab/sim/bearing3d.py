@@ -37,9 +37,14 @@ check_axial_keys(scene)                       -- the displacement preload's chec
 static_equilibrium_3d(scene, phi_c0, k_in, k_out, *, ball_mass, omega_cage, exponent) -> dict
 contact_angles(...)                           -- per ball, from states (see :func:`contact_angles`)
 axial_support(section) -> (k, c)             -- a support's axial stiffness and damping (its Y values if unset)
+load_zone_angle(scene) -> float               -- the load-zone centre, rad
+race_contacts(scene)                          -- the Hertz contacts (inner, outer) of the scene's bearing
+static_3d(scene, fid) -> dict                 -- the start of a 3-D run of fidelity fid, kept on the scene
+track_offset(defect, st, race, psi0, bearing) -- the defect as the 3-D contact track meets it
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import lazy_loader as lazy
@@ -47,6 +52,7 @@ import numpy as np
 
 from ..errors import SceneError, SolverError
 from ._equilibrium_kernel import balls_3d
+from .hertz import race_contact
 from .limits import MAX_SUPPORT_DEFLECTION
 from .numerics import brentq
 
@@ -55,7 +61,7 @@ from .numerics import brentq
 _optimize = lazy.load("scipy.optimize", suppress_warning=True)
 
 __all__ = ["needs_3d", "static_equilibrium_3d", "contact_angles", "groove_offsets", "preload_geometry",
-           "check_axial_keys", "axial_support"]
+           "check_axial_keys", "axial_support", "load_zone_angle", "race_contacts", "static_3d", "track_offset"]
 
 
 def needs_3d(scene) -> bool:
@@ -430,3 +436,63 @@ def contact_angles(state, phis, *, zoff, pd, a_i, a_o, multibody, z):
     else:
         ao = ai = np.degrees(np.arctan2(np.broadcast_to(zi - zo, ui.shape), a_i + a_o - pd / 2 + ui - uo))
     return ao.T, ai.T
+
+
+# ---- the start and the contact track, shared by the assembly and the auto choice (below both)
+def load_zone_angle(scene) -> float:
+    """Angle (rad) of the load-zone centre: the load direction for a load on the
+    inner ring, the opposite direction for a load on the outer ring."""
+    d = scene.data["load"]
+    beta = math.radians(d["direction_deg"])
+    return beta if d["on"] == "inner" else beta + math.pi
+
+
+def track_offset(defect, st, race, psi0, bearing):
+    """The defect as the contact meets it in the 3-D bearing: the groove's cross-section turned
+    about its curvature centre by the contact angle at the defect's position, so that the table,
+    built for a ball at the groove bottom, sees the outline where the contact track really runs.
+    The defect's centre at axial offset H (groove angle asin(H / r_g)) moves to r_g sin(asin(H /
+    r_g) - alpha), and for an unskewed rectangle or ellipse its axial edges alike (its width then
+    grows by about 1 / cos(alpha)); a skewed outline or a polygon only moves.  The along-track
+    radius change ((1 - cos alpha) r_g / R, 0.2 % at 10 deg) is neglected."""
+    a_i, a_o = groove_offsets(bearing)
+    if race == "outer":
+        r_g = a_o + bearing.ball_diameter / 2
+        alpha = float(np.interp(psi0 % (2 * math.pi), np.sort(st["phis"] % (2 * math.pi)),
+                                st["alpha_o"][np.argsort(st["phis"] % (2 * math.pi))], period=2 * math.pi))
+    else:
+        # a rotating (inner-race) defect: the angle of the most loaded ball
+        r_g = a_i + bearing.ball_diameter / 2
+        alpha = -float(st["alpha_i"][int(np.argmax(st["ball_loads_inner"]))])
+    def turn(zz):
+        return r_g * math.sin(math.asin(max(-1.0, min(1.0, zz / r_g))) - alpha)
+    if defect.skew == 0.0 and defect.shape in ("rectangle", "ellipse"):
+        # the axial edges turned too: a width B at the contact spans B / cos(alpha) of groove arc
+        lo, hi = turn(defect.offset - defect.width / 2), turn(defect.offset + defect.width / 2)
+        return dataclasses.replace(defect, offset=0.5 * (lo + hi), width=hi - lo), alpha
+    return dataclasses.replace(defect, offset=turn(defect.offset)), alpha
+
+
+def race_contacts(scene):
+    """The Hertz contacts (inner, outer) of the scene's bearing and material."""
+    b, mat = scene.bearing, scene.data["material"]
+    kw = dict(contact_angle=b.contact_angle, youngs_modulus=mat["youngs_modulus_gpa"] * 1e9,
+              poisson_ratio=mat["poisson_ratio"])
+    return (race_contact(b.ball_diameter, b.pitch_diameter, b.inner_conformity, "inner", **kw),
+            race_contact(b.ball_diameter, b.pitch_diameter, b.outer_conformity, "outer", **kw))
+
+
+def static_3d(scene, fid: str) -> dict:
+    """The 3-D bearing's static equilibrium at the start of a run of fidelity ``fid`` (cage with a
+    ball at the load-zone centre, at the starting speed): the one :func:`.assembly.assemble` starts from and
+    the one ``fidelity``/``solver.method = "auto"`` decide the contact track on.  Solved once per
+    scene and fidelity and kept on the scene (a scene is not changed after it is built)."""
+    cache = scene.__dict__.setdefault("_static_3d", {})
+    if fid not in cache:
+        hi, ho = race_contacts(scene)
+        _, rpm = scene.speed_profile()
+        omega_c0 = scene.bearing.frequency_factors()["ftf"] * rpm[0] * 2 * math.pi / 60
+        cache[fid] = static_equilibrium_3d(scene, load_zone_angle(scene), hi.stiffness, ho.stiffness,
+                                           ball_mass=0.0 if fid == "quasi-static" else scene.masses()[2],
+                                           omega_cage=omega_c0, exponent=scene.data["contact"]["exponent"])
+    return cache[fid]

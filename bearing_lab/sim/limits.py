@@ -1,4 +1,5 @@
-"""Physical limits of a scene, checked before anything runs, and warnings for likely typos.
+"""Physical limits of a scene, checked before anything runs, and the warning type for likely typos
+(:class:`SceneWarning`, warned by :func:`.auto.warn_off_track` and the auto choice).
 
 Why apart from :mod:`.scene`'s per-key checks: these need several keys at once (speed with
 the bearing's size, a support's stiffness with the load and the masses) and each guards a
@@ -7,12 +8,14 @@ without a sign change, a filter design without a pass band) or as hours of compu
 """
 from __future__ import annotations
 
-import warnings
-
 import numpy as np
 
-from ..errors import BearingLabError, SceneError
-from .scene import SceneWarning
+from ..errors import SceneError
+
+
+class SceneWarning(UserWarning):
+    """A valid scene that probably does not say what was meant (e.g. a defect off the track)."""
+
 
 MAX_SPEED_FACTOR = 3e6
 """n·d_m (r/min × mm) above which no ball bearing runs: about 1e6 is the usual oil-lubricated
@@ -78,25 +81,3 @@ def _check_supports(scene) -> None:
                                  f"bearing support gives less than "
                                  f"{MAX_SUPPORT_DEFLECTION * 1e3:g} mm (stiffness at least "
                                  f"{force / MAX_SUPPORT_DEFLECTION:.3g} N/m)")
-
-
-def warn_off_track(scene) -> None:
-    """A defect the balls never touch makes a healthy bearing: say so (a 5 for a 0.5?).  Judged on
-    the track the scene runs on (:func:`.auto.track_defects`: under an axial load, the 3-D track at
-    the static contact angle; a 3-D start that is not found is reported by the run, not here)."""
-    from .auto import MISS_DELTA, track_defects  # circle: bearing3d -> limits -> auto -> bearing3d
-    try:
-        defects, track = track_defects(scene)
-    except BearingLabError:
-        return
-    for i, defect in enumerate(defects):
-        if not defect.misses_track(scene.bearing, MISS_DELTA, clearance=scene.clearance):
-            continue
-        where = "defect" if len(scene.defects) == 1 else f"defect[{i}]"
-        raw = scene.data["defect"][i]
-        on = "" if track.startswith("planar") else " at the contact angle of the axial load"
-        warnings.warn(f"{where} misses the ball track{on}: no part of it comes within reach of the "
-                      f"balls (offset_mm={raw.get('offset_mm', 0)}, width_mm="
-                      f"{raw.get('width_mm', '-')}, skew_deg={raw.get('skew_deg', 0)}), so "
-                      "this simulates a healthy bearing; check defect.offset_mm",
-                      SceneWarning, stacklevel=4)

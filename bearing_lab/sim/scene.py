@@ -43,8 +43,11 @@ from .._docdict import fill_doc
 from ..bearings import BearingGeometry, CATALOG, get_bearing
 from ..errors import SceneError, check_choice
 from ..units import G
+from .auto import warn_off_track
+from .bearing3d import check_axial_keys, needs_3d
 from .defects import Defect  # the 2-D defect description
 from .defects import contact  # its registry CONTACT_MODELS, read at call time (models register at run time)
+from .limits import SceneWarning, check_limits  # noqa: F401  (SceneWarning: a scene's warning type)
 from .scene_keys import _NUM, DEFECT_KEYS, SCHEMA, STEEL_DENSITY  # noqa: F401  (the table of scene keys)
 
 
@@ -54,10 +57,6 @@ SETTLE_3D_S = 0.03
 #: settles, switched off ``SETTLE_FREE_S`` before the record starts (see :attr:`Scene.settle`)
 SETTLE_AXIAL_RATE = 1e3
 SETTLE_FREE_S = 0.01
-
-
-class SceneWarning(UserWarning):
-    """A valid scene that probably does not say what was meant (e.g. a defect off the track)."""
 
 
 # ---------------------------------------------------------------- units
@@ -234,7 +233,6 @@ class Scene:
             defects.append(defect)
         scene = cls(d, bearing, tuple(defects))
         scene._check_physics()
-        from .limits import warn_off_track  # circle: scene -> limits -> scene (and bearing3d -> limits)
         warn_off_track(scene)
         return scene
 
@@ -269,13 +267,11 @@ class Scene:
         if pd > 0.02 * b.ball_diameter:
             raise SceneError(f"clearance.radial_um={pd*1e6:g} is larger than 2 % of the ball diameter: "
                              "not a bearing")
-        from .bearing3d import check_axial_keys  # circle: scene -> limits -> scene (and bearing3d -> limits)
         check_axial_keys(self)
         if self.fs_out < 1000:
             raise SceneError(f"output.sample_rate_hz={self.fs_out:g} is below 1 kHz: too coarse for bearing vibration")
         if d["output"]["duration_s"] > 600:
             raise SceneError(f"output.duration_s={d['output']['duration_s']:g} s exceeds 600 s; split the run")
-        from .limits import check_limits  # circle: scene -> limits -> scene (and bearing3d -> limits)
         check_limits(self)
 
     # ---- SI accessors
@@ -314,7 +310,6 @@ class Scene:
         paper-healthy under 300 N it removes an axial ringing that 0.5 s undamped still holds
         (axial RMS -96 %).  Massless balls (no axial ball states) settle within 0.03 s alike."""
         s = self.data["output"]["settle_s"]
-        from .bearing3d import needs_3d  # circle: scene -> limits -> scene (and bearing3d -> limits)
         if needs_3d(self):
             return max(s, SETTLE_3D_S)
         return s

@@ -14,7 +14,8 @@ Modules: :mod:`.case` (parsing), :mod:`.quantities` (the table of quantities),
 :mod:`.evaluate` (rows), :mod:`.candidates` (geometries scored), :mod:`.recording_run` (the case
 end to end); :mod:`.paper` (a paper case), :mod:`.figures`, :mod:`.pages` (report,
 summary.json), :mod:`.runner`, :mod:`.standin` (stand-in recordings), :mod:`.newcase`
-(``bearing-lab case new``).
+(``bearing-lab case new``).  The names below are served lazily (``lazy_loader.attach``): each module
+loads the first time one of its names is used.
 
 Public API
 ----------
@@ -32,25 +33,22 @@ Public API
                                                       a resonance, tones and noise (UFF58b or Testlab .mat)
     new_case_text(recording_path, ...)             -- the commented starting case `bearing-lab case new` writes
 """
-from .case import DEFAULT_CASE, RecordingSpec, ValidationCase, shipped_cases  # noqa: F401
-from .load import list_cases, load_case  # noqa: F401
-from .quantities import QUANTITIES, Quantity  # noqa: F401
-from .rows import Tolerance, make_row  # noqa: F401
-from .runner import CaseOutcome, check_case, default_set, run_case, run_validation  # noqa: F401
+import lazy_loader as _lazy
 
-
-def __getattr__(name):
-    if name in ("make_standin_recording", "StandIn"):
-        from . import standin
-        return getattr(standin, name)
-    if name == "identify":
-        from .identify import identify
-        return identify
-    if name == "new_case_text":
-        from .newcase import new_case_text
-        return new_case_text
-    raise AttributeError(f"module 'bearing_lab.validation' has no attribute {name!r}")
-
+#: module -> the public names it serves; each module is imported the first time one of its names is
+#: used (``lazy_loader.attach``), so ``bearing-lab --help`` (the verdicts of ``validation.rows``) and
+#: ``import bearing_lab.validation`` load no simulator, analysis or page code
+_PUBLIC = {
+    "case": ["DEFAULT_CASE", "RecordingSpec", "ValidationCase", "shipped_cases"],
+    "load": ["list_cases", "load_case"],
+    "quantities": ["QUANTITIES", "Quantity"],
+    "rows": ["Tolerance", "make_row"],
+    "runner": ["CaseOutcome", "check_case", "default_set", "run_case", "run_validation"],
+    "standin": ["make_standin_recording", "StandIn"],
+    "identify": ["identify"],
+    "newcase": ["new_case_text"],
+}
+__getattr__, __dir__, _ = _lazy.attach(__name__, submod_attrs=_PUBLIC)
 
 __all__ = ["load_case", "list_cases", "shipped_cases", "check_case", "default_set", "run_case", "run_validation",
            "CaseOutcome", "ValidationCase", "RecordingSpec", "QUANTITIES", "Quantity", "Tolerance", "make_row",

@@ -19,7 +19,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..analysis.impacts import impact_times
+from ..analysis.structural_path import StructuralPath
 from ..errors import AnalysisError, ValidationCaseError
+from . import simulation
 from .evaluate import context
 from .recording_case import comparison_band, comparison_overrides, impact_period
 from .signature import WINDOW_S, impact_signature, misfit
@@ -90,7 +92,6 @@ def _signature_path(path):
     g = path.fit.get("signature_gain")
     if not g or abs(g - path.gain) <= 1e-12 * path.gain:
         return path, ""
-    from ..analysis.structural_path import StructuralPath
     note = (f"the path's gain for the impact signature is {g:.4g} (fitted {path.gain:.4g}, matched to the impact "
             "peaks): the declared scene's signature on the path's own recording peaks where that recording's does")
     return StructuralPath(path.resonances, g, path.source, dict(path.fit)), note
@@ -161,7 +162,6 @@ def score_candidates(prep, path, background, candidates: dict, *, level_weight=N
     Returns label -> misfit dict (``score_db``, ``shape_db``, ``level_db``, ``lag_s``), ordered
     best (lowest score) first; ``"_setting"`` is not a key, see :func:`setting_for` for that.
     """
-    from . import simulation
     st = setting_for(prep, path, background, level_weight=level_weight, band_hz=band_hz)
     out = {}
     for label, ov in candidates.items():

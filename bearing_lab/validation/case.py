@@ -25,7 +25,9 @@ from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
 
+from .. import datasets
 from ..errors import BearingLabError, ValidationCaseError
+from ..units import parse_sensitivity
 from .quantities import QUANTITIES
 from .rows import Tolerance
 
@@ -239,7 +241,6 @@ def recording_spec(name, where, raw, base_dir, *, allowed=None) -> RecordingSpec
         p = Path(str(raw["file"])).expanduser()
         spec.file = p if p.is_absolute() or base_dir is None else Path(str(base_dir)) / p
     else:
-        from .. import datasets
         try:
             datasets.get(spec.name)
         except BearingLabError as exc:
@@ -254,7 +255,6 @@ def recording_spec(name, where, raw, base_dir, *, allowed=None) -> RecordingSpec
             raise case_error(name, f"{where}.scale = {s!r}: a calibration factor must be a finite positive number "
                              f"between {SCALE_RANGE[0]:g} and {SCALE_RANGE[1]:g} (1 = the file's values are right)")
     if spec.sensitivity is not None:
-        from ..units import parse_sensitivity
         try:
             parse_sensitivity(spec.sensitivity)
         except BearingLabError as exc:
@@ -279,7 +279,6 @@ def ratio_spec(case, raw) -> RecordingSpec:
 
 
 def _is_registry(name) -> bool:
-    from .. import datasets
     try:
         datasets.get(name)
         return True

@@ -12,7 +12,9 @@ import math
 import tomllib
 from pathlib import Path
 
-from ..errors import ValidationCaseError, check_choice
+from ..errors import SceneError, ValidationCaseError, check_choice
+from ..sim import load_scene
+from . import simulation
 from .case import (CASE_KEYS, case_error, check_keys, check_number, check_speed, parse_tolerances,
                    recording_spec)
 
@@ -130,13 +132,10 @@ def _sections(case):
 
 
 def _scenes(case):
-    from . import simulation
     rpm = case.speed if isinstance(case.speed, float) else 1800.0
     simulation.build_scene(case, rpm=rpm, fs=20000.0, duration=0.1)
     ratio = case.section("ratio")
     if ratio:
-        from ..errors import SceneError
-        from ..sim import load_scene
         scene = str(ratio["scene"])
         if scene.endswith(".toml") and case.base_dir is not None and not Path(scene).is_absolute():
             scene = str(Path(str(case.base_dir)) / scene)
@@ -174,8 +173,6 @@ def check_recording(case):
 
 def check_paper(case):
     """Check a paper case in place (runs, reference figures, tolerances)."""
-    from ..errors import SceneError
-    from ..sim import load_scene
     name = case.name
     runs = case.data.get("run")
     if not isinstance(runs, list) or not runs:

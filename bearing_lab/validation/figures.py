@@ -5,15 +5,17 @@ Each function returns ``(figure, caption)``; accelerations are drawn in g.
 from __future__ import annotations
 
 import numpy as np
+from scipy.signal import welch
 
+from ..analysis import amplitude_spectrum
 from ..compare import SIGNAL_COLORS
 from ..units import G
+from ..utils.figures import new_figure
 
 __all__ = ["waveforms", "spectra", "envelope_spectra", "structural_path", "psd_overlay", "paper_run"]
 
 
 def _fig(h=3.2, n=1, w=10):
-    from ..utils.figures import new_figure
     fig = new_figure(figsize=(w, h * n), layout="constrained")
     return fig, fig.subplots(n, 1, squeeze=False)[:, 0]
 
@@ -45,7 +47,6 @@ def waveforms(signals: dict, fs, *, recording_label, window_s=0.1, shift=0):
 
 def spectra(signals: dict, fs):
     """Amplitude spectra: recording, and each simulated signal."""
-    from ..analysis import amplitude_spectrum
     fig, (ax,) = _fig(h=3.6)
     colors = SIGNAL_COLORS
     for k, y in signals.items():
@@ -90,7 +91,6 @@ def structural_path(path, fs):
 
 def psd_overlay(curves: dict, fs, title):
     """Welch PSDs (g²/Hz) of several signals on one axis."""
-    from scipy.signal import welch
     fig, (ax,) = _fig(h=3.4)
     for label, y in curves.items():
         y = np.nan_to_num(np.asarray(y, float))
@@ -105,7 +105,6 @@ def psd_overlay(curves: dict, fs, title):
 
 def paper_run(label, x, fs, *, kinematic: dict, measured: dict, paper_simulation: dict, amplitude_g=None):
     """One run of the paper case: waveform against the reported amplitude, spectrum with the reported lines."""
-    from ..analysis import amplitude_spectrum
     fig, (a1, a2) = _fig(n=2)
     t = np.arange(x.size) / fs
     sel = t <= 0.1

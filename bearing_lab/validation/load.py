@@ -8,6 +8,7 @@ list_cases()             -- {name: title} of the shipped cases
 """
 from __future__ import annotations
 
+from dataclasses import replace
 import tomllib
 from functools import partial
 from pathlib import Path
@@ -103,7 +104,6 @@ def load_case(spec) -> ValidationCase:
     case = ValidationCase(name=name, title=str(raw.get("title", name)), kind=kind, source=source, text=text,
                           data=raw, base_dir=base_dir, default=bool(raw.get("default", False)))
     (check_paper if kind == "paper" else check_recording)(case)
-    from dataclasses import replace
     for attr in ("tolerances", "reference_tolerances"):
         setattr(case, attr, {q: replace(t, declared_by=case.author) if t.known_limitation else t
                              for q, t in getattr(case, attr).items()})

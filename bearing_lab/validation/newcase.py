@@ -18,6 +18,11 @@ import os
 from pathlib import Path
 
 from .._version import __version__
+from ..analysis._diagnosis import coincidences
+from ..bearings import get_bearing
+from ..errors import BearingLabError
+from ..io import open_recording
+from ..units import lookup_unit
 from .quantities import QUANTITIES
 
 __all__ = ["new_case_text", "resolution_limits", "compared_duration", "DEFAULT_ROWS"]
@@ -40,8 +45,6 @@ def _relative(path, case_dir) -> str:
 
 
 def _channels(ds) -> list:
-    from ..errors import BearingLabError
-    from ..units import lookup_unit
     out = []
     for k, v in ds.data_vars.items():
         units = v.attrs.get("units", "?")
@@ -96,8 +99,6 @@ def resolution_limits(bearing, rpm, duration_s) -> list:
     that lie within two bins (1 / duration) of a shaft harmonic, where the line search cannot tell them apart
     (:func:`bearing_lab.analysis._diagnosis.coincidences`).  Each entry: ``family``, ``text`` and
     ``min_duration_s``, the shortest record that separates the two lines by two bins."""
-    from ..analysis._diagnosis import coincidences
-    from ..bearings import get_bearing
     geo = get_bearing(bearing) if isinstance(bearing, str) else bearing
     fr = float(rpm) / 60.0
     out = []
@@ -175,7 +176,6 @@ def new_case_text(recording, *, name=None, bearing=None, speed=None, channel=Non
     >>> [line for line in text.splitlines() if line.startswith(("bearing", "speed"))]
     ['bearing = "6308"', 'speed = 1800.0                 # r/min, given (the file stores no speed)']
     """
-    from ..io import open_recording
     path = Path(recording)
     opts = {k: v for k, v in (("format", fmt), ("sensitivity", sensitivity)) if v}
     ds = open_recording(path, **opts)

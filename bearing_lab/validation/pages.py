@@ -14,8 +14,10 @@ import json
 
 import numpy as np
 
-from ..report import Report
-from .rows import ROW_KEYS
+from ..report import Report, esc, fmt, table_html
+from ..utils._files import atomic_open
+from .rows import EXIT_STATUS, ROW_KEYS, VERDICTS, case_verdict
+
 
 __all__ = ["write_case", "summary", "verdict_html", "verdict_legend", "MODEL_ASSUMPTIONS", "clean"]
 
@@ -38,7 +40,6 @@ from ..utils._json import clean  # noqa: E402  (NaN/inf -> null: one rule for ev
 
 
 def summary(case, result, wall) -> dict:
-    from .rows import case_verdict
     rows = [{k: r.get(k) for k in ROW_KEYS} for r in result.rows]
     failing = [r for r in result.rows if not r["pass"]]
     v = case_verdict(result.rows)
@@ -55,8 +56,6 @@ def summary(case, result, wall) -> dict:
 def verdict_html(rows, author) -> str:
     """The verdict in words, first on a case page: unexplained failures, the limitations the case's
     author declared (with the author's reason), the passes, and what the case expects."""
-    from ..report import esc, fmt
-    from .rows import VERDICTS, case_verdict
     v = case_verdict(rows)
     word = {"pass": "PASS", "known limitations": "KNOWN LIMITATIONS", "fail": "FAIL"}[v["verdict"]]
     cls = {"pass": "good", "known limitations": "warn", "fail": "bad"}[v["verdict"]]
@@ -94,8 +93,6 @@ def verdict_html(rows, author) -> str:
 
 def verdict_legend(entries: list) -> str:
     """The index's opening: the overall verdict in words, then what each verdict and the exit status mean."""
-    from ..report import esc
-    from .rows import EXIT_STATUS, VERDICTS
     n_unexp = sum(len(e.get("failing") or []) for e in entries)
     n_decl = sum(len(e.get("known") or []) for e in entries)
     errors = [e["case"] for e in entries if e.get("status") == "error"]
@@ -158,7 +155,6 @@ def build_report(case, result, wall) -> Report:
     # the page counts the case's rows, as summary.json, the index and the terminal do (a rows table shown
     # twice, e.g. the healthy rows in their own section, is not counted twice)
     report.rows = list(result.rows)
-    from ..report import esc, table_html
     model = result.extra.get("model") or {}
     runs = model if model and all(isinstance(v, dict) for v in model.values()) else {"simulation": model}
     report.add_html("<ul>" + "".join(f"<li>{esc(a)}</li>" for a in MODEL_ASSUMPTIONS) + "</ul>"
@@ -181,7 +177,6 @@ def build_report(case, result, wall) -> Report:
 
 def write_case(case, result, out, *, wall) -> str:
     """Write the case's files into ``out`` (atomically); returns "pass" or "fail"."""
-    from ..utils._files import atomic_open
     out.mkdir(parents=True, exist_ok=True)
     report = build_report(case, result, wall)
     info = {k: v for k, v in report.info.items() if k != "case TOML"}

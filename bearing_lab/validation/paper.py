@@ -18,11 +18,16 @@ import time
 import numpy as np
 
 from ..analysis.measurement import measure
+from ..bearings import get_bearing
 from ..compare import compare
-from . import figures, simulation
-from .quantities import QUANTITIES, value_of
+from ..studies.paper import run_paper_studies
 from ..units import G
+from ..utils._files import sha256_bytes
+from . import figures, simulation
+from .evaluate import CaseResult
+from .quantities import QUANTITIES, value_of
 from .rows import make_row
+from .simulation import model_details
 
 __all__ = ["run_paper_case", "study_rows"]
 
@@ -110,7 +115,6 @@ def study_rows(case, table, reference):
 def _studies(case, out_dir):
     if not case.section("studies").get("enabled", False):
         return None
-    from ..studies.paper import run_paper_studies
     t0 = time.perf_counter()
     table = run_paper_studies(out_dir / "studies", progress=False)
     rows, trends = study_rows(case, table, case.data["_reference_data"])
@@ -119,8 +123,6 @@ def _studies(case, out_dir):
 
 
 def run_paper_case(case, out_dir, *, steps):
-    from ..bearings import get_bearing
-    from .evaluate import CaseResult
     ref = case.data["_reference_data"]
     rpm = float(ref["speed_rpm"])
     geom = get_bearing(case.data.get("bearing", ref.get("bearing", "6308")))
@@ -147,7 +149,6 @@ def run_paper_case(case, out_dir, *, steps):
         extra["compute"][label] = {"wall_time_s": float(ds.attrs["wall_time_s"]),
                                    "compile_time_s": float(ds.attrs.get("compile_time_s", 0.0))}
         prov[f"scene ({label})"] = scene.to_toml()
-        from .simulation import model_details
         extra.setdefault("model", {})[label] = model_details(ds)
         steps.step(f"simulate {label}")
     studies = _studies(case, out_dir)
@@ -158,7 +159,6 @@ def run_paper_case(case, out_dir, *, steps):
     result = compare(signals, fs, rows, n=n, ses_fmax=1000.0,
                      attrs={"case": case.name, "kind": "paper", "bpfo_hz": kin["bpfo"], "bpfi_hz": kin["bpfi"],
                             "shaft_hz": rpm / 60.0})
-    from ..utils._files import sha256_bytes
     prov["reference file sha256"] = sha256_bytes(case.data["_reference_text"].encode("utf-8"))
     sections = [("rows", "Comparison table", {"rows": rows, "show_reference": True, "show_paper": True, "intro": (
         "Experiment: what the paper measured. Reference: the kinematic value at the paper's stated speed (not "

@@ -16,8 +16,12 @@ from fractions import Fraction
 from pathlib import Path
 
 import numpy as np
+from scipy.signal import resample_poly
 
+from .. import datasets
 from ..errors import BearingLabError, ValidationCaseError
+from ..io import open_recording
+from ..utils._files import sha256_file
 
 __all__ = ["Recording", "locate", "open_spec", "missing_reason"]
 
@@ -37,7 +41,6 @@ class Recording:
     def sha256(self) -> str:
         if self.dataset.attrs.get("source_sha256"):
             return str(self.dataset.attrs["source_sha256"])
-        from ..utils._files import sha256_file
         return sha256_file(self.path)
 
     @property
@@ -51,7 +54,6 @@ class Recording:
         """The whole record at ``fs`` (identity when equal; polyphase resampling otherwise)."""
         if abs(fs - self.fs) < 1e-9 * fs:
             return self.x
-        from scipy.signal import resample_poly
         r = Fraction(float(fs) / self.fs).limit_denominator(1000)
         return resample_poly(self.x, r.numerator, r.denominator)
 
@@ -59,7 +61,6 @@ class Recording:
 def locate(spec, mirror=None) -> Path | None:
     if spec.file is not None:
         return spec.file if spec.file.is_file() else None
-    from .. import datasets
     return datasets.locate(spec.name, mirror=mirror)
 
 
@@ -82,7 +83,6 @@ def open_spec(spec, case_name, mirror=None) -> Recording:
         Missing file, a registry copy whose sha256 differs, an unknown channel, a channel that
         is not an acceleration in m s-2, or a record shorter than the compared segment.
     """
-    from ..io import open_recording
     path = locate(spec, mirror)
     if path is None:
         raise ValidationCaseError(f"validation case {case_name!r}: {missing_reason(spec, mirror)}")
@@ -91,7 +91,6 @@ def open_spec(spec, case_name, mirror=None) -> Recording:
     except BearingLabError as exc:
         raise ValidationCaseError(f"validation case {case_name!r}: {exc}") from None
     if spec.name:
-        from .. import datasets
         reg = datasets.get(spec.name)
         if reg.sha256 and ds.attrs.get("source_sha256") and ds.attrs["source_sha256"] != reg.sha256:
             raise ValidationCaseError(f"validation case {case_name!r}: {path}: sha256 does not match the "

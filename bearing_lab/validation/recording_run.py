@@ -20,6 +20,7 @@ from ..analysis.measurement import measure
 from ..compare import align_by_impulse_phase, compare, shift
 from ..units import G
 from . import figures, simulation
+from .case import ratio_spec
 from .evaluate import CaseResult, context, evaluate_rows
 from .recording import open_spec
 from .recording_case import comparison_band, measure_signals, prepare, simulate_signals
@@ -31,7 +32,6 @@ __all__ = ["run_recording_case", "ratio_companion", "healthy_reference", "assemb
 
 def ratio_companion(case, prep, path, *, mirror=None) -> dict:
     """Impulse strength of the ``[ratio]`` companion: its recording, and its scene through the same path."""
-    from .case import ratio_spec
     cfg = case.section("ratio")
     spec = ratio_spec(case, cfg)
     spec.duration_s, spec.start_s = case.recording.duration_s, case.recording.start_s

@@ -26,9 +26,15 @@ from pathlib import Path
 
 import numpy as np
 
+from ..analysis.background import estimate_background
+from ..analysis.impacts import impact_times
 from ..analysis.structural_path import Resonance, StructuralPath, fit_structural_path
 from ..errors import AnalysisError, ValidationCaseError
+from . import simulation
+from .case import shipped_cases
+from .load import load_case
 from .recording_case import comparison_band, comparison_overrides, impact_period, prepare
+from .signature import impact_signature, shape_residual
 
 __all__ = ["identify_path", "path_for", "background_for", "PATH_DEFAULT_BOUNDS"]
 
@@ -78,8 +84,6 @@ def _gain_on_signature(case, path, rec, measured, sim_x, period):
     uncertainty ``fit["signature_gain_sigma_db"]``): the declared scene's signature through the path, plus the
     recording's own background, then peaks where the recording's does.  The fitted ``gain`` (matched to the
     impact peaks, for the validation's waveform quantities) is left as it is."""
-    from ..analysis.impacts import impact_times
-    from .signature import impact_signature
     fs = rec.fs
     band = comparison_band(fs)
     seed = int(case.section("background").get("seed", 0))
@@ -112,8 +116,6 @@ def _shape_residual(path, trial, x, bg, rec, fs, period, band):
     and its RMS ``fit["signature_residual_rms_db"]``): how the declared scene's impact signature through the
     path differs in shape from the recording's.  Comparisons of *other* recordings through this path add it
     to their recording's log-envelope (see :mod:`bearing_lab.validation.signature`)."""
-    from ..analysis.impacts import impact_times
-    from .signature import impact_signature, shape_residual
     y = trial.apply(x, fs) + bg
     sim = impact_signature(y, fs, impact_times(y, fs, period, band=band), band=band, period=period)
     meas = impact_signature(rec.x, fs, impact_times(rec.x, fs, period, band=band), band=band, period=period)
@@ -126,7 +128,6 @@ def _shape_residual(path, trial, x, bg, rec, fs, period, band):
 def _subsets_db(x, fs, times, band, groups=4):
     """Standard uncertainty (dB) of a signature's peak from ``groups`` interleaved subsets of its impacts:
     the subsets' standard deviation over sqrt(groups) (each subset holds 1/groups of the impacts)."""
-    from .signature import impact_signature
     if times.size < 3 * groups:
         raise AnalysisError(f"{times.size} impacts: at least {3 * groups} are needed to split them in {groups}")
     db = [20.0 * math.log10(impact_signature(x, fs, times[k::groups], band=band).peak) for k in range(groups)]
@@ -150,7 +151,6 @@ def identify_path(case, *, mirror=None) -> StructuralPath:
     """
     key = (case.source, mirror)
     if key not in _CACHE:
-        from . import simulation
         prep = prepare(case, mirror=mirror)
         scene = simulation.build_scene(case, rpm=prep.speed.rpm, fs=prep.fs, duration=prep.n / prep.fs,
                                        overrides=comparison_overrides(case))
@@ -174,8 +174,6 @@ def path_for(case, rec, measured, sim_x, *, mirror=None) -> StructuralPath:
         path.source = f"read from {p.name} ({path.source})"
         return path
     if sp.get("from_case"):
-        from .case import shipped_cases
-        from .load import load_case
         ref = str(sp["from_case"])
         if ref not in shipped_cases() and case.base_dir is not None and not Path(ref).expanduser().is_absolute():
             beside = Path(str(case.base_dir)) / ref      # a relative file is read beside this case's file
@@ -203,7 +201,6 @@ def background_for(case, rec, measured, reference=None, *, model=None, band=None
 
 
 def _measured_background(case, rec, measured, reference, *, model=None, band=None):
-    from ..analysis.background import estimate_background
     cfg = case.section("background")
     src = cfg.get("source", "auto")
     opts = {"max_tones": int(cfg.get("max_tones", 20)), "tone_snr_db": float(cfg.get("tone_snr_db", 15.0))}
@@ -219,7 +216,6 @@ def _measured_background(case, rec, measured, reference, *, model=None, band=Non
     if times is None:
         # no impact train diagnosed on its own: time the impacts at the declared defect's fault line,
         # as the comparison does; measured over the whole record the background would hold the impacts
-        from ..analysis.impacts import impact_times
         period, note = impact_period(case, measured)
         if np.isfinite(period):
             times = impact_times(rec.x, rec.fs, period, band=band or comparison_band(rec.fs))
@@ -229,7 +225,6 @@ def _measured_background(case, rec, measured, reference, *, model=None, band=Non
         times, where = None, "whole record (no impact train)"
     extra = {}
     if model is not None:
-        from ..analysis.impacts import impact_times
         y = np.asarray(model, float)
         mt = impact_times(y, rec.fs, period, band=measured["extras"]["band"]) if times is not None else None
         extra = {"model": y, "model_times": mt}

@@ -18,10 +18,18 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from tqdm.auto import tqdm
+
 from .._docdict import fill_doc
 from ..errors import BearingLabError, ValidationCaseError
+from ..report import write_index
 from .case import DEFAULT_CASE, shipped_cases
 from .load import load_case
+from .pages import verdict_legend, write_case
+from .paper import run_paper_case
+from .recording import locate, missing_reason
+from .recording_run import run_recording_case
+from .rows import case_verdict
 
 __all__ = ["CaseOutcome", "check_case", "default_set", "run_case", "run_validation", "exit_status"]
 
@@ -40,7 +48,6 @@ class _Steps:
     def __init__(self, desc, total, progress, position=1):
         self.bar = None
         if progress:
-            from tqdm.auto import tqdm
             self.bar = tqdm(total=total, desc=desc, leave=False, position=position, unit="step")
 
     def step(self, what):
@@ -79,7 +86,6 @@ class CaseOutcome:
     @property
     def verdict(self) -> dict:
         """:func:`~bearing_lab.validation.rows.case_verdict` of the rows ("error"/"skip" when it did not run)."""
-        from .rows import case_verdict
         v = case_verdict(self.rows)
         if self.status in ("error", "skip"):
             v.update(verdict=self.status, text=self.reason)
@@ -115,7 +121,6 @@ def check_case(case, mirror=None) -> None:
     ...
     bearing_lab.errors.ValidationCaseError: validation case 'cwru-130': recording 'cwru/...' not found in the mirror no-such-folder ...
     """
-    from .recording import locate, missing_reason
     for spec in case.recording_labels:
         if locate(spec, mirror) is None:
             raise ValidationCaseError(f"validation case {case.name!r}: {missing_reason(spec, mirror)}")
@@ -194,17 +199,14 @@ def run_case(case, out_dir, *, progress=True, mirror=None, position=1) -> CaseOu
     >>> outcome.verdict["text"]                                             # doctest: +SKIP
     '... rows pass, ...'
     """
-    from .pages import write_case
     t0 = time.perf_counter()
     out = Path(out_dir) / case.name
     out.mkdir(parents=True, exist_ok=True)
     steps = _Steps(case.name, 3 if case.kind == "paper" else 4, progress, position=position)
     try:
         if case.kind == "paper":
-            from .paper import run_paper_case
             result = run_paper_case(case, out, steps=steps)
         else:
-            from .recording_run import run_recording_case
             result = run_recording_case(case, steps=steps, mirror=mirror)
     finally:
         steps.close()
@@ -276,7 +278,6 @@ def run_validation(specs=None, out_dir="reports", *, strict=False, progress=True
 
     >>> outcomes, status = run_validation(["paper"], "reports", progress=False)   # doctest: +SKIP
     """
-    from ..report import write_index
     out_dir = Path(out_dir)
     notes, skipped = [], []
     if specs:
@@ -293,7 +294,6 @@ def run_validation(specs=None, out_dir="reports", *, strict=False, progress=True
     outcomes = []
     bar = None
     if progress:
-        from tqdm.auto import tqdm
         bar = tqdm(total=len(cases), desc="validate", unit="case", position=0)
     for c in cases:
         if bar is not None:
@@ -305,6 +305,5 @@ def run_validation(specs=None, out_dir="reports", *, strict=False, progress=True
         bar.close()
     entries = [_index_entry(o) for o in outcomes]
     entries += [{"case": n, "title": t, "status": "skip", "reason": r, "link": None} for n, t, r in skipped]
-    from .pages import verdict_legend
     write_index(out_dir / "index.html", entries, notes=notes, opening=verdict_legend(entries))
     return outcomes, exit_status(outcomes, strict)

@@ -50,6 +50,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.signal import butter, hilbert, sosfiltfilt
 
 from ..errors import AnalysisError
 
@@ -80,7 +81,6 @@ class Signature:
 
 
 def _envelope(x, fs, band):
-    from scipy.signal import butter, hilbert, sosfiltfilt
     lo, hi = float(band[0]), float(band[1])
     hi = min(hi, 0.49 * fs)
     if not 0 <= lo < hi:

@@ -21,10 +21,12 @@ numerical_error(scene, ds, *, duration)      -- peak difference against a rerun 
 from __future__ import annotations
 
 import copy
+from pathlib import Path
 
 import numpy as np
 
 from ..errors import SceneError, ValidationCaseError
+from ..sim import load_scene, simulate
 
 __all__ = ["scene_mapping", "build_scene", "scene_from", "run", "signal", "numerical_error", "SENSOR_OFF"]
 
@@ -33,12 +35,10 @@ SENSOR_OFF = {"sensor.enabled": False}
 
 
 def _base_mapping(case) -> dict:
-    from ..sim import load_scene
     base = case.section("scene").get("base")
     if not base:
         return {"name": case.name}
     if str(base).endswith(".toml") and case.base_dir is not None:
-        from pathlib import Path
         p = Path(str(base))
         base = str(p if p.is_absolute() else Path(str(case.base_dir)) / p)
     try:
@@ -75,7 +75,6 @@ def build_scene(case, *, rpm, fs, duration, healthy=False, overrides=None):
 
     ``overrides`` are scene keys applied last (after the case's ``[scene] set``).
     """
-    from ..sim import load_scene
     ov = dict(case.section("scene").get("set", {}) or {})
     ov.update({"speed_rpm": float(rpm), "output.sample_rate_hz": float(fs), "output.duration_s": float(duration)})
     ov.update(overrides or {})
@@ -87,7 +86,6 @@ def build_scene(case, *, rpm, fs, duration, healthy=False, overrides=None):
 
 def run(scene, **overrides):
     """Simulate ``scene`` (a Scene, name or path) with scene-key ``overrides``; no progress bar."""
-    from ..sim import simulate
     return simulate(scene, progress=False, **overrides)
 
 
@@ -115,7 +113,6 @@ def numerical_error(scene, ds, *, duration=0.25, overrides=None) -> dict:
 
 def scene_from(scene, *, rpm, fs, duration, overrides=None, case_name=""):
     """A built-in scene or scene file at ``rpm``, sampled at ``fs`` for ``duration`` s (plus ``overrides``)."""
-    from ..sim import load_scene
     ov = dict(overrides or {})
     ov.update({"speed_rpm": float(rpm), "output.sample_rate_hz": float(fs), "output.duration_s": float(duration)})
     try:

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from .. import analysis
 from ..errors import AnalysisError, ValidationCaseError
 
 __all__ = ["Speed", "estimate_speed", "resolve_speed"]
@@ -51,7 +52,6 @@ def estimate_speed(x, fs, *, bearing, prior_rpm=None) -> Speed:
     signal's 1x family within 5 % refines it; a prior the signal does not confirm is used
     as it is (and said so); a prior the signal contradicts stops the case.
     """
-    from .. import analysis
     try:
         sp = analysis.shaft_speed(x, fs, bearing=bearing, rpm=prior_rpm, rpm_source="file")
     except AnalysisError as exc:

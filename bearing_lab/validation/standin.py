@@ -22,12 +22,19 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
+import tempfile
 
 import numpy as np
+import scipy.io
+import xarray as xr
 
 from .._version import __version__
+from ..datasets import SAMPLE
 from ..errors import BearingLabError, RecordingError
+from ..io import to_uff58b
 from ..units import G
+from ..utils._files import atomic_path
+from . import simulation
 
 __all__ = ["StandIn", "make_standin_recording", "default_tones", "FORMATS"]
 
@@ -60,7 +67,6 @@ def _speed_profile(rpm, duration, jitter, rng):
 
 
 def _write_testlab_mat(path, x, fs, channel):
-    import scipy.io
     sig = {"x_values": {"start_value": 0.0, "increment": 1.0 / fs, "number_of_values": x.size,
                         "quantity": {"label": "s"}},
            "y_values": {"values": x.astype(np.float64),
@@ -71,7 +77,6 @@ def _write_testlab_mat(path, x, fs, channel):
 
 
 def _dataset(x, fs, channel, hidden):
-    import xarray as xr
     t = np.arange(x.size) / fs
     return xr.Dataset({channel: ("time", x, {"units": "m s-2", "quantity": "acceleration", "original_units": "m/s2",
                                              "long_name": "housing acceleration (stand-in)"})},
@@ -136,7 +141,6 @@ def make_standin_recording(path, *, scene="paper-O2", overrides=None, rpm=1793.0
     >>> ds.sizes["time"], ds.attrs["sampling_rate_hz"], s.hidden["rpm"]     # 0.05 s at 20 kHz
     (1000, 20000.0, 1793.0)
     """
-    from . import simulation
     path = Path(path)
     fmt = FORMATS.get(path.suffix.lower())
     if fmt is None:
@@ -167,8 +171,6 @@ def make_standin_recording(path, *, scene="paper-O2", overrides=None, rpm=1793.0
 
 
 def _write(path, ds, x, fs, channel):
-    from ..utils._files import atomic_path
-    from ..io import to_uff58b
     try:
         with atomic_path(path) as tmp:
             if path.suffix.lower() == ".mat":
@@ -181,21 +183,11 @@ def _write(path, ds, x, fs, channel):
         raise
 
 
-#: the sample recording shipped as package data (``bearing-lab data sample``): how it is made
-SAMPLE = {"scene": "paper-O2", "overrides": {"load.radial_n": 320.0}, "rpm": 1800.0, "duration": 1.0,
-          "fs": 12800.0, "seed": 7, "sensitivity_v_per_g": 9.91e-3, "channel": "Acc"}
-
-
 def make_sample_recording(path) -> Path:
     """Write the project's sample recording: a 1 s stand-in (6308, hidden 3 x 1 mm outer-race defect,
     320 N, 1800 r/min with jitter, a 4.3 kHz resonance, tones, noise) stored as an IEPE accelerometer's
     voltage at 9.91 mV/g in UFF 58b, as a rig's front end would record it.  The file shipped as
     ``bearing_lab/data/sample_recording.uff`` is this function's output (a test regenerates it)."""
-    import tempfile
-
-    import xarray as xr
-    from ..utils._files import atomic_path
-    from ..io import to_uff58b
     s = SAMPLE
     with tempfile.TemporaryDirectory() as tmp:
         st = make_standin_recording(Path(tmp) / "a.uff", scene=s["scene"], overrides=s["overrides"], rpm=s["rpm"],

@@ -171,12 +171,13 @@ def test_a_defect_the_3d_track_moves_onto_is_struck():
 def test_planar_scenes_decide_on_the_groove_bottom_without_a_3d_start(offset_mm, monkeypatch):
     """A planar scene's kind is the groove-bottom decision, reached without solving any 3-D start
     (so its settings and results are those of before)."""
-    from bearing_lab.sim import assembly, load_scene
+    from bearing_lab.sim import assembly, auto, load_scene
     from bearing_lab.sim.auto import MISS_DELTA, resolve
 
     def refuse(*a, **k):
         raise AssertionError("a planar scene solved a 3-D start")
-    monkeypatch.setattr(assembly, "static_3d", refuse)
+    for user in (assembly, auto):    # the two users of bearing3d.static_3d
+        monkeypatch.setattr(user, "static_3d", refuse)
     sc = load_scene("paper-O1", **{"defect.offset_mm": offset_mm})
     choice = resolve(sc)
     missed = sc.defects[0].misses_track(sc.bearing, MISS_DELTA, clearance=sc.clearance)

@@ -151,8 +151,9 @@ def test_the_dynamic_cage_is_refused_with_an_axial_load():
 def test_break_it_a_table_blind_to_the_contact_track_keeps_striking_the_centred_defect(monkeypatch):
     """With the defect table built at the groove bottom whatever the contact angle, the centred defect is
     struck under 300 N axial as without it: the previous test would fail."""
-    from bearing_lab.sim import assembly
-    monkeypatch.setattr(assembly, "track_offset", lambda defect, st, race, psi0, bearing: (defect, 0.0))
+    from bearing_lab.sim import assembly, auto
+    for user in (assembly, auto):    # the tables and the auto choice, both blind to the track
+        monkeypatch.setattr(user, "track_offset", lambda defect, st, race, psi0, bearing: (defect, 0.0))
     p0 = float(np.abs(simulate("paper-O1", duration=0.1, progress=False, **{"load.on": "outer"})
                       ["outer_ring_acc_y"]).max())
     p1 = float(np.abs(simulate("paper-O1", duration=0.1, progress=False, **{"load.on": "outer", "load.axial_n": 300.0})
@@ -195,7 +196,7 @@ def test_the_turned_table_sees_the_drop_a_ball_meets_at_its_contact_angle(h_mm):
     """A 1 x 1 mm defect at offset H met at 8.22 deg (300 N axial on the 6308): the drop the 3-D model's
     table holds (the defect turned about the groove's curvature centre) against brute force on the
     torus with the ball centre moved along the contact normal."""
-    from bearing_lab.sim.assembly import track_offset
+    from bearing_lab.sim.bearing3d import track_offset
     from bearing_lab.sim.defects import Defect
     from bearing_lab.sim.defects.geometry import RaceGeometry, drop_profile_2d
     b = get_bearing("6308")

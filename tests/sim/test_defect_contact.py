@@ -194,7 +194,7 @@ def test_halfspace_against_hertz_and_local_law():
     300 N against Hertz (0.90 x 0.16 mm, K_o = 3.27e10 N/m^1.5; Harris & Kotzalas 2007); the
     local law overstates the load lost over a centred 1 x 1 mm defect, the half-space table
     follows the fine solve."""
-    from bearing_lab.sim.defects.halfspace import compare_local_law
+    from bearing_lab.sim.defects.compare_law import compare_local_law
     r = compare_local_law(s_positions=(0.0, 0.5e-3))
     assert r["intact_force"] == pytest.approx(300.0, rel=0.01)
     assert r["a"] == pytest.approx(0.90e-3, rel=0.03)

@@ -142,12 +142,12 @@ def test_share_follows_a_small_skew_change_in_proportion():
     moves it (within a factor 2), and a second 0.1 deg moves it by nearly the same amount
     again (second difference below a fifth of the first): the share is a smooth function
     of the outline, not a staircase of cells flipping between pit and surface."""
-    from bearing_lab.sim.defects.halfspace import ratio_curve
+    from bearing_lab.sim.defects.halfspace_skewed import ratio_curve_skewed
     geom = RaceGeometry.from_bearing(B6308, "outer")
     s = np.linspace(-2.5e-3, 2.5e-3, 2001)
     curves = {}
     for th in (30.0, 30.1, 30.2, 31.0):
-        sn, r, _ = ratio_curve(_skewed(th), geom, 4.04e-6, coarse_step=1)
+        sn, r, _ = ratio_curve_skewed(_skewed(th), geom, 4.04e-6, coarse_step=1)
         curves[th] = np.interp(s, sn, r, left=1.0, right=1.0)
     d1 = curves[30.1] - curves[30.0]
     d1b = curves[30.2] - curves[30.1]

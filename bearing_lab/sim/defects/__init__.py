@@ -11,8 +11,9 @@ CONTACT_MODELS    -- name -> ContactModel: "profile", "drop", "area", "halfspace
 
 Modules: model (Defect), geometry (exact sphere-torus gap, rigid drop), contact (tables
 and the models), halfspace (elastic half-space contact solver behind the default
-"halfspace" model), _table_cache (the on-disk table cache), _halfspace_kernels (numba
-steps of the solver).
+"halfspace" model; halfspace_skewed for a rectangle skewed to the track), _table_cache (the
+on-disk table cache), _halfspace_kernels (numba steps of the solver), compare_law (the local law
+against the half-space, a check).
 """
 from .model import Defect
 from .geometry import RaceGeometry, rigid_drop

@@ -27,9 +27,8 @@ import numpy as np
 
 from bearing_lab.utils._files import atomic_path, cache_dir, sha256_bytes
 
-from . import contact  # a module (contact imports this one): its names are read at call time
-from .halfspace import (COARSE_STEP, DIRECT_UPDATE_CELLS, ENTER_SCALE, REFINE_TOL, REFRESH_EVERY, SOLVE_TOL,
-                        TABLE_CELLS)
+from .halfspace import (ABOVE_NODE_STEP, COARSE_STEP, DIRECT_UPDATE_CELLS, ENTER_SCALE, HALFSPACE_NODES,
+                        REFINE_TOL, REFRESH_EVERY, SOLVE_TOL, TABLE_CELLS)
 from .halfspace_skewed import INTACT_LATTICE
 
 FORMAT = 1
@@ -67,15 +66,17 @@ def _plain(x):
 BEARING_FIELDS = ("ball_diameter", "pitch_diameter", "inner_conformity", "outer_conformity")
 
 
-def table_key(defect, bearing, **args) -> str:
+def table_key(defect, bearing, *, halfspace_nodes=HALFSPACE_NODES, above_node_step=ABOVE_NODE_STEP,
+              **args) -> str:
     """sha256 (hex) of everything a table depends on (JSON floats round-trip exactly).
 
     ``defect`` must have angle 0: where the defect sits around the ring does not enter
-    the table."""
+    the table.  The half-space nodes are the table builder's (:mod:`.contact` hands in the
+    values it builds with)."""
     payload = {"format": FORMAT, "code": code_fingerprint(), "defect": _plain(defect),
                "bearing": {f: _plain(getattr(bearing, f)) for f in BEARING_FIELDS},
                "args": _plain(args),
-               "halfspace": _plain([contact.HALFSPACE_NODES, contact.ABOVE_NODE_STEP, TABLE_CELLS, SOLVE_TOL,
+               "halfspace": _plain([halfspace_nodes, above_node_step, TABLE_CELLS, SOLVE_TOL,
                                     REFINE_TOL, COARSE_STEP, INTACT_LATTICE, DIRECT_UPDATE_CELLS,
                                     REFRESH_EVERY, ENTER_SCALE])}
     return hashlib.sha256(json.dumps(payload, sort_keys=True).encode()).hexdigest()
@@ -142,7 +143,8 @@ def _problem(meta: dict, arrays: dict, key: str) -> str | None:
 
 
 def load(key: str, model: str | None = None):
-    """The cached table for ``key``, or None (missing, or damaged: then warned)."""
+    """The cached table's fields for ``key`` (keyword arguments of :class:`.contact.ContactTable`), or None
+    (missing, or damaged: then warned)."""
     if model is None:
         candidates = sorted(cache_dir("tables").glob(f"*-{key[:40]}.npz"))
         if not candidates:
@@ -175,8 +177,7 @@ def load(key: str, model: str | None = None):
     for name, parts in tuples.items():
         info[name] = tuple(parts[i] for i in sorted(parts))
     info["source"] = "disk"
-    return contact.ContactTable(psi=arrays["psi"], delta=arrays["delta"], G=arrays["G"], drop=arrays["drop"],
-                                intact_fraction=arrays["intact_fraction"], model=meta["model"],
-                                race=meta["race"], psi_min=float(meta["psi_min"]),
-                                psi_max=float(meta["psi_max"]), track_radius=float(meta["track_radius"]),
-                                info=info)
+    return dict(psi=arrays["psi"], delta=arrays["delta"], G=arrays["G"], drop=arrays["drop"],
+                intact_fraction=arrays["intact_fraction"], model=meta["model"], race=meta["race"],
+                psi_min=float(meta["psi_min"]), psi_max=float(meta["psi_max"]),
+                track_radius=float(meta["track_radius"]), info=info)

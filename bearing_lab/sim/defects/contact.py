@@ -86,7 +86,8 @@ from bearing_lab.errors import SceneError, check_choice
 from ...utils.figures import new_figure
 from . import _table_cache
 from .geometry import RaceGeometry, drop_profile_1d, drop_profile_2d
-from .halfspace import TABLE_CELLS, ratio_curve
+from .halfspace import ABOVE_NODE_STEP, HALFSPACE_NODES, TABLE_CELLS, aligned_sides, ratio_curve
+from .halfspace_skewed import ratio_curve_skewed
 from .lattice import track_lattice
 from .model import Defect
 
@@ -94,10 +95,8 @@ from .model import Defect
 _interpolate = lazy.load("scipy.interpolate", suppress_warning=True)
 
 # CONTACT_MODELS, the registry of models (one entry each), closes this module.
-#: approach nodes of the "halfspace" model, as fractions of delta_max (the loaded range)
-HALFSPACE_NODES = (0.05, 0.1, 0.16, 0.25, 0.35, 0.5, 0.7, 1.0)
-#: spacing of the half-space nodes above the loaded range (inside a deep defect), as a fraction of it
-ABOVE_NODE_STEP = 0.1
+# the "halfspace" model's approach nodes (HALFSPACE_NODES, ABOVE_NODE_STEP) are set in :mod:`.halfspace`;
+# the tables are built with this module's names and the cache key is made with them
 #: Young's modulus and Poisson ratio the tables assume unless told (52100 steel)
 DEFAULT_MATERIAL = (208e9, 0.3)
 _CELLS_ALONG = 60   # lattice cells per along-track reach at delta_max ("area")
@@ -250,7 +249,8 @@ def _arguments_and_key(defect, bearing, *, model, clearance=0.0, delta_max, n_ps
         args["above_drop"] = float(above_drop)
     if delta_top is not None:
         args["delta_top"] = float(delta_top)
-    return args, _table_cache.table_key(replace(defect, angle=0.0), bearing, **args)
+    return args, _table_cache.table_key(replace(defect, angle=0.0), bearing, halfspace_nodes=HALFSPACE_NODES,
+                                        above_node_step=ABOVE_NODE_STEP, **args)
 
 
 def table_is_cached(defect: Defect, bearing, **kw) -> bool:
@@ -314,7 +314,8 @@ def contact_table(defect: Defect, bearing, *, model: str, clearance: float = 0.0
     hit = _MEMORY.get(key)
     if hit is not None:
         return hit
-    table = _table_cache.load(key, model) if cache else None
+    fields = _table_cache.load(key, model) if cache else None
+    table = ContactTable(**fields) if fields is not None else None
     if table is None:
         table = _build(defect, bearing, **args)
         table.info["source"] = "built"
@@ -436,14 +437,16 @@ def _halfspace_G(defect, geom, s_tab, delta, drop, *, e_star, misses, settings=N
         info["halfspace_ratio"] = np.ones((n_psi, nodes_d.size))
         return np.broadcast_to(delta ** 1.5, (n_psi, n_delta)).copy(), info
     coarse = (cells[0] // 2, cells[1] // 2)
+    # a rectangle skewed to the track is solved on a grid turned with it
+    curve = ratio_curve_skewed if defect.shape == "rectangle" and aligned_sides(defect) is None else ratio_curve
     ratios, forces, axes, solves = [], [], [], 0
     for dn in nodes_d:
-        s_f, r_f, inf_f = ratio_curve(defect, geom, dn, cells=cells, e_star=e_star, **settings)
+        s_f, r_f, inf_f = curve(defect, geom, dn, cells=cells, e_star=e_star, **settings)
         r = np.interp(s_tab, s_f, r_f, left=1.0, right=1.0)
         solves += inf_f["solves"]
         if richardson:
             # first-order error in the cell size h: r = r_h + (r_h - r_2h) h / (h_2h - h)
-            s_c, r_c, inf_c = ratio_curve(defect, geom, dn, cells=coarse, e_star=e_star, **settings)
+            s_c, r_c, inf_c = curve(defect, geom, dn, cells=coarse, e_star=e_star, **settings)
             rc = np.interp(s_tab, s_c, r_c, left=1.0, right=1.0)
             h_f, h_c = math.sqrt(math.prod(inf_f["cell_m"])), math.sqrt(math.prod(inf_c["cell_m"]))
             r = r + (r - rc) * h_f / (h_c - h_f)

@@ -57,7 +57,7 @@ import numpy as np
 
 from bearing_lab.errors import SceneError, check_choice
 
-from .model import Defect
+# ``Defect`` in the annotations is :class:`.model.Defect` (model imports this module, not the reverse)
 
 # only the exact Hertz semi-axes need them (sim/numerics.py serves the simulator's own)
 _optimize = lazy.load("scipy.optimize", suppress_warning=True)

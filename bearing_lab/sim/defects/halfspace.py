@@ -59,14 +59,16 @@ import math
 import lazy_loader as lazy
 import numpy as np
 
-from ...bearings import get_bearing
-from . import contact
 from .geometry import RaceGeometry, hertz_semi_axes
 from .model import Defect
 
 # the FFT of the influence coefficients: loaded when a half-space is first solved
 sfft = lazy.load("scipy.fft", suppress_warning=True)
 
+#: approach nodes of the "halfspace" table, as fractions of delta_max (the loaded range)
+HALFSPACE_NODES = (0.05, 0.1, 0.16, 0.25, 0.35, 0.5, 0.7, 1.0)
+#: spacing of the half-space nodes above the loaded range (inside a deep defect), as a fraction of it
+ABOVE_NODE_STEP = 0.1
 #: cells (across, along the track) over the interpenetration region at each approach
 TABLE_CELLS = (32, 24)
 #: Polonsky-Keer stopping rule: sum |p - p_previous| / sum p
@@ -428,11 +430,12 @@ def ratio_curve(defect: Defect, geom: RaceGeometry, delta: float, *, cells=TABLE
     Returns ``(s, ratio, info)``: ball positions s (m from the defect centre, sorted)
     with ratio = F(defect) / F(intact) at the same approach (1 where the grid does not
     meet the outline), and info (intact force N, semi-axes m, cells, solves, iterations).
+    A rectangle skewed to the track is solved on a grid turned with it,
+    :func:`.halfspace_skewed.ratio_curve_skewed` (same arguments and result); here it is refused.
     """
     if defect.shape == "rectangle" and aligned_sides(defect) is None:
-        from .halfspace_skewed import ratio_curve_skewed  # circle: halfspace_skewed imports halfspace
-        return ratio_curve_skewed(defect, geom, delta, cells=cells, e_star=e_star, tol=tol,
-                                  refine_tol=refine_tol, coarse_step=coarse_step)
+        raise ValueError(f"halfspace.ratio_curve: a rectangle skewed to the track (skew {math.degrees(defect.skew):g} "
+                         "deg) is solved by halfspace_skewed.ratio_curve_skewed")
     base = intact_contact(geom, delta, cells=cells, e_star=e_star, tol=min(tol, 1e-6),
                           defect=defect)
     grid, hs = base["grid"], base["solver"]
@@ -567,32 +570,3 @@ def race_contact(geom: RaceGeometry, defect: Defect | None, approach: float, *,
         raise ValueError("the contact reaches the edge of the half-space grid; enlarge it")
     a, b = pressure_semi_axes(p, Z, S, dx, dy) if c.any() else (0.0, 0.0)
     return {"force": float(p.sum() * dx * dy), "a": a, "b": b, "p": p, "iterations": it, "solver": hs}
-
-
-def compare_local_law(bearing=None, *, load: float = 300.0, k_hertz: float = 3.27e10,
-                      s_positions=(0.0, 0.3e-3, 0.5e-3, 0.6e-3), dx: float = 0.0125e-3,
-                      dy: float = 0.004e-3) -> dict:
-    """6308 outer race: fine-grid half-space against the "area" local law and the
-    "halfspace" table over a centred 1 x 1 mm defect.
-
-    At the approach ``(load / k_hertz)^(2/3)`` returns the intact half-space force and
-    semi-axes, and for each ball position ``s`` (m from the defect centre) the share of the
-    intact force still carried: fine half-space solve, local-law table, half-space table.
-    """
-    bearing = get_bearing("6308") if bearing is None else bearing
-    geom = RaceGeometry.from_bearing(bearing, "outer")
-    d = Defect(length=1e-3, width=1e-3, depth=0.5e-3)
-    delta = (load / k_hertz) ** (2 / 3)
-    intact = race_contact(geom, None, delta, dx=dx, dy=dy)
-    tables = {m: contact.contact_table(d, bearing, model=m, delta_max=2 * delta, n_delta=81)
-              for m in ("area", "halfspace")}
-    out = {"approach": delta, "intact_force": intact["force"], "a": intact["a"], "b": intact["b"],
-           "iterations": intact["iterations"], "positions": []}
-    for s in s_positions:
-        r = race_contact(geom, d, delta, s_ball=s, dx=dx, dy=dy, solver=intact["solver"])
-        row = {"s": s, "halfspace": r["force"] / intact["force"]}
-        for m, T in tables.items():
-            row["local_law" if m == "area" else "table"] = (
-                float(T.lookup(s / geom.track_radius, delta)) / delta ** 1.5)
-        out["positions"].append(row)
-    return out

@@ -35,8 +35,8 @@ import math
 import numpy as np
 
 from .geometry import RaceGeometry
-from .halfspace import (TABLE_CELLS, HalfSpace, _curve, _refine, _symmetry, contact_grid, e_star_of,
-                        hertz_start, pressure_semi_axes)
+from .halfspace import (COARSE_STEP, REFINE_TOL, SOLVE_TOL, TABLE_CELLS, HalfSpace, _curve, _refine, _symmetry,
+                        contact_grid, e_star_of, hertz_start, pressure_semi_axes)
 from .model import Defect
 
 #: odd sizes of the lattice of the ball's sub-cell offsets on which the intact force is solved:
@@ -200,8 +200,9 @@ def _intact_diagnostics(defect: Defect, g: SkewedGrid, p: np.ndarray):
     return float(p.sum()) * g.du * g.dv, pressure_semi_axes(p, Z, S, dz, ds)
 
 
-def ratio_curve_skewed(defect: Defect, geom: RaceGeometry, delta: float, *, cells, e_star,
-                       tol, refine_tol, coarse_step):
+def ratio_curve_skewed(defect: Defect, geom: RaceGeometry, delta: float, *, cells=TABLE_CELLS,
+                       e_star: float | None = None, tol: float = SOLVE_TOL, refine_tol: float = REFINE_TOL,
+                       coarse_step: int = COARSE_STEP):
     """:func:`.halfspace.ratio_curve` for a rectangle inclined to the track: the same
     returns, computed on the defect-anchored rotated grid.  Ball positions are whole
     numbers of the track-aligned grid's along-track cells from the defect centre."""

@@ -36,6 +36,7 @@ import numpy as np
 
 from bearing_lab.errors import SceneError, check_choice
 
+from .geometry import RaceGeometry
 from .outlines import OUTLINES, finite as _finite
 
 RACES = ("outer", "inner", "ball")
@@ -276,7 +277,6 @@ class Defect:
         outline can be reached only if its axial gap to the ball, h(0, z), is below
         ``delta_max``.  Such a defect gives the healthy response.
         """
-        from .geometry import RaceGeometry  # circle: geometry imports model
         g = RaceGeometry.from_bearing(bearing, self.race if self.race != "ball" else "outer",
                                       clearance=clearance)
         zmin = self.min_abs_axial()
