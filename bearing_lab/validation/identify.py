@@ -3,13 +3,14 @@
 Method (docs/identification.md): the recording is prepared once, the rig's structural path
 and background are obtained once and held fixed (:mod:`.rig`); a coarse grid of scenes over
 the defect's length, offset and skew is simulated with the sweep machinery (Dask or serial,
-finished scenes and contact tables cached on disk); every scene's impact signature is scored
-against the recording's (:mod:`.candidates`, :mod:`.signature`).  From the best coarse scene a
-simplex search follows the misfit's valleys (:func:`.identify_search.minimise`); the score's roughness is probed
-there; each parameter's *profile* is then walked from the best value through the coarse values
-and half steps, minimising over the other parameters at each (:func:`.identify_search.walk_profiles`) until a
-value lies more than ``threshold_db`` above the best; and a polish searches again from the
-profile points that explain the recording as well but lie apart from the best (:func:`polish`).
+finished scenes and contact tables cached on disk), each scene :data:`SCENE_PASSAGES` impact periods
+long; every scene's impact signature is scored against the recording's (:mod:`.candidates`,
+:mod:`.signature`).  The refinement (:mod:`.identify_search`, on a lattice of 1/16 of the coarse
+steps): from the best coarse scene a simplex search follows the misfit's valleys; the score's
+roughness is probed there; each parameter's *profile* is then walked from the best value through the
+coarse values and half steps, minimising over the other parameters at each until a value lies more
+than ``threshold_db`` above the best; and a polish searches again from the profile points that
+explain the recording as well but lie apart from the best.
 The interval of a parameter spans the accepted values up to the nearest excluded walked value on
 each side.  A parameter no walked value excludes is *flat*: not identifiable from this recording.
 
@@ -59,7 +60,7 @@ class Identification:
     notes: list = field(default_factory=list)
     signatures: dict = field(default_factory=dict)   # "recording", "best" -> Signature
     declared: dict = field(default_factory=dict)
-    roughness_db: float | None = None    # score change for 1 % of a grid step at the best scene
+    roughness_db: float | None = None    # score change for ROUGHNESS_STEP of a grid step at the best scene
     partial: bool = False                # stopped before the end: the scenes done only, nothing final
     resumed: int = 0                     # scenes read back from the journal of an earlier run
     estimate: dict = field(default_factory=dict)   # identify_run.estimate() made before the scenes ran
@@ -257,7 +258,7 @@ def identify(case, *, grid=None, refine=True, scheduler="serial", n_workers=None
         ``defect.skew_deg``, ``defect.depth_mm``.
     refine : bool
         After the coarse grid: a simplex search from its best scene, the roughness probe there (each
-        parameter moved by 1 % of its grid step; the threshold is at least twice the score change),
+        parameter moved by 0.3 % of its grid step; the threshold is at least twice the score change),
         profiles walked by minimisation, and the polish.  False: the grid's scores (profiles are upper bounds).
     scheduler, n_workers, cache_dir : as :func:`bearing_lab.sweep.run_sweep` (default serial, in process, no
         sweep cache: 3.6 MB per scene of 1 s at 20 kHz; contact tables are cached regardless).

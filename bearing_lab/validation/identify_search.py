@@ -190,7 +190,7 @@ ROUGHNESS_STEP = 0.003
 
 
 def probes(grid, best) -> list:
-    """Scenes a hundredth of a coarse step from the best one, each parameter alone, both ways:
+    """Scenes ROUGHNESS_STEP (0.3 %) of a coarse step from the best one, each parameter alone, both ways:
     geometries no recording can tell apart.  How much their scores differ from the best's is the
     score's roughness at this scale (the contact tables' discretisation of the outline, the
     impact signature's sampling): differences below it carry no information."""
