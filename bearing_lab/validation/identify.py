@@ -163,8 +163,6 @@ def _run_chunk(setting, base, grid, v, chunk, todo, *, scheduler, cache_dir, bar
         out.extend({**dict(zip(keys, c)), **scored[c]} for c in todo if c in scored)
 
 
-
-
 def _digest(base, point) -> str:
     """The sweep's cache key of the scene ``point`` over ``base`` (what the journal is keyed on)."""
     from ..sweep import scene_hash

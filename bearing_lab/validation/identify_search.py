@@ -85,8 +85,6 @@ def minimise(grid, start, score, keys, max_scenes, first_step=0.5):
                       "maxfev": max_scenes})
 
 
-
-
 class _Accepted(Exception):
     """A profile value's minimisation found a scene within the threshold: the value is accepted."""
 
