@@ -131,7 +131,7 @@ VALIDATION_LAYERS = [
     ("quantities", "rows", "recording", "speed", "simulation", "signature"),
     ("case", "case_checks", "load", "standin", "newcase"),
     ("recording_case", "rig"),
-    ("evaluate", "candidates", "identify", "identify_run", "identify_report"),
+    ("evaluate", "candidates", "identify", "identify_run", "identify_search", "identify_report"),
     ("recording_run", "paper", "figures"),
     ("pages", "runner"),
 ]

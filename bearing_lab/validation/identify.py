@@ -3,13 +3,14 @@
 Method (docs/identification.md): the recording is prepared once, the rig's structural path
 and background are obtained once and held fixed (:mod:`.rig`); a coarse grid of scenes over
 the defect's length, offset and skew is simulated with the sweep machinery (Dask or serial,
-finished scenes and contact tables cached on disk); every scene's impact signature is scored
-against the recording's (:mod:`.candidates`, :mod:`.signature`).  From the best coarse scene a
-simplex search follows the misfit's valleys (:func:`_minimise`); the score's roughness is probed
-there; each parameter's *profile* is then walked from the best value through the coarse values
-and half steps, minimising over the other parameters at each (:func:`_walk_profiles`) until a
-value lies more than ``threshold_db`` above the best; and a polish searches again from the
-profile points that explain the recording as well but lie apart from the best (:func:`_polish`).
+finished scenes and contact tables cached on disk), each scene :data:`SCENE_PASSAGES` impact periods
+long; every scene's impact signature is scored against the recording's (:mod:`.candidates`,
+:mod:`.signature`).  The refinement (:mod:`.identify_search`, on a lattice of 1/16 of the coarse
+steps): from the best coarse scene a simplex search follows the misfit's valleys; the score's
+roughness is probed there; each parameter's *profile* is then walked from the best value through the
+coarse values and half steps, minimising over the other parameters at each until a value lies more
+than ``threshold_db`` above the best; and a polish searches again from the profile points that
+explain the recording as well but lie apart from the best.
 The interval of a parameter spans the accepted values up to the nearest excluded walked value on
 each side.  A parameter no walked value excludes is *flat*: not identifiable from this recording.
 
@@ -27,8 +28,10 @@ import time
 import numpy as np
 
 from ..errors import ValidationCaseError
-from .identify_run import (POLISH_MAX_SCENES, POLISH_STARTS, PROFILE_MAX_SCENES, REFINE_MAX_SCENES, Journal, Progress,
-                           comparison_fingerprint, estimate, estimate_text)
+from .identify_run import (REFINE_MAX_SCENES, Journal, Progress, comparison_fingerprint, estimate, estimate_text,
+                           mirrors)
+from .identify_search import (REFINE_FIRST_STEP, REFINE_XTOL, ROUGHNESS_STEP, coarse_steps, minimise, polish, probes,
+                              recheck, walk_profiles)
 
 __all__ = ["Identification", "IdentificationInterrupted", "default_grid", "identify", "PARAMS"]
 
@@ -57,7 +60,7 @@ class Identification:
     notes: list = field(default_factory=list)
     signatures: dict = field(default_factory=dict)   # "recording", "best" -> Signature
     declared: dict = field(default_factory=dict)
-    roughness_db: float | None = None    # score change for 1 % of a grid step at the best scene
+    roughness_db: float | None = None    # score change for ROUGHNESS_STEP of a grid step at the best scene
     partial: bool = False                # stopped before the end: the scenes done only, nothing final
     resumed: int = 0                     # scenes read back from the journal of an earlier run
     estimate: dict = field(default_factory=dict)   # identify_run.estimate() made before the scenes ran
@@ -100,148 +103,12 @@ def _declared(case) -> dict:
 
 
 def default_grid(case) -> dict:
-    """Lengths 0.5-2 × the declared one (ratio 2^(1/3)), H = 0, B/6, B/3, B/2, θ = -60 ... 60° by 30°."""
+    """Lengths 0.5, 1 and 2 × the declared one, H = 0, B/4, B/2, θ = -60 ... 60° by 30° (45 scenes)."""
     d = _declared(case)
     b = d["defect.width_mm"]
-    return {"defect.length_mm": [round(d["defect.length_mm"] * 2 ** (k / 3), 4) for k in range(-3, 4)],
-            "defect.offset_mm": [round(b * k / 6, 4) for k in range(4)],
+    return {"defect.length_mm": [round(d["defect.length_mm"] * 2.0 ** k, 4) for k in range(-1, 2)],
+            "defect.offset_mm": [round(b * k / 4, 4) for k in range(3)],
             "defect.skew_deg": [-60.0, -30.0, 0.0, 30.0, 60.0]}
-
-
-#: the refinement stops at REFINE_MAX_SCENES (identify_run.py, with the other budgets), or when its simplex
-#: is smaller than REFINE_XTOL of the coarse step in every parameter and its scores differ by less than
-#: REFINE_FTOL_DB
-REFINE_XTOL = 1.0 / 16.0
-REFINE_FTOL_DB = 0.01
-
-
-def _coarse_steps(grid, best) -> dict:
-    """Per searched parameter: the coarse grid's spacing next to the scene ``best`` (the mean of the gaps
-    to the grid values on either side of it)."""
-    out = {}
-    for k, vals in grid.items():
-        v = sorted(vals)
-        if len(v) < 2:
-            continue
-        i = int(np.argmin([abs(x - best[k]) for x in v]))
-        gaps = [v[j + 1] - v[j] for j in (i - 1, i) if 0 <= j < len(v) - 1]
-        out[k] = float(np.mean(gaps))
-    return out
-
-
-def _minimise(grid, start, score, keys, max_scenes, first_step=0.5):
-    """Nelder-Mead simplex search (Nelder & Mead, Computer Journal 7, 1965; scipy's bounded
-    implementation) over the parameters ``keys`` from the scene ``start`` (the others held at its
-    values), inside the coarse grid's range, in units of the coarse step.  A simplex stretches along
-    a valley of the misfit that runs diagonally through the parameters (a longer defect further off
-    the centre meets the ball over a similar chord), which a search along one parameter at a time
-    cannot follow.  ``score(point) -> dB`` simulates one scene (or reads it back)."""
-    from scipy.optimize import minimize
-    steps = _coarse_steps(grid, start)
-    keys = [k for k in keys if k in steps]
-    if not keys:
-        return
-    x0 = np.array([start[k] for k in keys], float)
-    s = np.array([steps[k] for k in keys])
-    lo = np.array([min(grid[k]) for k in keys])
-    hi = np.array([max(grid[k]) for k in keys])
-    simplex = [np.zeros(len(keys))]
-    for i in range(len(keys)):      # first_step coarse steps along each parameter, into the searched range
-        e = np.zeros(len(keys))
-        e[i] = first_step if x0[i] + first_step * s[i] <= hi[i] else -first_step
-        simplex.append(e)
-
-    def f(z):
-        x = np.clip(x0 + z * s, lo, hi)
-        return score({**start, **{k: round(float(v), 4) for k, v in zip(keys, x)}})
-    minimize(f, np.zeros(len(keys)), method="Nelder-Mead", bounds=list(zip((lo - x0) / s, (hi - x0) / s)),
-             options={"initial_simplex": np.array(simplex), "xatol": REFINE_XTOL, "fatol": REFINE_FTOL_DB,
-                      "maxfev": max_scenes})
-
-
-
-
-def _walk_profiles(grid, best_point, score, best_score, thr, points, max_scenes=PROFILE_MAX_SCENES) -> dict:
-    """Profiles by optimisation: for each searched parameter, step from the best scene through its coarse
-    grid values and the midpoints between them, each way; at each value minimise the score over the *other* parameters
-    (:func:`_minimise` with a first step of a quarter of the coarse step, from the better of the best
-    scene's other values and the best scene already simulated at this value) and stop at the first value
-    whose minimum lies more than ``thr`` above the best (``best_score()``, which may fall while walking).
-    Returns {key: {value: profile score}}, the best scene's value included."""
-    prof = {}
-    for k, vals in grid.items():
-        if len(vals) < 2:
-            continue
-        v = sorted(vals)
-        v = sorted(set(v) | {round((a + b) / 2, 4) for a, b in zip(v[:-1], v[1:])})   # and the half steps
-        others = [q for q in grid if q != k]
-        prof[k] = {best_point[k]: best_point["score_db"]}
-        for side in (-1, 1):
-            ahead = [x for x in v if (x - best_point[k]) * side > 1e-12]
-            for x in sorted(ahead, key=lambda x: abs(x - best_point[k])):
-                found = []
-
-                def f(point):
-                    val = score(point)
-                    found.append(val)
-                    return val
-                start = {**{q: best_point[q] for q in grid}, k: x}
-                here = [p for p in points if abs(p[k] - x) <= 1e-12]
-                if here and min(p["score_db"] for p in here) < f(start):
-                    start = {q: min(here, key=lambda p: p["score_db"])[q] for q in grid}
-                _minimise(grid, start, f, others, max_scenes - len(found), first_step=0.25)
-                prof[k][x] = min(found)
-                if prof[k][x] > best_score() + thr:
-                    break
-    return prof
-
-
-
-
-def _polish(grid, walked, points, score, thr):
-    """Search again, all parameters free and with a first step of an eighth of the coarse step, from the
-    best scene of every profile value within ``thr`` of the best that lies more than a quarter of a coarse
-    step (in some parameter) from the best scene and from the other starts (at most POLISH_STARTS, best
-    first): a narrow basin the first search stepped over is found from a start next to it.  Every scene a
-    polish reaches within the threshold accepts its values (see :func:`_profile`)."""
-    best = min(points, key=lambda p: p["score_db"])
-    steps = _coarse_steps(grid, best)
-
-    def apart(a, b):
-        return any(abs(a[k] - b[k]) > 0.25 * steps[k] for k in steps)
-    cands = []
-    for k, prof in walked.items():
-        for v, sc in prof.items():
-            if sc <= best["score_db"] + thr:
-                cands.append(min((p for p in points if abs(p[k] - v) <= 1e-12), key=lambda p: p["score_db"]))
-    starts = []
-    for q in sorted(cands, key=lambda p: p["score_db"]):
-        if apart(q, best) and all(apart(q, o) for o in starts):
-            starts.append(q)
-    for q in starts[:POLISH_STARTS]:
-        _minimise(grid, {j: q[j] for j in grid}, score, list(grid), POLISH_MAX_SCENES, first_step=0.125)
-
-
-#: the roughness probe moves each parameter by this fraction of its coarse grid step
-ROUGHNESS_STEP = 0.01
-
-
-def _probes(grid, best) -> list:
-    """Scenes a hundredth of a coarse step from the best one, each parameter alone, both ways:
-    geometries no recording can tell apart.  How much their scores differ from the best's is the
-    score's roughness at this scale (the contact tables' discretisation of the outline, the
-    impact signature's sampling): differences below it carry no information."""
-    out = []
-    for k, vals in grid.items():
-        v = sorted(vals)
-        if len(v) < 2:
-            continue
-        step = ROUGHNESS_STEP * (v[-1] - v[0]) / (len(v) - 1)
-        for sign in (-1, 1):
-            x = round(best[k] + sign * step, 5)
-            if v[0] <= x <= v[-1]:          # inside the searched range (an offset beyond B/2 is another defect)
-                out.append({**{q: [best[q]] for q in grid}, k: [x]})
-    return out
 
 
 def _run_grid(setting, base, grid, *, scheduler, cache_dir, bar, out, keep, journal=None):
@@ -253,30 +120,47 @@ def _run_grid(setting, base, grid, *, scheduler, cache_dir, bar, out, keep, jour
     keys = list(grid)
     first, rest = keys[0], keys[1:]
     done = {tuple(p[k] for k in keys) for p in out}
-    for v in grid[first]:
-        chunk = [(v, *c) for c in itertools.product(*(grid[k] for k in rest))]
-        todo = [c for c in chunk if c not in done]
-        if not todo:
-            continue
-        scored = {}
-        digests = {c: _digest(base, dict(zip(keys, c))) for c in todo} if journal is not None else {}
-        for c in todo:
-            hit = journal.get(digests[c]) if journal is not None else None
-            if hit is not None:
-                scored[c] = hit
+    mirror = mirrors(base, keys, list(itertools.product(*grid.values())), done)
+    try:
+        for v in grid[first]:
+            chunk = [(v, *c) for c in itertools.product(*(grid[k] for k in rest))]
+            _run_chunk(setting, base, grid, v, chunk, [c for c in chunk if c not in done and c not in mirror],
+                       scheduler=scheduler, cache_dir=cache_dir, bar=bar, out=out, keep=keep, journal=journal)
+    finally:
+        scored = {tuple(p[k] for k in keys): p for p in out}
+        for c, m in mirror.items():
+            if m in scored:
+                out.append({**{k: scored[m][k] for k in scored[m] if k not in keys}, **dict(zip(keys, c))})
                 if bar is not None:
                     bar.scene()
-        try:
-            missing = [c for c in todo if c not in scored]
-            if len(missing) == len(chunk):
-                _sweep_scored(setting, base, {first: [v], **{k: grid[k] for k in rest}}, chunk, scored, digests,
+
+
+def _run_chunk(setting, base, grid, v, chunk, todo, *, scheduler, cache_dir, bar, out, keep, journal):
+    """The scenes ``todo`` of one chunk (the scenes ``chunk`` of the first key's value ``v``): read back from
+    the journal or simulated (one sweep over the chunk if none is, else one per scene), appended to ``out``."""
+    keys = list(grid)
+    first, rest = keys[0], keys[1:]
+    if not todo:
+        return
+    scored = {}
+    digests = {c: _digest(base, dict(zip(keys, c))) for c in todo} if journal is not None else {}
+    for c in todo:
+        hit = journal.get(digests[c]) if journal is not None else None
+        if hit is not None:
+            scored[c] = hit
+            if bar is not None:
+                bar.scene()
+    try:
+        missing = [c for c in todo if c not in scored]
+        if len(missing) == len(chunk):
+            _sweep_scored(setting, base, {first: [v], **{k: grid[k] for k in rest}}, chunk, scored, digests,
+                          scheduler=scheduler, cache_dir=cache_dir, bar=bar, keep=keep, journal=journal)
+        else:
+            for c in missing:
+                _sweep_scored(setting, base, {k: [x] for k, x in zip(keys, c)}, [c], scored, digests,
                               scheduler=scheduler, cache_dir=cache_dir, bar=bar, keep=keep, journal=journal)
-            else:
-                for c in missing:
-                    _sweep_scored(setting, base, {k: [x] for k, x in zip(keys, c)}, [c], scored, digests,
-                                  scheduler=scheduler, cache_dir=cache_dir, bar=bar, keep=keep, journal=journal)
-        finally:
-            out.extend({**dict(zip(keys, c)), **scored[c]} for c in todo if c in scored)
+    finally:
+        out.extend({**dict(zip(keys, c)), **scored[c]} for c in todo if c in scored)
 
 
 def _digest(base, point) -> str:
@@ -315,7 +199,7 @@ def _profile(points, key, threshold, walked=None, span=None):
     """A parameter's profile, interval and statement.
 
     Without ``walked``: the profile is the best score among ``points`` at each searched value (the coarse
-    grid's). With ``walked`` ({value: score minimised over the other parameters}, :func:`_walk_profiles`):
+    grid's). With ``walked`` ({value: score minimised over the other parameters}, :func:`.identify_search.walk_profiles`):
     only those values can be *excluded* (more than ``threshold`` above the best); any simulated scene within
     the threshold *accepts* its value (a geometry that explains the recording that well is an answer,
     whatever the others score).  The interval runs from the nearest excluded value below the accepted ones
@@ -372,7 +256,7 @@ def identify(case, *, grid=None, refine=True, scheduler="serial", n_workers=None
         ``defect.skew_deg``, ``defect.depth_mm``.
     refine : bool
         After the coarse grid: a simplex search from its best scene, the roughness probe there (each
-        parameter moved by 1 % of its grid step; the threshold is at least twice the score change),
+        parameter moved by 0.3 % of its grid step; the threshold is at least twice the score change),
         profiles walked by minimisation, and the polish.  False: the grid's scores (profiles are upper bounds).
     scheduler, n_workers, cache_dir : as :func:`bearing_lab.sweep.run_sweep` (default serial, in process, no
         sweep cache: 3.6 MB per scene of 1 s at 20 kHz; contact tables are cached regardless).
@@ -435,8 +319,30 @@ def identify(case, *, grid=None, refine=True, scheduler="serial", n_workers=None
         bar.close()
         if close:
             client.close()
-    return _stamped(_result(case, st, points, grid, thr, declared, t_cpu, t_wall, keep["signature"], roughness,
-                            walked), len(old), est, setup_cpu)
+    res = _stamped(_result(case, st, points, grid, thr, declared, t_cpu, t_wall, keep["signature"], roughness,
+                           walked), len(old), est, setup_cpu)
+    res.notes += _method_notes(st, base, grid, res.best, est, refine)
+    return res
+
+
+def _method_notes(st, base, grid, best, est, refine) -> list:
+    """What the search's economies mean for this result: the candidates' length, the mirrored scenes, and
+    the refinement's lattice (the resolution of the best values)."""
+    rec = st.prep.n / st.prep.fs
+    out = []
+    if base.duration < rec - 1e-9:
+        out.append(f"each candidate scene records {base.duration:g} s ({base.duration / st.period_s:.0f} impact "
+                   f"periods) of the recording's {rec:g} s: its mean impact envelope settles within that")
+    if est.get("mirrored"):
+        out.append(f"{est['mirrored']} coarse scenes at H = 0 and θ < 0 were not simulated: they are scored as their "
+                   "mirror images (H = 0, -θ), which give the same signal")
+    if refine:
+        steps = {k: v * REFINE_XTOL for k, v in coarse_steps(grid, best).items()}
+        out.append(f"refinement scenes lie on a lattice of 1/{round(1 / REFINE_XTOL)} of the coarse grid's steps "
+                   "(near the best: "
+                   + ", ".join(f"{PARAMS[k][0]} {v:.3g} {PARAMS[k][1]}" for k, v in steps.items())
+                   + "): the best values are resolved to it")
+    return out
 
 
 def _stamped(res, resumed, est, setup_cpu):
@@ -483,15 +389,27 @@ def _setting(case, mirror, level_weight):
     reference = open_spec(case.reference, case.name, mirror) if case.reference is not None else None
     bg = background_for(case, prep.recording, m, reference, band=comparison_band(prep.fs))
     st = setting_for(prep, path, bg, level_weight=level_weight)
-    return st, base_scene(case, prep)
+    return st, base_scene(case, prep, st.period_s)
 
 
-def base_scene(case, prep):
-    """The scene every candidate is a change of: the case's, at the recording's measured speed, sampling
-    rate and length, with the comparison's solver settings (``prep``: the prepared recording)."""
+#: defect passages (impact periods) a candidate scene records, after the scene's own settling
+#: (``output.settle_s``); a recording shorter than that is simulated whole.  The score compares *mean*
+#: impact envelopes, so the candidate needs enough passages for its mean to settle, not the recording's
+#: length: on the README walkthrough's stand-in (183 passages in 2 s) 55 passages moved the scores of
+#: 12 geometries by at most 0.03 dB against the full length, 37 by 0.07 dB (docs/identification.md)
+SCENE_PASSAGES = 60
+
+
+def base_scene(case, prep, period_s=None):
+    """The scene every candidate is a change of: the case's, at the recording's measured speed and sampling
+    rate, with the comparison's solver settings (``prep``: the prepared recording), as long as the
+    recording or, given the impact period ``period_s``, :data:`SCENE_PASSAGES` periods if that is shorter."""
     from . import simulation
     from .recording_case import comparison_overrides
-    return simulation.build_scene(case, rpm=prep.speed.rpm, fs=prep.fs, duration=prep.n / prep.fs,
+    duration = prep.n / prep.fs
+    if period_s is not None and period_s > 0:
+        duration = min(duration, round(SCENE_PASSAGES * period_s, 4))
+    return simulation.build_scene(case, rpm=prep.speed.rpm, fs=prep.fs, duration=duration,
                                   overrides=comparison_overrides(case))
 
 
@@ -513,18 +431,22 @@ def _refinement(st, base, grid, points, run, thr, widen):
     profiles).  ``run``: keywords of :func:`_run_grid`; ``widen``: raise the threshold to twice the roughness."""
     score = _scorer(st, base, grid, points, run)
     best = min(points, key=lambda p: p["score_db"])
-    _minimise(grid, {k: best[k] for k in grid}, score, list(grid), REFINE_MAX_SCENES)
+    minimise(grid, {k: best[k] for k in grid}, score, list(grid), REFINE_MAX_SCENES,
+             first_step=REFINE_FIRST_STEP)
     best = min(points, key=lambda p: p["score_db"])
     n_before = len(points)
-    for probe in _probes(grid, best):
+    for probe in probes(grid, best):
         _run_grid(st, base, probe, **run)
     roughness = None
     if len(points) > n_before:
         roughness = max(abs(p["score_db"] - best["score_db"]) for p in points[n_before:])
         if widen:                   # the best and any other scene each move by up to it
             thr = max(thr, 2 * roughness)
-    walked = _walk_profiles(grid, best, score, lambda: min(p["score_db"] for p in points), thr, points)
-    _polish(grid, walked, points, score, thr)
+    early: dict = {}
+    walked = walk_profiles(grid, best, score, lambda: min(p["score_db"] for p in points), thr, points,
+                            early=early)
+    polish(grid, walked, points, score, thr)
+    recheck(grid, walked, early, score, points, thr)
     return roughness, thr, walked
 
 

@@ -29,21 +29,23 @@ TABLE_CPU_S = {"aligned": (0.08, 1.0), "skewed": (0.3, 3.0)}
 #: CPU s per second of record of one scene with its table cached, its signature and score included
 #: (0.08-0.10 s for the time loop at rtol 1e-6, 20 kHz; the sweep, the Dataset and the scoring add to it)
 SCENE_CPU_S_PER_S = (0.08, 0.8)
-#: fewest scenes the refinement adds in the runs measured (210-244 on the stand-ins); its most is its budget
-REFINE_FEWEST = 100
+#: fewest scenes the refinement adds in the runs measured (68-80 on the stand-ins, docs/identification.md);
+#: its most is its budget
+REFINE_FEWEST = 40
 #: the likely figures inside those brackets: the middle of the measured tables (0.17 s aligned, 0.47-1.14 s
-#: skewed), a scene with its scoring, and the refinement's scenes in the runs measured
+#: skewed), a scene with its scoring (0.065 s for the README walkthrough's 0.65 s scenes), and the
+#: refinement's scenes in the runs measured
 TABLE_CPU_LIKELY_S = {"aligned": 0.17, "skewed": 0.9}
-SCENE_CPU_LIKELY_S_PER_S = 0.15
-REFINE_LIKELY = 230
+SCENE_CPU_LIKELY_S_PER_S = 0.12
+REFINE_LIKELY = 75
 #: the search's budgets (identify.py runs the search; the estimate bounds it from these):
 #: the refinement's simplex stops at REFINE_MAX_SCENES scenes; a profile value is the best score over
 #: the other parameters found in at most PROFILE_MAX_SCENES scenes; the polish makes at most
 #: POLISH_STARTS starts, each a simplex search of at most POLISH_MAX_SCENES scenes
-REFINE_MAX_SCENES = 40
-PROFILE_MAX_SCENES = 12
+REFINE_MAX_SCENES = 30
+PROFILE_MAX_SCENES = 10
 POLISH_STARTS = 2
-POLISH_MAX_SCENES = 30
+POLISH_MAX_SCENES = 15
 
 
 def refine_budget(grid) -> int:
@@ -92,6 +94,31 @@ def table_plan(base, points) -> dict:
     return {"tables": len(seen), "cached": cached, "new": new, "builds": builds}
 
 
+def mirrors(base, keys, combos, done) -> dict:
+    """{combo: its mirror image} of the scenes ``combos`` (tuples over ``keys``) not in ``done`` at H = 0 and
+    θ < 0 whose mirror (H = 0, -θ) is among ``combos`` or done and gives the same signal: a rectangle or
+    ellipse centred on the track whose contact table request is the mirror's with the skew negated (a
+    3-D bearing under axial load moves the track off H = 0, and then nothing is mirrored)."""
+    from ..sim.assembly import scene_statics, table_requests
+    if "defect.offset_mm" not in keys or "defect.skew_deg" not in keys:
+        return {}
+    io, isk = keys.index("defect.offset_mm"), keys.index("defect.skew_deg")
+    known = set(combos) | set(done)
+    out, statics = {}, None
+    for c in combos:
+        m = tuple(-x if j == isk else x for j, x in enumerate(c))
+        if c in done or c[io] != 0.0 or c[isk] >= 0.0 or m not in known:
+            continue
+        statics = statics or scene_statics(base)
+        a = table_requests(base.replace(**dict(zip(keys, c))), statics=statics)
+        b = table_requests(base.replace(**dict(zip(keys, m))), statics=statics)
+        if len(a) == len(b) == 1 and a[0][1] == b[0][1] and a[0][0].shape in ("rectangle", "ellipse") \
+                and a[0][0].race != "ball" and abs(a[0][0].offset) < 1e-12 \
+                and dataclasses.replace(a[0][0], skew=-a[0][0].skew) == b[0][0]:
+            out[c] = m
+    return out
+
+
 def estimate(base, grid, *, refine: bool, done=()) -> dict:
     """CPU seconds (low, high) of the scenes of an identification still to run, and the counts they rest on.
 
@@ -103,7 +130,9 @@ def estimate(base, grid, *, refine: bool, done=()) -> dict:
     keys = list(grid)
     done = {tuple(p[k] for k in keys) for p in done}
     coarse = set(itertools.product(*(grid[k] for k in keys)))
-    todo = [dict(zip(keys, c)) for c in itertools.product(*(grid[k] for k in keys)) if c not in done]
+    combos = list(itertools.product(*(grid[k] for k in keys)))
+    mirrored = mirrors(base, keys, combos, done)         # scored as their mirror images, not simulated
+    todo = [dict(zip(keys, c)) for c in combos if c not in done and c not in mirrored]
     plan = table_plan(base, todo)
     sec = float(base.duration)
     skews = grid.get("defect.skew_deg") or [d.skew for d in base.defects]
@@ -125,6 +154,7 @@ def estimate(base, grid, *, refine: bool, done=()) -> dict:
               + (len(todo) + r_mid) * SCENE_CPU_LIKELY_S_PER_S * sec + r_mid * share * TABLE_CPU_LIKELY_S[kind])
     return {"cpu_s": (lo, hi), "likely_cpu_s": likely, "refine_likely": r_mid,
             "builds": [tuple(todo[k][q] for q in keys) for k in plan["builds"]], "coarse_scenes": len(todo),
+            "mirrored": len(mirrored),
             "coarse_done": len(done & coarse), "refine_scenes": (r_lo, r_hi),
             "tables": plan["tables"], "tables_cached": plan["cached"], "tables_new": plan["new"],
             "record_s": sec}
@@ -136,6 +166,7 @@ def estimate_text(est) -> str:
     lo, hi = est["cpu_s"]
     return (f"{est['coarse_scenes']} coarse scenes to simulate"
             + (f" ({est['coarse_done']} of the grid read back from the journal)" if est["coarse_done"] else "")
+            + (f" ({est['mirrored']} at H = 0, θ < 0 scored as their mirror images)" if est.get("mirrored") else "")
             + (f" + {r_lo}-{r_hi} in the refinement" if r_hi else "")
             + f", {est['record_s']:g} s each; contact tables of the coarse grid: {n_new} to build "
               f"({est['tables_new']['skewed']} skewed), {est['tables_cached']} cached: about "

@@ -85,7 +85,9 @@ def test_only_optimised_profile_values_exclude(found):
     with the other parameters minimised there, still explains the recording within the threshold, so the
     naive interval excludes an answer.  The intervals reported must hold every such value."""
     from bearing_lab.validation import load_case
-    from bearing_lab.validation.identify import PROFILE_MAX_SCENES, _minimise, _profile, _scorer, _setting
+    from bearing_lab.validation.identify import _profile, _scorer, _setting
+    from bearing_lab.validation.identify_run import PROFILE_MAX_SCENES
+    from bearing_lab.validation.identify_search import minimise
     _, case, r = found
     for k, p in r.parameters.items():
         assert p["optimised"], k
@@ -113,7 +115,7 @@ def test_only_optimised_profile_values_exclude(found):
             return tried[-1]
         start = {**{q: best[q] for q in r.grid}, k: x}
         f(start)
-        _minimise(r.grid, start, f, [q for q in r.grid if q != k], PROFILE_MAX_SCENES - 1, first_step=0.25)
+        minimise(r.grid, start, f, [q for q in r.grid if q != k], PROFILE_MAX_SCENES - 1, first_step=0.25)
         if min(tried) <= best["score_db"] + r.threshold_db:
             lo_r, hi_r = r.parameters[k]["interval"]
             assert lo_r <= x <= hi_r, (k, x, min(tried), r.parameters[k])

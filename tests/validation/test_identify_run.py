@@ -162,3 +162,40 @@ def test_the_truth_explains_the_recording_and_a_far_geometry_does_not(rig):
     assert far.explains_recording is False and far.best["score_db"] > far.threshold_db
     assert "the model does not explain this recording" in far.notes[0]
     assert far.to_dict()["explains_recording"] is False
+
+
+
+def test_a_mirrored_scene_scores_as_its_mirror_and_only_one_on_the_track_centre_is_mirrored(rig):
+    """At H = 0 a defect at θ and at -θ are mirror images: simulated both, they score alike (within 0.01 dB,
+    a thirtieth of the smallest threshold), so the search scores the one at -θ as its mirror.  Off the track
+    centre nothing is mirrored."""
+    from bearing_lab.validation import load_case
+    from bearing_lab.validation.identify import _run_grid, _setting
+    from bearing_lab.validation.identify_run import mirrors
+    _, case, _, _, _ = rig
+    st, base = _setting(load_case(case), None, None)
+    keys = ["defect.length_mm", "defect.offset_mm", "defect.skew_deg"]
+    pair = [(2.5, 0.0, 30.0), (2.5, 0.0, -30.0)]
+    assert mirrors(base, keys, pair, set()) == {pair[1]: pair[0]}
+    assert mirrors(base, keys, [(2.5, 0.25, 30.0), (2.5, 0.25, -30.0)], set()) == {}
+    assert mirrors(base, keys, [pair[1]], set()) == {}             # its mirror is not searched: simulated
+    scores = []
+    for c in pair:                                  # each simulated on its own: no mirror is used
+        out: list = []
+        _run_grid(st, base, {k: [x] for k, x in zip(keys, c)}, scheduler="serial", cache_dir=False, bar=None,
+                  out=out, keep={})
+        scores.append(out[0]["score_db"])
+    assert abs(scores[0] - scores[1]) < 0.01, scores
+    both: list = []                                 # searched together: the one at -θ is the other's score
+    _run_grid(st, base, {"defect.length_mm": [2.5], "defect.offset_mm": [0.0], "defect.skew_deg": [-30.0, 30.0]},
+              scheduler="serial", cache_dir=False, bar=None, out=both, keep={})
+    assert len(both) == 2 and both[0]["score_db"] == both[1]["score_db"] == scores[0]
+
+
+def test_refinement_scenes_lie_on_the_lattice_of_the_grid():
+    """Grid values and half steps are lattice points; any value moves to the nearest sixteenth of its gap."""
+    from bearing_lab.validation.identify_search import snap
+    grid = {"defect.length_mm": [1.5, 3.0, 6.0]}
+    assert [snap(grid, "defect.length_mm", x) for x in (1.5, 2.25, 3.0, 4.5, 6.0)] == [1.5, 2.25, 3.0, 4.5, 6.0]
+    assert snap(grid, "defect.length_mm", 3.1) == 3.1875 and snap(grid, "defect.length_mm", 2.95) == 2.9062
+    assert snap(grid, "defect.length_mm", 7.0) == 6.0            # inside the searched range
