@@ -208,8 +208,7 @@ def test_the_layer_checks_can_fail():
 #: the function-level imports left in each module (all others sit at the module top), each for the
 #: reason on its line (docs/architecture.md, "Imports"): an import circle, a CLI handler's command
 #: library (the parser imports no numpy), a library a light path must not pay for, a registry read
-#: at call time.  A module not listed has none.  validation/identify*.py are not converted yet (another
-#: change to them is under way); their counts hold them where they are.
+#: at call time.  A module not listed has none.
 FUNCTION_LEVEL_IMPORTS = {
     "_accessor.py": 3, "_xarray.py": 3, "compare.py": 1,
     "cli/analyze.py": 5, "cli/bench.py": 2, "cli/case.py": 4, "cli/identify.py": 6, "cli/recording.py": 13,
@@ -221,7 +220,6 @@ FUNCTION_LEVEL_IMPORTS = {
     "sim/integrate.py": 1,
     "studies/bench.py": 2, "studies/paper.py": 1, "sweep/__init__.py": 5, "sweep/store.py": 1,
     "utils/figures.py": 2,
-    "validation/identify.py": 14, "validation/identify_report.py": 13, "validation/identify_run.py": 5,
 }
 
 

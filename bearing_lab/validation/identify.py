@@ -23,15 +23,27 @@ identify(case, *, grid=None, refine=True, scheduler="serial", ...) -> Identifica
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+import itertools
 import time
 
+import lazy_loader as lazy
 import numpy as np
 
 from ..errors import ValidationCaseError
+from ..sweep import dim_name, run_sweep, scene_hash
+from . import simulation
+from .candidates import candidate_signature, setting_for
 from .identify_run import (REFINE_MAX_SCENES, Journal, Progress, comparison_fingerprint, estimate, estimate_text,
                            mirrors)
 from .identify_search import (REFINE_FIRST_STEP, REFINE_XTOL, ROUGHNESS_STEP, coarse_steps, minimise, polish, probes,
                               recheck, walk_profiles)
+from .load import load_case
+from .recording import open_spec
+from .recording_case import comparison_band, comparison_overrides, prepare
+from .rig import background_for, path_for
+
+# a local Dask cluster (``scheduler="local"``): loaded when one is started
+_distributed = lazy.load("dask.distributed", suppress_warning=True)
 
 __all__ = ["Identification", "IdentificationInterrupted", "default_grid", "identify", "PARAMS"]
 
@@ -116,7 +128,6 @@ def _run_grid(setting, base, grid, *, scheduler, cache_dir, bar, out, keep, jour
     ``keep`` holds the best simulated scene's signature; ``bar``: a :class:`.identify_run.Progress` (or
     None), moved by each scene as it finishes.  A scene in ``journal`` is read back, one simulated is added
     to it; when the run is stopped the scenes scored so far are still appended."""
-    import itertools
     keys = list(grid)
     first, rest = keys[0], keys[1:]
     done = {tuple(p[k] for k in keys) for p in out}
@@ -165,15 +176,12 @@ def _run_chunk(setting, base, grid, v, chunk, todo, *, scheduler, cache_dir, bar
 
 def _digest(base, point) -> str:
     """The sweep's cache key of the scene ``point`` over ``base`` (what the journal is keyed on)."""
-    from ..sweep import scene_hash
     return scene_hash(base.replace(**point).to_toml(), {})
 
 
 def _sweep_scored(setting, base, params, combos, scored, digests, *, scheduler, cache_dir, bar, keep, journal):
     """One sweep over ``params`` (whose C-order scenes are ``combos``); each scene is scored into ``scored``
     (and the journal) as it finishes."""
-    from ..sweep import run_sweep
-    from .candidates import candidate_signature
     keys = list(params)
 
     def on_scene(i, ds, cached):
@@ -191,7 +199,6 @@ def _sweep_scored(setting, base, params, combos, scored, digests, *, scheduler, 
 
 
 def ds_dim(key):
-    from ..sweep import dim_name
     return dim_name(key)
 
 
@@ -284,7 +291,6 @@ def identify(case, *, grid=None, refine=True, scheduler="serial", n_workers=None
     --------
     bearing_lab.validation.load_case, bearing_lab.validation.make_standin_recording
     """
-    from .load import load_case
     t_cpu, t_wall = time.process_time(), time.perf_counter()
     case = case if hasattr(case, "section") else load_case(case)
     declared = _declared(case)
@@ -379,10 +385,6 @@ def _prepare(case, grid, refine, mirror, level_weight, threshold_db, journal, no
 def _setting(case, mirror, level_weight):
     """The comparison setting (recording's signature, fixed path, background, score) and the base scene
     of a loaded case."""
-    from .candidates import setting_for
-    from .recording import open_spec
-    from .recording_case import comparison_band, prepare
-    from .rig import background_for, path_for
     prep = prepare(case, mirror=mirror)
     m = prep.measured["record"]
     path = path_for(case, prep.recording, m, prep.simulated["model"], mirror=mirror)
@@ -404,8 +406,6 @@ def base_scene(case, prep, period_s=None):
     """The scene every candidate is a change of: the case's, at the recording's measured speed and sampling
     rate, with the comparison's solver settings (``prep``: the prepared recording), as long as the
     recording or, given the impact period ``period_s``, :data:`SCENE_PASSAGES` periods if that is shorter."""
-    from . import simulation
-    from .recording_case import comparison_overrides
     duration = prep.n / prep.fs
     if period_s is not None and period_s > 0:
         duration = min(duration, round(SCENE_PASSAGES * period_s, 4))
@@ -452,10 +452,9 @@ def _refinement(st, base, grid, points, run, thr, widen):
 
 def _client(scheduler, n_workers):
     if scheduler in (None, "local"):
-        from dask.distributed import Client, LocalCluster
-        cluster = LocalCluster(n_workers=n_workers or 2, threads_per_worker=1, processes=True,
+        cluster = _distributed.LocalCluster(n_workers=n_workers or 2, threads_per_worker=1, processes=True,
                                dashboard_address=None)
-        return Client(cluster), True
+        return _distributed.Client(cluster), True
     return scheduler, False
 
 

@@ -13,8 +13,17 @@ import json
 from pathlib import Path
 
 import numpy as np
+import xarray as xr
 
+from .._version import __version__
+from ..report import Report
+from ..report.html import esc
+from ..sweep import dim_name, key_units
 from ..units import G as G0
+from ..utils._files import atomic_open, atomic_path
+from ..utils._json import clean
+from ..utils.figures import new_figure
+from .identify import PARAMS
 
 __all__ = ["landscape", "figures", "write_identification", "add_to_case_report"]
 
@@ -24,9 +33,6 @@ _VARS = {"score_db": "misfit score (shape + weight x |level|)",
 
 
 def landscape(result):
-    import xarray as xr
-    from .._version import __version__
-    from ..sweep import dim_name, key_units
     keys = list(result.grid)
     vals = [sorted(result.grid[k]) for k in keys]
     shape = tuple(len(v) for v in vals)
@@ -59,7 +65,6 @@ def landscape(result):
 
 
 def figures(result) -> list:
-    from matplotlib.figure import Figure
     rec, best = result.signatures["recording"], result.signatures["best"]
     out = []
     if best is not None:        # None: a partial result whose best scene was read back from the journal
@@ -68,8 +73,7 @@ def figures(result) -> list:
 
 
 def _best_figure(result, rec, best):
-    from matplotlib.figure import Figure
-    fig = Figure(figsize=(10, 3.4), layout="constrained")
+    fig = new_figure(figsize=(10, 3.4), layout="constrained")
     ax = fig.subplots()
     ax.plot(rec.time * 1e3, rec.envelope / G0, color="k", lw=1.2, label=f"recording ({rec.n_impacts} impacts)")
     lag = result.best.get("lag_s", 0.0)
@@ -85,9 +89,8 @@ def _best_figure(result, rec, best):
 
 
 def _profile_figure(result):
-    from matplotlib.figure import Figure
     keys = list(result.grid)
-    fig2 = Figure(figsize=(10, 2.8), layout="constrained")
+    fig2 = new_figure(figsize=(10, 2.8), layout="constrained")
     axes = np.atleast_1d(fig2.subplots(1, len(keys)))
     for ax, k in zip(axes, keys):
         p = result.parameters[k]
@@ -98,7 +101,6 @@ def _profile_figure(result):
             ax.plot(v[~opt], s[~opt], ".", color="0.55", ms=3)
         ax.axhline(result.best["score_db"] + result.threshold_db, color="tab:red", lw=0.8, ls="--")
         ax.axvspan(*p["interval"], color="tab:red", alpha=0.12)
-        from .identify import PARAMS
         ax.set_xlabel(f"{PARAMS[k][0]} ({p['unit']})")
         ax.set_title(("" if p["identifiable"] else "not identifiable: ") + f"best {p['best']:g}", fontsize=9)
     axes[0].set_ylabel("profile misfit (dB)")
@@ -109,7 +111,6 @@ def _profile_figure(result):
 
 
 def _sections(result) -> list:
-    from ..report.html import esc
     items = "".join(f"<li>{esc(p['statement'])}</li>" for p in result.parameters.values())
     notes = "".join(f"<p class=\"note\">{esc(n)}</p>" for n in result.notes)
     text = (f"<p>{result.n_scenes} simulated scenes, {result.cpu_time_s:.0f} s CPU in this process "
@@ -121,7 +122,6 @@ def _sections(result) -> list:
 
 
 def add_to_case_report(result, case_dir):
-    from ..report import Report
     case_dir = Path(case_dir)
     rj = case_dir / "report.json"
     rep = Report.load(rj) if rj.is_file() else Report(f"{result.case}: defect identification")
@@ -138,15 +138,11 @@ def add_to_case_report(result, case_dir):
 
 
 def write_identification(result, out, *, report=False, stem="identification") -> dict:
-    from ..utils._files import atomic_open
-    from ..utils._json import clean
-    from ..report import Report
     d = Path(out) / result.case
     d.mkdir(parents=True, exist_ok=True)
     paths = {ext: d / f"{stem}.{ext}" for ext in ("json", "nc", "html")}
     with atomic_open(paths["json"], "w", encoding="utf-8") as fh:
         json.dump(clean(result.to_dict()), fh, indent=1, allow_nan=False)
-    from ..utils._files import atomic_path
     with atomic_path(paths["nc"]) as tmp:
         landscape(result).to_netcdf(tmp)
     rep = Report(f"{result.case}: defect identification" + (" (PARTIAL: interrupted)" if result.partial else ""))

@@ -16,11 +16,17 @@ from __future__ import annotations
 
 import dataclasses
 import hashlib
+import itertools
 import json
 import math
 from pathlib import Path
 
 import numpy as np
+from tqdm.auto import tqdm
+
+from ..sim.assembly import scene_statics, table_requests
+from ..sim.defects.contact import table_is_cached
+from ..utils._json import clean
 
 #: CPU s of one contact table built cold, as the simulation builds it (half-space; 6308 stand-in rig):
 #: an outline with sides along and across the track, and a skewed one (rotated cells).  Measured with
@@ -60,7 +66,6 @@ def refine_budget(grid) -> int:
 
 def _table_cached(defect, bearing, kw) -> bool:
     """Whether the table :func:`contact_table` would return for (defect, kw) is in memory or on disk."""
-    from ..sim.defects.contact import table_is_cached
     return table_is_cached(defect, bearing, **kw)
 
 
@@ -68,7 +73,6 @@ def table_plan(base, points) -> dict:
     """Contact tables the scenes ``points`` ([{key: value}] over ``base``) need: distinct ones, split into
     cached / to build (aligned or skewed outline), and ``builds``: the indices of the points that build one
     (the first to need each table not cached)."""
-    from ..sim.assembly import scene_statics, table_requests
     statics = scene_statics(base)
     seen, new, of_point = {}, {"aligned": 0, "skewed": 0}, []
     cached = 0
@@ -99,7 +103,6 @@ def mirrors(base, keys, combos, done) -> dict:
     θ < 0 whose mirror (H = 0, -θ) is among ``combos`` or done and gives the same signal: a rectangle or
     ellipse centred on the track whose contact table request is the mirror's with the skew negated (a
     3-D bearing under axial load moves the track off H = 0, and then nothing is mirrored)."""
-    from ..sim.assembly import scene_statics, table_requests
     if "defect.offset_mm" not in keys or "defect.skew_deg" not in keys:
         return {}
     io, isk = keys.index("defect.offset_mm"), keys.index("defect.skew_deg")
@@ -126,7 +129,6 @@ def estimate(base, grid, *, refine: bool, done=()) -> dict:
     cached or not); the refinement's scenes are counted from :data:`REFINE_FEWEST` to :func:`refine_budget`,
     each with a table of its own to build (skewed unless every searched skew is 0; at the low end only in
     the share of the coarse grid's tables that were not cached)."""
-    import itertools
     keys = list(grid)
     done = {tuple(p[k] for k in keys) for p in done}
     coarse = set(itertools.product(*(grid[k] for k in keys)))
@@ -193,7 +195,6 @@ class Progress:
         self.builds = set()
         self.bar = None
         if bar:
-            from tqdm.auto import tqdm
             # smoothing 0: the mean rate over the run (the first scenes build tables and are slower)
             self.bar = tqdm(total=self.total, unit="scene", desc=desc, leave=False, smoothing=0.0)
 
@@ -314,7 +315,6 @@ class Journal:
         return None if e is None else {k: (math.nan if v is None else v) for k, v in e["score"].items()}
 
     def add(self, digest, point, score):
-        from ..utils._json import clean
         e = {"scene": digest, "point": clean(point), "score": clean(score)}
         self.entries[digest] = e
         with open(self.path, "a", encoding="utf-8") as fh:

@@ -9,9 +9,13 @@ polish(grid, walked, points, score, thr)   -- searches again from profile points
 """
 from __future__ import annotations
 
+import lazy_loader as lazy
 import numpy as np
 
 from .identify_run import POLISH_MAX_SCENES, POLISH_STARTS, PROFILE_MAX_SCENES
+
+# the simplex (Nelder-Mead): loaded when a refinement runs
+_optimize = lazy.load("scipy.optimize", suppress_warning=True)
 
 __all__ = ["REFINE_XTOL", "REFINE_FIRST_STEP", "REFINE_FTOL_DB", "ROUGHNESS_STEP", "snap", "coarse_steps", "minimise",
            "probes", "profile_value", "walk_profiles", "recheck", "polish"]
@@ -62,7 +66,6 @@ def minimise(grid, start, score, keys, max_scenes, first_step=0.5):
     a valley of the misfit that runs diagonally through the parameters (a longer defect further off
     the centre meets the ball over a similar chord), which a search along one parameter at a time
     cannot follow.  ``score(point) -> dB`` simulates one scene (or reads it back)."""
-    from scipy.optimize import minimize
     steps = coarse_steps(grid, start)
     keys = [k for k in keys if k in steps]
     if not keys:
@@ -80,7 +83,7 @@ def minimise(grid, start, score, keys, max_scenes, first_step=0.5):
     def f(z):
         x = x0 + z * s
         return score({**start, **{k: snap(grid, k, v) for k, v in zip(keys, x)}})
-    minimize(f, np.zeros(len(keys)), method="Nelder-Mead", bounds=list(zip((lo - x0) / s, (hi - x0) / s)),
+    _optimize.minimize(f, np.zeros(len(keys)), method="Nelder-Mead", bounds=list(zip((lo - x0) / s, (hi - x0) / s)),
              options={"initial_simplex": np.array(simplex), "xatol": REFINE_XTOL, "fatol": REFINE_FTOL_DB,
                       "maxfev": max_scenes})
 
