@@ -35,14 +35,30 @@ if not os.environ.get("PYTEST_XDIST_WORKER"):
 
 #: test files whose work is longest, started first so that under `make test` (one file per worker, files
 #: handed out in this order: --no-loadscope-reorder) no worker is left with a long file at the end: the
-#: identification (its module fixture is most of the suite's CPU); the other files follow by their number of
-#: tests, as xdist's default ordering had them
+#: identification (its module fixture is most of the suite's CPU)
 FIRST = ("validation/test_identify.py",)
+#: then, on the other worker, the long files that compile no simulation kernel in this process, while the
+#: identification compiles its kernels into the numba cache (NUMBA_CACHE_DIR) that later files load instead of
+#: compiling them again (a fresh clone's cache is empty: the four sim files test_physics, test_bearing3d,
+#: test_axial_preload and test_scene_budget cost 67 s of CPU with it empty, 17 s with it filled)
+NO_KERNELS = ("io/test_io_fuzz.py", "test_wheel_install.py", "test_architecture.py",
+              "analysis/test_analysis_recordings.py", "analysis/test_analysis_impulse.py",
+              "io/test_io_fuzz_structured.py")
+#: then the others that cost most, longest first (CPU s of each alone, in a full run on a loaded machine); the
+#: ones whose child processes load the kernels (benchmark runner, docs build, notebooks, scene budget) last of
+#: these, when more of the kernels are in the cache
+LONGEST = ("test_readme.py", "validation/test_cwru_cases.py", "validation/test_candidate_ranking.py",
+           "validation/test_walkthrough.py", "validation/test_perfect_model.py", "sim/test_physics.py",
+           "sim/test_bearing3d.py", "sim/test_axial_preload.py", "sim/test_halfspace.py",
+           "validation/test_structural_path.py", "test_sweep.py", "validation/test_identify_run.py",
+           "sim/test_hard_cases.py", "sim/test_defect_dynamics.py", "io/test_io_integrity.py",
+           "test_benchmarks_registry.py", "validation/test_validation_notebooks.py", "sim/test_scene_budget.py",
+           "test_api_docs.py")
 
 
 def pytest_collection_modifyitems(config, items):
-    """Files in FIRST first, then the others by their number of tests, most first (what xdist's
-    default --loadscope-reorder did), keeping the order of tests inside a file."""
+    """Files in FIRST, NO_KERNELS and LONGEST first, in that order, then the others by their number of tests,
+    most first (what xdist's default --loadscope-reorder did), keeping the order of tests inside a file."""
     if not hasattr(config, "workerinput"):
         return                      # a plain (serial) run keeps the collection order
     root = Path(__file__).resolve().parent
@@ -55,8 +71,9 @@ def pytest_collection_modifyitems(config, items):
     count = {}
     for it in items:
         count[rel(it)] = count.get(rel(it), 0) + 1
-    rank = {f: i for i, f in enumerate(FIRST)}
-    items.sort(key=lambda it: (rank.get(rel(it), len(FIRST)), -count[rel(it)] if rel(it) not in rank else 0))
+    ordered = FIRST + NO_KERNELS + LONGEST
+    rank = {f: i for i, f in enumerate(ordered)}
+    items.sort(key=lambda it: (rank.get(rel(it), len(ordered)), -count[rel(it)] if rel(it) not in rank else 0))
 
 IN_CI = os.environ.get("CI", "").lower() in ("1", "true", "yes")
 
