@@ -71,23 +71,30 @@ def _perturb_recordings(eps):
             mod.open_spec = open_spec
 
 
+def report_rows(reports, cases):
+    """The table's rows of the cases ``(name, status)`` from their summaries in the report folder ``reports``
+    (a case that wrote none: one error row with its status)."""
+    rows = []
+    for name, status in cases:
+        f = Path(reports) / name / "summary.json"
+        if not f.is_file():
+            rows.append({"case": name, "quantity": "(case)", "status": "error", "note": str(status)})
+            continue
+        for r in json.loads(f.read_text())["rows"]:
+            rows.append({"case": name, "quantity": r["quantity"], "status": r["status"],
+                         "simulation": r["simulation"], "experiment": r["experiment"], "rule": r["rule"],
+                         "tolerance": r["tolerance"], "margin": margin(r), "note": r["note"]})
+    return rows
+
+
 def table(out, *, perturb_recording=0.0, mirror=None):
     """Run the shipped cases; write their rows (FIELDS) to ``out`` (CSV) and return them."""
     if perturb_recording:
         _perturb_recordings(perturb_recording)
     from bearing_lab.validation import run_validation
-    rows = []
     with tempfile.TemporaryDirectory() as tmp:
         outcomes, _ = run_validation(shipped_names(), tmp, progress=False, mirror=mirror)
-        for o in outcomes:
-            f = Path(tmp) / o.name / "summary.json"
-            if not f.is_file():
-                rows.append({"case": o.name, "quantity": "(case)", "status": "error", "note": str(o.status)})
-                continue
-            for r in json.loads(f.read_text())["rows"]:
-                rows.append({"case": o.name, "quantity": r["quantity"], "status": r["status"],
-                             "simulation": r["simulation"], "experiment": r["experiment"], "rule": r["rule"],
-                             "tolerance": r["tolerance"], "margin": margin(r), "note": r["note"]})
+        rows = report_rows(tmp, [(o.name, o.status) for o in outcomes])
     with open(out, "w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=FIELDS, lineterminator="\n")
         w.writeheader()

@@ -45,13 +45,20 @@ def _tour_lines():
     return [ln.split("  #")[0].strip() for ln in block.strip().splitlines() if ln.strip()]
 
 
+#: the tour line whose run the suite shares (tests/conftest.py, DEFAULT_VALIDATION_ARGS)
+SHARED_VALIDATE = ("validate", "-o", "reports")
+
+
 @pytest.mark.slow
 @pytest.mark.xdist_group("readme_tour")
-def test_readme_tour_runs_as_written(tmp_path, mirror, monkeypatch):
+def test_readme_tour_runs_as_written(tmp_path, mirror, monkeypatch, request):
     """Every line of the README tour, in order, in a fresh directory beside `../shared/data`, as a user
-    who cloned the repository next to the mirror types them (only `.venv/bin/bearing-lab` is this process)."""
+    who cloned the repository next to the mirror types them (only `.venv/bin/bearing-lab` is this process).
+    The line `validate -o reports` is the run's shared default-set validation (tests/conftest.py runs that
+    line as written, in a fresh directory beside `../shared/data`): its exit status and reports are used."""
     import json
     import shlex
+    import shutil
 
     from bearing_lab.cli import main
     lines = _tour_lines()
@@ -68,7 +75,13 @@ def test_readme_tour_runs_as_written(tmp_path, mirror, monkeypatch):
     monkeypatch.setenv("BEARING_LAB_PROGRESS", "0")
     for line in lines:
         args = shlex.split(line)[1:]
-        status = main(args)
+        if tuple(args) == SHARED_VALIDATE:
+            shared = request.getfixturevalue("default_validation")
+            assert shared.args == SHARED_VALIDATE
+            shutil.copytree(shared.reports, clone / "reports", dirs_exist_ok=True)
+            status = shared.status
+        else:
+            status = main(args)
         if args[0] == "validate":
             # 1 means a row fails without a declared reason (today the paper case's offset ratios)
             verdicts = [json.loads(p.read_text())["verdict"] for p in (clone / "reports").glob("*/summary.json")]
