@@ -325,17 +325,20 @@ def _tables_module_at(rev: str):
     atexit.register(shutil.rmtree, tmp, ignore_errors=True)
     with tarfile.open(fileobj=io.BytesIO(blob)) as tar:
         tar.extractall(tmp, filter="data")
-    name = f"defects_{rev}"
+    name = "defects_" + "".join(ch if ch.isalnum() else "_" for ch in rev)
     shutil.move(str(tmp / "bearing_lab" / "sim" / "defects"), str(tmp / name))
     # modules the old code imports that have moved since (bearing_lab._files -> bearing_lab.utils)
+    import bearing_lab.sim
     import bearing_lab.utils._files
     sys.modules.setdefault("bearing_lab._files", bearing_lab.utils._files)
-    sys.path.insert(0, str(tmp))
+    # imported as a sibling of bearing_lab.sim.defects, so that its relative imports of the rest
+    # of the package (``from ...utils import``) resolve
+    bearing_lab.sim.__path__.append(str(tmp))
     try:
-        mod = importlib.import_module(f"{name}.contact")
-        importlib.import_module(f"{name}._halfspace_kernels").warm_up()
+        mod = importlib.import_module(f"bearing_lab.sim.{name}.contact")
+        importlib.import_module(f"bearing_lab.sim.{name}._halfspace_kernels").warm_up()
     finally:
-        sys.path.remove(str(tmp))
+        bearing_lab.sim.__path__.remove(str(tmp))
     return mod
 
 
