@@ -43,8 +43,12 @@ Prints (markdown):
    time (cache off, one core, numba compiled, minimum of 3), half-space solves, and the largest
    difference of the carried share G/δ^1.5 over the whole table (every ψ, every δ > 0),
    relative to the intact contact.
+12. skewed outlines on and off the track's centre line (paper-O2's pit at θ = 30° and 60°, H = 0 and
+   0.3 mm): cold CPU time and a profile of one build each (per grid: approach nodes, ball positions in
+   the share curves, solves, CG iterations, window and transform sizes), and the table of the outline
+   at (H, -θ) against the mirror image (ψ reversed) of the one at (H, θ).
 ``--quick`` skips 3, 7 and 10 (the converged tables take several minutes); ``--range`` runs 9
-only, ``--slot`` 10 only, ``--before [REV]`` 11 only.
+only, ``--slot`` 10 only, ``--before [REV]`` 11 only, ``--offcentre`` 12 only.
 """
 from __future__ import annotations
 
@@ -325,17 +329,20 @@ def _tables_module_at(rev: str):
     atexit.register(shutil.rmtree, tmp, ignore_errors=True)
     with tarfile.open(fileobj=io.BytesIO(blob)) as tar:
         tar.extractall(tmp, filter="data")
-    name = f"defects_{rev}"
+    name = "defects_" + "".join(ch if ch.isalnum() else "_" for ch in rev)
     shutil.move(str(tmp / "bearing_lab" / "sim" / "defects"), str(tmp / name))
     # modules the old code imports that have moved since (bearing_lab._files -> bearing_lab.utils)
+    import bearing_lab.sim
     import bearing_lab.utils._files
     sys.modules.setdefault("bearing_lab._files", bearing_lab.utils._files)
-    sys.path.insert(0, str(tmp))
+    # imported as a sibling of bearing_lab.sim.defects, so that its relative imports of the rest
+    # of the package (``from ...utils import``) resolve
+    bearing_lab.sim.__path__.append(str(tmp))
     try:
-        mod = importlib.import_module(f"{name}.contact")
-        importlib.import_module(f"{name}._halfspace_kernels").warm_up()
+        mod = importlib.import_module(f"bearing_lab.sim.{name}.contact")
+        importlib.import_module(f"bearing_lab.sim.{name}._halfspace_kernels").warm_up()
     finally:
-        sys.path.remove(str(tmp))
+        bearing_lab.sim.__path__.remove(str(tmp))
     return mod
 
 
@@ -378,6 +385,97 @@ def before_after(rev: str = BEFORE_REV) -> None:
     print(f"\nlargest share difference over every table: {worst:.5f} of the intact load")
 
 
+#: section 12's pairs: a skewed outline centred on the track and the same one off it
+OFFCENTRE_CASES = [(f"O2 θ={th:g}° H={h:g} mm", "paper-O2", {"defect.offset_mm": h, "defect.skew_deg": th})
+                   for th in (30.0, 60.0) for h in (0.0, 0.3)]
+
+
+def _skewed_profile(d, b, kw):
+    """One cold build of a skewed outline's "halfspace" table with every ratio curve's counts recorded:
+    per grid (the tables' cells and the coarse Richardson partner), the approach nodes, distinct ball
+    positions, solves, CG iterations, the mean window (cells) and the transforms' sizes (padded
+    cells per problem and iteration, weighted by the problems)."""
+    from bearing_lab.sim.defects import contact as C
+    from bearing_lab.sim.defects.halfspace import HalfSpace
+    curves, sizes = [], []
+    curve, iterate = C.ratio_curve_skewed, HalfSpace._iterate
+
+    def rec_curve(*a, **k):
+        n0 = len(sizes)
+        out = curve(*a, **k)
+        curves.append((k["cells"], out[0].size, out[2], sizes[n0:]))
+        return out
+
+    def rec_iterate(self, h, *a):
+        p, its = iterate(self, h, *a)
+        sizes.append((self.mx * self.my, int(its.sum())))
+        return p, its
+    C.ratio_curve_skewed, HalfSpace._iterate = rec_curve, rec_iterate
+    try:
+        _MEMORY.clear()
+        c = time.process_time()
+        T = contact_table(d, b, **kw)
+        cpu = time.process_time() - c
+    finally:
+        C.ratio_curve_skewed, HalfSpace._iterate = curve, iterate
+    grids = {}
+    for cells, n_pos, info, fft in curves:
+        g = grids.setdefault(tuple(cells), {"nodes": 0, "positions": 0, "solves": 0, "iterations": 0, "cells": 0,
+                                            "fft": 0, "fft_its": 0})
+        g["fft"] += sum(n * i for n, i in fft)
+        g["fft_its"] += sum(i for _, i in fft)
+        g["nodes"] += 1
+        g["positions"] += n_pos
+        g["solves"] += info["solves"]
+        g["iterations"] += info["iterations"]
+        g["cells"] += info["cells"][0] * info["cells"][1]
+    return T, cpu, grids
+
+
+def offcentre() -> None:
+    """Section 12: why a skewed outline's table costs about twice as much off the track's centre
+    line as on it (profile of one cold build each), and whether the mirror image of a table could
+    stand in for the table of the outline with its skew negated."""
+    print("\n## Skewed outlines on and off the track's centre line (\"halfspace\", cold, cache off, one core)\n")
+    print("| defect | CPU s (min of 3) | grid | δ nodes | ψ positions in the curves | solves | CG iterations "
+          "(per solve) | window cells (mean) | padded transform cells (mean) |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    for label, name, ov in OFFCENTRE_CASES:
+        sc = load_scene(name, **ov)
+        d, b = sc.defects[0], sc.bearing
+        dmax = assemble(sc).tables[0].info["loaded_range_m"]
+        kw = dict(model="halfspace", clearance=sc.clearance, delta_max=dmax, above_drop=dmax, cache=False)
+        cpu, _ = _cpu(lambda: contact_table(d, b, **kw))
+        _, _, grids = _skewed_profile(d, b, kw)
+        for j, (cells, g) in enumerate(sorted(grids.items(), reverse=True)):
+            head = f"| {label} | {cpu:.3f}" if j == 0 else "| | "
+            print(f"{head} | {cells[0]} x {cells[1]} | {g['nodes']} | {g['positions']} | {g['solves']} | "
+                  f"{g['iterations']} ({g['iterations'] / g['solves']:.1f}) | {g['cells'] / g['nodes']:.0f} | "
+                  f"{g['fft'] / g['fft_its']:.0f} |", flush=True)
+    print("\nThe mirror image through the ball's path (s -> -s) of the outline at (H, θ) is the outline at (H, -θ): "
+          "its table is the other's with ψ reversed, up to the discretisation. Largest and RMS difference of the "
+          "carried share G/δ^1.5 (every ψ, δ > 0) and of the shares at the approach nodes, relative to the intact "
+          "contact:\n")
+    print("| outline | table: largest / RMS | at the nodes: largest | where the largest is (δ, rigid drop µm) |")
+    print("|---|---|---|---|")
+    for h, th in ((0.3, 30.0), (0.3, 60.0), (0.2, 45.0)):
+        T = []
+        for sign in (1.0, -1.0):
+            sc = load_scene("paper-O2", **{"defect.offset_mm": h, "defect.skew_deg": sign * th})
+            dmax = assemble(sc).tables[0].info["loaded_range_m"]
+            _MEMORY.clear()
+            T.append(contact_table(sc.defects[0], sc.bearing, model="halfspace", clearance=sc.clearance,
+                                   delta_max=dmax, above_drop=dmax, cache=False))
+        a, m = T[1], T[0]
+        assert np.allclose(a.psi, -m.psi[::-1], rtol=0, atol=1e-12) and np.array_equal(a.delta, m.delta)
+        e = np.abs(a.G[:, 1:] - m.G[::-1, 1:]) / a.delta[1:] ** 1.5
+        i, k = np.unravel_index(np.argmax(e), e.shape)
+        en = np.abs(a.info["halfspace_ratio"] - m.info["halfspace_ratio"][::-1]).max()
+        print(f"| O2 H = {h:g} mm, θ = -{th:g}° against +{th:g}° mirrored | {e.max():.4f} / "
+              f"{np.sqrt(np.mean(e ** 2)):.5f} | {en:.4f} | {a.delta[k + 1] * 1e6:.2f}, {a.drop[i] * 1e6:.2f} |",
+              flush=True)
+
+
 def main(quick: bool = False) -> None:
     warm_up()
     drops()
@@ -395,6 +493,9 @@ if __name__ == "__main__":
         warm_up()
         i = sys.argv.index("--before")
         before_after(sys.argv[i + 1] if len(sys.argv) > i + 1 else BEFORE_REV)
+    elif "--offcentre" in sys.argv:
+        warm_up()
+        offcentre()
     elif "--range" in sys.argv:
         warm_up()
         table_range()
