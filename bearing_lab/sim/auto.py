@@ -156,13 +156,21 @@ def rate_rule(rule: dict, fs: float) -> tuple[dict, str]:
                "was not studied")
 
 
+#: the setting a defect the track only grazes takes (the defect rules' tolerances miss its shallow impacts):
+#: cwru-or007-6 under 300 N axial load, 0.3 s, against dp54 rtol 1e-9: bs32 rtol 1e-5 and 1e-4 read the
+#: peak at 1.66 and 11 times the converged one; dp54 rtol 1e-6 3.5e-4 at 0.05 CPU s (the same as bs32)
+GRAZED = {"method": "dp54", "rtol": 1e-6}
+GRAZED_PEAK_ERROR = 3.5e-4
+
+
 def resolve(scene) -> dict:
     """The settings auto picks for ``scene``: fidelity, method, rtol, max_step_s, kind, reason, track.
 
     The kind is decided on the contact track the scene runs on (:func:`track_defects`); with
     ``fidelity = "auto"`` the 3-D track is that of the rule's fidelity (decided again on it if the
-    rule's fidelity is not the one first assumed).  A defect the track only grazes gets a
-    ``SceneWarning`` naming the setting to use.
+    rule's fidelity is not the one first assumed).  A defect the track only grazes takes
+    :data:`GRAZED` (dp54, rtol 1e-6), said in the reason; a scene that sets its own solver method then
+    gets a ``SceneWarning`` naming that setting.
 
     Parameters
     ----------
@@ -206,12 +214,17 @@ def resolve(scene) -> dict:
         out["reason"] = f"no measured rule for '{kind}': conservative default"
     grazed = _grazed(scene, defects) if kind.startswith("defect") else []
     if grazed:
-        out["reason"] += ("; " + ", ".join(f"defect {k} is only grazed ({gap * 1e6:.3g} um of approach before the "
-                                           "ball reaches it)" for k, gap in grazed)
-                          + ": the rule's accuracy is not measured for a grazed defect (one came out at 12 times the "
-                          "converged peak); set solver.method = 'dp54' and solver.rtol = 1e-6")
-        if scene.data["solver"]["method"] == "auto":
-            warnings.warn(f"scene {scene.name!r}: " + out["reason"].split("; ", 1)[1], SceneWarning, stacklevel=3)
+        said = ", ".join(f"defect {k} is only grazed ({gap * 1e6:.3g} um of approach before the ball reaches it)"
+                         for k, gap in grazed)
+        out.update(GRAZED)
+        out["expected_peak_error"] = GRAZED_PEAK_ERROR
+        out["reason"] += (f"; {said}: the defect rules do not hold there (a grazed pit's peak came out at 1.66 and 11 "
+                          "times the converged one at bs32 rtol 1e-5 and 1e-4), so dp54 rtol 1e-6 is taken (within 0.04 %, "
+                          "at the same cost)")
+        if scene.data["solver"]["method"] != "auto":
+            warnings.warn(f"scene {scene.name!r}: {said}: the solver set by the scene may miss the impacts (the "
+                          "automatic choice for a grazed defect is solver.method = 'dp54', solver.rtol = 1e-6)",
+                          SceneWarning, stacklevel=3)
     out["kind"] = kind
     out["track"] = track
     return out
