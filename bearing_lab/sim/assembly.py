@@ -22,6 +22,7 @@ from .bearing3d import axial_support, groove_offsets, needs_3d, static_equilibri
 # table builder replaced at run time counts
 from . import defects
 from .defects import contact
+from ._loopargs import Model
 from .hertz import race_contact, series_stiffness
 from .numerics import brentq
 from .scene import Scene
@@ -54,6 +55,12 @@ class Assembly:
     @property
     def sensor_index(self) -> int:
         return int(self.p[kernels.P_SENSOFF])
+
+    @property
+    def model(self) -> Model:
+        """The arrays the compiled right-hand side reads, as its :class:`._loopargs.Model` (the
+        same arrays, not copies: the run raises the defect tables' reach in ``dflt``)."""
+        return Model(self.p, self.sp_t, self.sp_w, self.sp_th, self.dint, self.dflt, self.hbuf, self.gbuf)
 
 
 def load_zone_angle(scene: Scene) -> float:

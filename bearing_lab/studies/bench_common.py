@@ -73,11 +73,11 @@ def scipy_acc(asm, method, rtol, max_step=2.5e-5):
     fine_t = scene.settle - m_pad * dt_f + (np.arange(n_fine + 1) - 0.5) * dt_f
     z = asm.n_balls
     fi, fo = np.empty(z), np.empty(z)
-    args = (asm.p, asm.sp_t, asm.sp_w, asm.sp_th, asm.dint, asm.dflt, asm.hbuf, asm.gbuf)
+    model = asm.model
 
     def f(t, y):
         dy = np.empty_like(y)
-        kernels.rhs(t, y, *args, dy, fi, fo)
+        kernels.rhs(t, y, model, dy, fi, fo)
         return dy
     t_end = fine_t[-1] + 1e-9
     tic = time.process_time()

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from bearing_lab.sim import _kernels as K, _stepper as S, load_scene, simulate
+from bearing_lab.sim._loopargs import Cage
 from bearing_lab.sim.assembly import assemble
 
 
@@ -52,11 +53,12 @@ def test_zone_candidates_find_the_same_balls_as_a_loop_over_all(race):
         theta_s = rng.uniform(-50, 50) if race == "inner" else 0.0
         if race == "inner":  # put the zone where the balls are for the edge cases
             phic = phic + theta_s
-        ja, jb, cnt = K._zone_candidates(0, z, phic, theta_s, asm.dint, asm.dflt)
+        cg = Cage(z, phic, math.cos(phic), math.sin(phic), 1.0, theta_s, 2.0)  # cage speed 1, shaft 2 rad/s
+        ja, jb, cnt = K._zone_candidates(0, cg, asm.dint, asm.dflt)
         cands = set(range(z)) if cnt == z else {ja, jb}
         found = set()
         for j in cands:
-            rel, _ = K.rel_angle(0, j, phic + 2 * math.pi / z * j, 1.0, theta_s, 2.0, 0.0, asm.dint, asm.dflt)
+            rel, _ = K.rel_angle(0, j, phic + 2 * math.pi / z * j, 1.0, cg, asm.model)
             if zlo <= rel <= zhi:
                 found.add(j)
         want = _naive_in_zone(asm, phic, theta_s)
@@ -96,11 +98,10 @@ def _naive_step_limit(asm, t, h, nsteps):
 @pytest.mark.parametrize("race", ["outer", "inner"])
 def test_step_limit_lands_on_zone_entry_like_a_loop_over_all_balls(race):
     asm = _asm(race)
-    args = (asm.p, asm.sp_t, asm.sp_w, asm.sp_th, asm.dint, asm.dflt)
     y = asm.y0.copy()
     bounded = 0
     for t in np.linspace(0.0, 0.05, 4001):
-        got = S.step_limit(t, y, 2.5e-5, *args, 40.0)
+        got = S.step_limit(t, y, 2.5e-5, asm.model, 40.0)
         want = _naive_step_limit(asm, t, 2.5e-5, 40.0)
         assert got == pytest.approx(want, rel=1e-6, abs=1e-13), t
         bounded += got < 2.5e-5
