@@ -240,14 +240,14 @@ def _interp_g(k, psi, delta, dint, dflt, gbuf):
 
 
 @njit(cache=True, error_model="numpy", **NO_REFCOUNT)
-def defect_force(kk, rel, reld, delta, delta_rate, k, m):
+def defect_force(kk, rel, reld, delta, delta_rate, k, p, dint, dflt, hbuf, gbuf):
     """Normal force of a ball at relative angle ``rel`` inside the zone of defect kk (the
     contact's own damping coefficient); see :func:`contact_force`."""
-    return contact_force(kk, rel, reld, delta, delta_rate, k, m.p[P_CMAX], m)
+    return contact_force(kk, rel, reld, delta, delta_rate, k, p[P_CMAX], p, dint, dflt, hbuf, gbuf)
 
 
 @njit(cache=True, error_model="numpy", **NO_REFCOUNT)
-def contact_force(kk, rel, reld, delta, delta_rate, k, cmax, m):
+def contact_force(kk, rel, reld, delta, delta_rate, k, cmax, p, dint, dflt, hbuf, gbuf):
     """Normal force of a contact at relative angle ``rel`` inside the zone of defect kk, with
     stiffness ``k`` and damping coefficient ``cmax`` (one ball-race contact, or for a drop
     profile the quasi-static ball's two contacts in series).
@@ -259,16 +259,15 @@ def contact_force(kk, rel, reld, delta, delta_rate, k, cmax, m):
     ``pen`` itself, which adds the change of the contact as the ball rolls over the
     outline (``p[P_DRATE] == 1``).  See docs/contact-model.md for the choice.
     """
-    p, dint, dflt = m.p, m.dint, m.dflt
     rolling = p[P_DRATE] > 0.5
     if dint[kk, D_KIND] == 0:
-        h, dh = _interp_h(kk, rel, dint, dflt, m.hbuf)
+        h, dh = _interp_h(kk, rel, dint, dflt, hbuf)
         pen = delta - h
         if pen <= 0.0:
             return 0.0
         rate = delta_rate - dh * reld if rolling else delta_rate
         return impact(pen, rate, k, p[P_EXP], cmax, p[P_DPEN])
-    g, dg_dd, dg_dpsi = _interp_g23(kk, rel, delta, dint, dflt, m.gbuf)
+    g, dg_dd, dg_dpsi = _interp_g23(kk, rel, delta, dint, dflt, gbuf)
     _note_reach(kk, rel, delta, dflt)
     if g <= 0.0:
         return 0.0
@@ -278,11 +277,8 @@ def contact_force(kk, rel, reld, delta, delta_rate, k, cmax, m):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def rel_angle(kk, j, phi, phidot, cg, m):
-    """Relative angle (on the defect's table) and its rate for ball j at angle ``phi`` (rate
-    ``phidot``) and defect kk, the shaft as in :class:`Cage` ``cg``."""
-    dint, dflt = m.dint, m.dflt
-    theta_s, omega_s = cg.theta_s, cg.omega_s
+def rel_angle(kk, j, phi, phidot, theta_s, omega_s, spin, dint, dflt):
+    """Relative angle (on the defect's table) and its rate for ball j and defect kk."""
     race = dint[kk, D_RACE]
     if race == 0:
         return wrap(phi - dflt[kk, F_PSI0]), phidot
@@ -291,7 +287,6 @@ def rel_angle(kk, j, phi, phidot, cg, m):
     # ball defect: spin angle of the defect on ball D_BALL, 0 facing the outer race
     if j != dint[kk, D_BALL]:
         return 10.0, 0.0
-    spin = m.p[P_SPIN]
     theta_b = dflt[kk, F_PSI0] + spin * theta_s
     if race == 3:
         theta_b -= math.pi
@@ -300,32 +295,31 @@ def rel_angle(kk, j, phi, phidot, cg, m):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def find_zone(contact, j, phi, phidot, cg, m):
+def find_zone(contact, j, phi, phidot, theta_s, omega_s, spin, ndef, dint, dflt):
     """(defect index or -1, relative angle, rate) for ball j's ``contact`` (0 outer, 1 inner)."""
-    for kk in range(int(m.p[P_NDEF])):
-        if m.dint[kk, D_RACE] % 2 != contact:
+    for kk in range(ndef):
+        if dint[kk, D_RACE] % 2 != contact:
             continue
-        rel, reld = rel_angle(kk, j, phi, phidot, cg, m)
-        if m.dflt[kk, F_ZLO] <= rel <= m.dflt[kk, F_ZHI]:
+        rel, reld = rel_angle(kk, j, phi, phidot, theta_s, omega_s, spin, dint, dflt)
+        if dflt[kk, F_ZLO] <= rel <= dflt[kk, F_ZHI]:
             return kk, rel, reld
     return -1, 0.0, 0.0
 
 
 @njit(cache=True, error_model="numpy", **NO_REFCOUNT)
-def _qs_ball(kk, rel, reld, dtot, dtot_rate, m):
+def _qs_ball(kk, rel, reld, dtot, dtot_rate, p, dint, dflt, hbuf, gbuf):
     """Quasi-static (massless) ball whose contact kk has a defect: load through the two
     contacts in series."""
-    p, dint, dflt, gbuf = m.p, m.dint, m.dflt, m.gbuf
     e = p[P_EXP]
     cser = 0.5 * p[P_CMAX]  # two equal dampers in series
     dpen = p[P_DPEN]
     rolling = p[P_DRATE] > 0.5
-    h, dh = _interp_h(kk, rel, dint, dflt, m.hbuf)
+    h, dh = _interp_h(kk, rel, dint, dflt, hbuf)
     pen = dtot - h
     if pen <= 0.0:
         return 0.0
     if dint[kk, D_KIND] == 0:  # a drop: the two contacts in series as one law
-        return contact_force(kk, rel, reld, dtot, dtot_rate, p[P_KEFF], cser, m)
+        return contact_force(kk, rel, reld, dtot, dtot_rate, p[P_KEFF], cser, p, dint, dflt, hbuf, gbuf)
     # 2-D table on one contact, Hertz on the other: split the approach by bisection
     outer = dint[kk, D_RACE] % 2 == 0
     k_def = p[P_KO] if outer else p[P_KI]
@@ -387,10 +381,9 @@ def _ball_dir(p, z, j, c0, s0):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _zone_candidates(kk, cg, dint, dflt):
-    """Balls that may sit in defect kk's zone (kinematic cage ``cg``), found in O(1): (first, second,
+def _zone_candidates(kk, z, phic, theta_s, dint, dflt):
+    """Balls that may sit in defect kk's zone (kinematic cage), found in O(1): (first, second,
     count); count == z means every ball must be checked (a zone wider than the ball spacing)."""
-    z = cg.z
     race = dint[kk, D_RACE]
     if race >= 2:  # a ball defect: its own ball
         return dint[kk, D_BALL], -1, 1
@@ -398,7 +391,7 @@ def _zone_candidates(kk, cg, dint, dflt):
     zlo = dflt[kk, F_ZLO]
     if dflt[kk, F_ZHI] - zlo >= sp:
         return 0, 0, z
-    u = cg.phic - dflt[kk, F_PSI0] - (cg.theta_s if race == 1 else 0.0) - zlo
+    u = phic - dflt[kk, F_PSI0] - (theta_s if race == 1 else 0.0) - zlo
     # ball j sits u + j sp past the zone's start: j = -floor(u / sp) is the one within a ball
     # spacing past it; its predecessor, in case rounding put the boundary on the other side
     ja = (-int(math.floor(u / sp))) % z
@@ -426,7 +419,7 @@ def _balls_kinematic(y, m, cg, dy, fi_out, fo_out):
     ring sums corrected (the lowest-numbered defect wins where zones overlap).  Returns the
     ball forces on the inner and outer ring (x, y)."""
     p, dint, dflt = m.p, m.dint, m.dflt
-    z, c0, s0, phic, phidot = cg.z, cg.c0, cg.s0, cg.phic, cg.phidot
+    z, phic, c0, s0, phidot, theta_s, omega_s = cg
     xi, yi, vxi, vyi = y[0], y[1], y[2], y[3]
     xo, yo, vxo, vyo = y[4], y[5], y[6], y[7]
     pd4 = 0.25 * p[P_PD]
@@ -462,25 +455,26 @@ def _balls_kinematic(y, m, cg, dy, fi_out, fo_out):
     if ndef == 0:
         return fix, fiy, fox, foy
     sp = TWO_PI / z
+    spin = p[P_SPIN]
     for im in range(ndef):
         kk = ndef - 1 - im
-        ja, jb, cnt = _zone_candidates(kk, cg, dint, dflt)
+        ja, jb, cnt = _zone_candidates(kk, z, phic, theta_s, dint, dflt)
         outer = dint[kk, D_RACE] % 2 == 0
         for q in range(cnt):
             j = q if cnt == z else (ja if q == 0 else jb)
-            rel, reld = rel_angle(kk, j, phic + sp * j, phidot, cg, m)
+            rel, reld = rel_angle(kk, j, phic + sp * j, phidot, theta_s, omega_s, spin, dint, dflt)
             if not (dflt[kk, F_ZLO] <= rel <= dflt[kk, F_ZHI]):
                 continue
             c, s = _ball_dir(p, z, j, c0, s0)
             d_o, d_or, d_i, d_ir = _approaches(y, z, j, c, s, phidot, pd4)
             if outer:
-                f = contact_force(kk, rel, reld, d_o, d_or, ko, cmax, m)
+                f = contact_force(kk, rel, reld, d_o, d_or, ko, cmax, p, dint, dflt, m.hbuf, m.gbuf)
                 df = f - fo_out[j]
                 fo_out[j] = f
                 fox += df * c
                 foy += df * s
             else:
-                f = contact_force(kk, rel, reld, d_i, d_ir, ki, cmax, m)
+                f = contact_force(kk, rel, reld, d_i, d_ir, ki, cmax, p, dint, dflt, m.hbuf, m.gbuf)
                 df = f - fi_out[j]
                 fi_out[j] = f
                 fix -= df * c
@@ -496,7 +490,7 @@ def _balls_quasi_static(y, m, cg, fi_out, fo_out):
     outer-race defect wins over an inner-race one, the lowest-numbered over the others).
     Returns the ball forces on the inner and outer ring (x, y)."""
     p, dint, dflt = m.p, m.dint, m.dflt
-    z, c0, s0, phic, phidot = cg.z, cg.c0, cg.s0, cg.phic, cg.phidot
+    z, phic, c0, s0, phidot, theta_s, omega_s = cg
     pd4 = 0.25 * p[P_PD]
     keff = p[P_KEFF]
     e = p[P_EXP]
@@ -515,21 +509,22 @@ def _balls_quasi_static(y, m, cg, fi_out, fo_out):
         fo_out[j] = q
     ndef = int(p[P_NDEF])
     sp = TWO_PI / z
+    spin = p[P_SPIN]
     for im in range(2 * ndef):
         # inner-race defects first, then outer-race ones, each from the last to the first
         kk = ndef - 1 - (im % ndef)
         if dint[kk, D_RACE] % 2 != (1 if im < ndef else 0):
             continue
-        ja, jb, cnt = _zone_candidates(kk, cg, dint, dflt)
+        ja, jb, cnt = _zone_candidates(kk, z, phic, theta_s, dint, dflt)
         for q in range(cnt):
             j = q if cnt == z else (ja if q == 0 else jb)
-            rel, reld = rel_angle(kk, j, phic + sp * j, phidot, cg, m)
+            rel, reld = rel_angle(kk, j, phic + sp * j, phidot, theta_s, omega_s, spin, dint, dflt)
             if not (dflt[kk, F_ZLO] <= rel <= dflt[kk, F_ZHI]):
                 continue
             c, s = _ball_dir(p, z, j, c0, s0)
             dtot = dx * c + dyy * s - 2.0 * pd4
             drate = dvx * c + dvy * s + (dx * (-s) + dyy * c) * phidot
-            qd = _qs_ball(kk, rel, reld, dtot, drate, m)
+            qd = _qs_ball(kk, rel, reld, dtot, drate, p, dint, dflt, m.hbuf, m.gbuf)
             fi_out[j] = qd
             fo_out[j] = qd
     fix = fiy = fox = foy = 0.0
@@ -547,12 +542,14 @@ def _balls_dynamic(y, m, cg, dy, fi_out, fo_out):
     """Multibody balls in a dynamic cage: each ball's orbital angle, speed and spin are states;
     traction at both contacts (regularised Coulomb), cage pockets.  Returns the ball forces on
     the inner and outer ring (x, y) and the pockets' torque on the cage."""
-    p, z, omega_s = m.p, cg.z, cg.omega_s
+    p, dint, dflt = m.p, m.dint, m.dflt
+    z, _, _, _, _, theta_s, omega_s = cg
     xi, yi, vxi, vyi = y[0], y[1], y[2], y[3]
     xo, yo, vxo, vyo = y[4], y[5], y[6], y[7]
     pd4 = 0.25 * p[P_PD]
     mb = p[P_MB]
     ndef = int(p[P_NDEF])
+    spin = p[P_SPIN]
     base = 8
     fix = fiy = fox = foy = 0.0
     pocket_torque = 0.0
@@ -567,14 +564,14 @@ def _balls_dynamic(y, m, cg, dy, fi_out, fo_out):
         ko = -1
         ki = -1
         if ndef > 0:
-            ko, relo, reldo = find_zone(0, j, phi, phidot, cg, m)
-            ki, reli, reldi = find_zone(1, j, phi, phidot, cg, m)
+            ko, relo, reldo = find_zone(0, j, phi, phidot, theta_s, omega_s, spin, ndef, dint, dflt)
+            ki, reli, reldi = find_zone(1, j, phi, phidot, theta_s, omega_s, spin, ndef, dint, dflt)
         if ko >= 0:
-            fo = defect_force(ko, relo, reldo, d_o, d_or, p[P_KO], m)
+            fo = defect_force(ko, relo, reldo, d_o, d_or, p[P_KO], p, dint, dflt, m.hbuf, m.gbuf)
         else:
             fo = impact(d_o, d_or, p[P_KO], p[P_EXP], p[P_CMAX], p[P_DPEN])
         if ki >= 0:
-            fi = defect_force(ki, reli, reldi, d_i, d_ir, p[P_KI], m)
+            fi = defect_force(ki, reli, reldi, d_i, d_ir, p[P_KI], p, dint, dflt, m.hbuf, m.gbuf)
         else:
             fi = impact(d_i, d_ir, p[P_KI], p[P_EXP], p[P_CMAX], p[P_DPEN])
         dy[base + j] = qd
@@ -649,7 +646,7 @@ def _balls_kinematic_3d(y, m, cg, dy, fi_out, fo_out):
     (the contact angle), its approach measured along it.  Returns the ball forces on the inner
     and outer ring (x, y, z)."""
     p, dint, dflt = m.p, m.dint, m.dflt
-    z, c0, s0, phic, phidot = cg.z, cg.c0, cg.s0, cg.phic, cg.phidot
+    z, phic, c0, s0, phidot, theta_s, omega_s = cg
     pd4 = 0.25 * p[P_PD]
     ko = p[P_KO]
     ki = p[P_KI]
@@ -695,19 +692,21 @@ def _balls_kinematic_3d(y, m, cg, dy, fi_out, fo_out):
     if ndef == 0:
         return fix, fiy, fiz, fox, foy, foz
     sp = TWO_PI / z
+    spin = p[P_SPIN]
     for im in range(ndef):
         kk = ndef - 1 - im
-        ja, jb, cnt = _zone_candidates(kk, cg, dint, dflt)
+        ja, jb, cnt = _zone_candidates(kk, z, phic, theta_s, dint, dflt)
         outer = dint[kk, D_RACE] % 2 == 0
         for q in range(cnt):
             j = q if cnt == z else (ja if q == 0 else jb)
-            rel, reld = rel_angle(kk, j, phic + sp * j, phidot, cg, m)
+            rel, reld = rel_angle(kk, j, phic + sp * j, phidot, theta_s, omega_s, spin, dint, dflt)
             if not (dflt[kk, F_ZLO] <= rel <= dflt[kk, F_ZHI]):
                 continue
             c, s = _ball_dir(p, z, j, c0, s0)
             if outer:
                 ro, zo, lo, ro_r, zo_r = _geom_outer(y, zb, j, z, c, s, phidot, pd4, ago)
-                f = contact_force(kk, rel, reld, lo - ago, (ro * ro_r + zo * zo_r) / lo, ko, cmax, m)
+                f = contact_force(kk, rel, reld, lo - ago, (ro * ro_r + zo * zo_r) / lo, ko, cmax, p, dint, dflt,
+                                  m.hbuf, m.gbuf)
                 df = f - fo_out[j]
                 fo_out[j] = f
                 fox += df * ro / lo * c
@@ -717,7 +716,8 @@ def _balls_kinematic_3d(y, m, cg, dy, fi_out, fo_out):
                 dy[wb + z + j] -= df * zo / lo * inv_mb
             else:
                 ri, zi, li, ri_r, zi_r = _geom_inner(y, zb, j, z, c, s, phidot, pd4, agi)
-                f = contact_force(kk, rel, reld, li - agi, (ri * ri_r + zi * zi_r) / li, ki, cmax, m)
+                f = contact_force(kk, rel, reld, li - agi, (ri * ri_r + zi * zi_r) / li, ki, cmax, p, dint, dflt,
+                                  m.hbuf, m.gbuf)
                 df = f - fi_out[j]
                 fi_out[j] = f
                 fix -= df * ri / li * c
@@ -744,7 +744,7 @@ def _balls_quasi_static_3d(y, m, cg, fi_out, fo_out):
     """Massless balls in 3-D: the two contacts in series along the line through both grooves'
     curvature centres (one contact angle per ball).  Returns the forces on the rings (x, y, z)."""
     p, dint, dflt = m.p, m.dint, m.dflt
-    z, c0, s0, phic, phidot = cg.z, cg.c0, cg.s0, cg.phic, cg.phidot
+    z, phic, c0, s0, phidot, theta_s, omega_s = cg
     pd4 = 0.25 * p[P_PD]
     keff = p[P_KEFF]
     e = p[P_EXP]
@@ -760,19 +760,21 @@ def _balls_quasi_static_3d(y, m, cg, fi_out, fo_out):
         fo_out[j] = q
     ndef = int(p[P_NDEF])
     sp = TWO_PI / z
+    spin = p[P_SPIN]
     for im in range(2 * ndef):
         kk = ndef - 1 - (im % ndef)
         if dint[kk, D_RACE] % 2 != (1 if im < ndef else 0):
             continue
-        ja, jb, cnt = _zone_candidates(kk, cg, dint, dflt)
+        ja, jb, cnt = _zone_candidates(kk, z, phic, theta_s, dint, dflt)
         for q in range(cnt):
             j = q if cnt == z else (ja if q == 0 else jb)
-            rel, reld = rel_angle(kk, j, phic + sp * j, phidot, cg, m)
+            rel, reld = rel_angle(kk, j, phic + sp * j, phidot, theta_s, omega_s, spin, dint, dflt)
             if not (dflt[kk, F_ZLO] <= rel <= dflt[kk, F_ZHI]):
                 continue
             c, s = _ball_dir(p, z, j, c0, s0)
             rho, zeta, ln, rho_r, zeta_r = _qs_geom(y, zb, c, s, phidot, pd4, a0)
-            qd = _qs_ball(kk, rel, reld, ln - a0, (rho * rho_r + zeta * zeta_r) / ln, m)
+            qd = _qs_ball(kk, rel, reld, ln - a0, (rho * rho_r + zeta * zeta_r) / ln, p, dint, dflt, m.hbuf,
+                          m.gbuf)
             fi_out[j] = qd
             fo_out[j] = qd
     fix = fiy = fiz = fox = foy = foz = 0.0

@@ -128,8 +128,11 @@ def step_limit(t, y, h, m, nsteps_def):
     ndef = int(p[K.P_NDEF])
     if ndef == 0:
         return h
-    cg = K.cage_at(t, m)
-    z, phic, phidot, theta_s, omega_s = cg.z, cg.phic, cg.phidot, cg.theta_s, cg.omega_s
+    z = int(p[K.P_Z])
+    theta_s, omega_s = K.shaft_state(t, m.sp_t, m.sp_w, m.sp_th)
+    phic = p[K.P_PHI0] + p[K.P_FTF] * theta_s
+    phidot = p[K.P_FTF] * omega_s
+    spin = p[K.P_SPIN]
     dyn = p[K.P_CAGE] > 0.5
     sp = TWO_PI / z
     hh = h
@@ -155,9 +158,10 @@ def step_limit(t, y, h, m, nsteps_def):
             continue
         for j in range(z):
             if dyn:
-                rel, reld = K.rel_angle(kk, j, y[8 + 2 * z + j], y[8 + 3 * z + j], cg, m)
+                rel, reld = K.rel_angle(kk, j, y[8 + 2 * z + j], y[8 + 3 * z + j], theta_s, omega_s, spin,
+                                        dint, dflt)
             else:
-                rel, reld = K.rel_angle(kk, j, phic + TWO_PI * j / z, phidot, cg, m)
+                rel, reld = K.rel_angle(kk, j, phic + TWO_PI * j / z, phidot, theta_s, omega_s, spin, dint, dflt)
             if rel > 5.0 or abs(reld) < 1e-12:
                 continue
             if zlo <= rel <= zhi:
@@ -190,7 +194,7 @@ def _dense(t, hstep, y, ynew, f0, f1, o, fine_pos, out_pos):
     :class:`Output` ``o``, from positions ``fine_pos`` and ``out_pos`` on; returns the next ones."""
     tn = t + hstep
     n = y.shape[0]
-    fine_t, vel_idx = o.fine_t, o.vel_idx
+    fine_t, fine_out, vel_idx, vel_sign = o.fine_t, o.fine_out, o.vel_idx, o.vel_sign
     while fine_pos < fine_t.shape[0] and fine_t[fine_pos] <= tn:
         th = (fine_t[fine_pos] - t) / hstep
         for ch in range(vel_idx.shape[0]):
@@ -198,14 +202,14 @@ def _dense(t, hstep, y, ynew, f0, f1, o, fine_pos, out_pos):
             for r in range(vel_idx.shape[1]):
                 idx = vel_idx[ch, r]
                 if idx >= 0:
-                    v += o.vel_sign[ch, r] * _hermite(y[idx], ynew[idx], f0[idx], f1[idx], hstep, th)
-            o.fine_out[fine_pos, ch] = v
+                    v += vel_sign[ch, r] * _hermite(y[idx], ynew[idx], f0[idx], f1[idx], hstep, th)
+            fine_out[fine_pos, ch] = v
         fine_pos += 1
-    out_t = o.out_t
+    out_t, out_state = o.out_t, o.out_state
     while out_pos < out_t.shape[0] and out_t[out_pos] <= tn:
         th = (out_t[out_pos] - t) / hstep
         for m in range(n):
-            o.out_state[out_pos, m] = _hermite(y[m], ynew[m], f0[m], f1[m], hstep, th)
+            out_state[out_pos, m] = _hermite(y[m], ynew[m], f0[m], f1[m], hstep, th)
         out_pos += 1
     return fine_pos, out_pos
 
@@ -303,15 +307,16 @@ def integrate(t, t_stop, h, m, sol, w, o):
 
 
 @njit(cache=True, error_model="numpy", **K.NO_REFCOUNT)
-def loads_at(out_t, out_state, m, fi_all, fo_all, w):
+def loads_at(out_t, out_state, m, fi_all, fo_all, dy, fi, fo):
     """Ball loads (N) into ``fi_all``, ``fo_all`` (Z × samples) at the output samples from the
-    interpolated states (on the scratch arrays ``w.ytmp``, ``w.fi``, ``w.fo`` of :class:`Work`)."""
-    z = w.fi.shape[0]
+    interpolated states (``dy``, ``fi``, ``fo``: scratch, the loop's ``Work.ytmp``, ``.fi``, ``.fo``;
+    only these three are passed: each array argument costs compile time to unbox)."""
+    z = fi.shape[0]
     for i in range(out_t.shape[0]):
-        K.rhs(out_t[i], out_state[i], m, w.ytmp, w.fi, w.fo)
+        K.rhs(out_t[i], out_state[i], m, dy, fi, fo)
         for j in range(z):
-            fi_all[j, i] = w.fi[j]
-            fo_all[j, i] = w.fo[j]
+            fi_all[j, i] = fi[j]
+            fo_all[j, i] = fo[j]
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -337,9 +342,11 @@ def contact_angles_at(out_t, out_state, m, out):
     deg = 180.0 / math.pi
     for i in range(out_t.shape[0]):
         y = out_state[i]
-        cg = K.cage_at(out_t[i], m)
+        phic = p[K.P_PHI0] + p[K.P_FTF] * K.shaft_state(out_t[i], m.sp_t, m.sp_w, m.sp_th)[0]
+        c0 = math.cos(phic)
+        s0 = math.sin(phic)
         for j in range(z):
-            c, s = K._ball_dir(p, z, j, cg.c0, cg.s0)
+            c, s = K._ball_dir(p, z, j, c0, s0)
             ui = y[0] * c + y[1] * s
             uo = y[4] * c + y[5] * s
             if multibody:

@@ -172,7 +172,7 @@ class _Stream:
             # written into new contiguous blocks, so that one compiled signature serves every chunk
             z = w.fi.size
             fi, fo = np.empty((z, hi - lo)), np.empty((z, hi - lo))
-            kern.loads_at(o.out_t, o.out_state, m, fi, fo, w)
+            kern.loads_at(o.out_t, o.out_state, m, fi, fo, w.ytmp, w.fi, w.fo)
             self.fi[:, lo:hi], self.fo[:, lo:hi] = fi, fo
         self.o_next = hi
 

@@ -8,7 +8,6 @@ import numpy as np
 import pytest
 
 from bearing_lab.sim import _kernels as K, _stepper as S, load_scene, simulate
-from bearing_lab.sim._loopargs import Cage
 from bearing_lab.sim.assembly import assemble
 
 
@@ -53,12 +52,11 @@ def test_zone_candidates_find_the_same_balls_as_a_loop_over_all(race):
         theta_s = rng.uniform(-50, 50) if race == "inner" else 0.0
         if race == "inner":  # put the zone where the balls are for the edge cases
             phic = phic + theta_s
-        cg = Cage(z, phic, math.cos(phic), math.sin(phic), 1.0, theta_s, 2.0)  # cage speed 1, shaft 2 rad/s
-        ja, jb, cnt = K._zone_candidates(0, cg, asm.dint, asm.dflt)
+        ja, jb, cnt = K._zone_candidates(0, z, phic, theta_s, asm.dint, asm.dflt)
         cands = set(range(z)) if cnt == z else {ja, jb}
         found = set()
         for j in cands:
-            rel, _ = K.rel_angle(0, j, phic + 2 * math.pi / z * j, 1.0, cg, asm.model)
+            rel, _ = K.rel_angle(0, j, phic + 2 * math.pi / z * j, 1.0, theta_s, 2.0, 0.0, asm.dint, asm.dflt)
             if zlo <= rel <= zhi:
                 found.add(j)
         want = _naive_in_zone(asm, phic, theta_s)
