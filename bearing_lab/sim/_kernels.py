@@ -10,7 +10,8 @@ Conventions the kernels rely on (assembled by :mod:`bearing_lab.sim.assembly`):
 
 - SI units; angles in rad, counter-clockwise positive; the shaft turns
   counter-clockwise; Y is up.
-- ``p``: float64 parameter vector, indices ``P_*`` below.
+- ``p``: float64 parameter vector, indices ``P_*`` below; the kernels get it with the speed
+  profile and the defect tables as one :class:`._loopargs.Model` ``m``.
 - state ``y``: inner ring (x, y, vx, vy), outer ring (x, y, vx, vy), then for the
   multibody fidelity each ball's radial coordinate q_j = r_j − d_m/2 and its
   rate, then the sensor's relative displacements and rates (x, y).
@@ -28,6 +29,8 @@ import math
 
 import numpy as np
 from numba import njit
+
+from ._loopargs import Cage
 
 # ---- parameter vector layout
 P_Z, P_RP, P_PD, P_KI, P_KO, P_KEFF, P_CMAX, P_DPEN, P_EXP = 0, 1, 2, 3, 4, 5, 6, 7, 8
@@ -121,6 +124,15 @@ def shaft_state(t, sp_t, sp_w, sp_th):
     dt = t - sp_t[lo]
     slope = (sp_w[hi] - sp_w[lo]) / (sp_t[hi] - sp_t[lo])
     return sp_th[lo] + sp_w[lo] * dt + 0.5 * slope * dt * dt, sp_w[lo] + slope * dt
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def cage_at(t, m):
+    """The shaft and a kinematic cage at time t (:class:`Cage`) for :class:`Model` ``m``."""
+    p = m.p
+    theta_s, omega_s = shaft_state(t, m.sp_t, m.sp_w, m.sp_th)
+    phic = p[P_PHI0] + p[P_FTF] * theta_s
+    return Cage(int(p[P_Z]), phic, math.cos(phic), math.sin(phic), p[P_FTF] * omega_s, theta_s, omega_s)
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -399,13 +411,15 @@ def _approaches(y, z, j, c, s, phidot, pd4):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _balls_kinematic(y, p, z, c0, s0, phic, phidot, theta_s, omega_s, dint, dflt, hbuf, gbuf, dy, fi_out, fo_out):
+def _balls_kinematic(y, m, cg, dy, fi_out, fo_out):
     """Ball loads and ball equations for multibody balls in a kinematic cage.
 
     Every contact as intact first (one loop without branches on defects), then for each defect
     the O(1) candidate balls in its zone get the defect's law, with the ball's equation and the
     ring sums corrected (the lowest-numbered defect wins where zones overlap).  Returns the
     ball forces on the inner and outer ring (x, y)."""
+    p, dint, dflt = m.p, m.dint, m.dflt
+    z, phic, c0, s0, phidot, theta_s, omega_s = cg
     xi, yi, vxi, vyi = y[0], y[1], y[2], y[3]
     xo, yo, vxo, vyo = y[4], y[5], y[6], y[7]
     pd4 = 0.25 * p[P_PD]
@@ -418,10 +432,7 @@ def _balls_kinematic(y, p, z, c0, s0, phic, phidot, theta_s, omega_s, dint, dflt
     rp = p[P_RP]
     g = p[P_G]
     w2 = phidot * phidot
-    fix = 0.0
-    fiy = 0.0
-    fox = 0.0
-    foy = 0.0
+    fix = fiy = fox = foy = 0.0
     for j in range(z):
         c, s = _ball_dir(p, z, j, c0, s0)
         qj = y[8 + j]
@@ -445,8 +456,8 @@ def _balls_kinematic(y, p, z, c0, s0, phic, phidot, theta_s, omega_s, dint, dflt
         return fix, fiy, fox, foy
     sp = TWO_PI / z
     spin = p[P_SPIN]
-    for m in range(ndef):
-        kk = ndef - 1 - m
+    for im in range(ndef):
+        kk = ndef - 1 - im
         ja, jb, cnt = _zone_candidates(kk, z, phic, theta_s, dint, dflt)
         outer = dint[kk, D_RACE] % 2 == 0
         for q in range(cnt):
@@ -457,13 +468,13 @@ def _balls_kinematic(y, p, z, c0, s0, phic, phidot, theta_s, omega_s, dint, dflt
             c, s = _ball_dir(p, z, j, c0, s0)
             d_o, d_or, d_i, d_ir = _approaches(y, z, j, c, s, phidot, pd4)
             if outer:
-                f = contact_force(kk, rel, reld, d_o, d_or, ko, cmax, p, dint, dflt, hbuf, gbuf)
+                f = contact_force(kk, rel, reld, d_o, d_or, ko, cmax, p, dint, dflt, m.hbuf, m.gbuf)
                 df = f - fo_out[j]
                 fo_out[j] = f
                 fox += df * c
                 foy += df * s
             else:
-                f = contact_force(kk, rel, reld, d_i, d_ir, ki, cmax, p, dint, dflt, hbuf, gbuf)
+                f = contact_force(kk, rel, reld, d_i, d_ir, ki, cmax, p, dint, dflt, m.hbuf, m.gbuf)
                 df = f - fi_out[j]
                 fi_out[j] = f
                 fix -= df * c
@@ -473,11 +484,13 @@ def _balls_kinematic(y, p, z, c0, s0, phic, phidot, theta_s, omega_s, dint, dflt
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _balls_quasi_static(y, p, z, c0, s0, phic, phidot, theta_s, omega_s, dint, dflt, hbuf, gbuf, fi_out, fo_out):
+def _balls_quasi_static(y, m, cg, fi_out, fo_out):
     """Ball loads of massless (quasi-static) balls: the two contacts of a ball in series, the
     same load on both.  Intact first, then the O(1) candidate balls of each defect zone (an
     outer-race defect wins over an inner-race one, the lowest-numbered over the others).
     Returns the ball forces on the inner and outer ring (x, y)."""
+    p, dint, dflt = m.p, m.dint, m.dflt
+    z, phic, c0, s0, phidot, theta_s, omega_s = cg
     pd4 = 0.25 * p[P_PD]
     keff = p[P_KEFF]
     e = p[P_EXP]
@@ -497,10 +510,10 @@ def _balls_quasi_static(y, p, z, c0, s0, phic, phidot, theta_s, omega_s, dint, d
     ndef = int(p[P_NDEF])
     sp = TWO_PI / z
     spin = p[P_SPIN]
-    for m in range(2 * ndef):
+    for im in range(2 * ndef):
         # inner-race defects first, then outer-race ones, each from the last to the first
-        kk = ndef - 1 - (m % ndef)
-        if dint[kk, D_RACE] % 2 != (1 if m < ndef else 0):
+        kk = ndef - 1 - (im % ndef)
+        if dint[kk, D_RACE] % 2 != (1 if im < ndef else 0):
             continue
         ja, jb, cnt = _zone_candidates(kk, z, phic, theta_s, dint, dflt)
         for q in range(cnt):
@@ -511,13 +524,10 @@ def _balls_quasi_static(y, p, z, c0, s0, phic, phidot, theta_s, omega_s, dint, d
             c, s = _ball_dir(p, z, j, c0, s0)
             dtot = dx * c + dyy * s - 2.0 * pd4
             drate = dvx * c + dvy * s + (dx * (-s) + dyy * c) * phidot
-            qd = _qs_ball(kk, rel, reld, dtot, drate, p, dint, dflt, hbuf, gbuf)
+            qd = _qs_ball(kk, rel, reld, dtot, drate, p, dint, dflt, m.hbuf, m.gbuf)
             fi_out[j] = qd
             fo_out[j] = qd
-    fix = 0.0
-    fiy = 0.0
-    fox = 0.0
-    foy = 0.0
+    fix = fiy = fox = foy = 0.0
     for j in range(z):
         c, s = _ball_dir(p, z, j, c0, s0)
         fix -= fi_out[j] * c
@@ -528,10 +538,12 @@ def _balls_quasi_static(y, p, z, c0, s0, phic, phidot, theta_s, omega_s, dint, d
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _balls_dynamic(y, p, z, phic, theta_s, omega_s, dint, dflt, hbuf, gbuf, dy, fi_out, fo_out):
+def _balls_dynamic(y, m, cg, dy, fi_out, fo_out):
     """Multibody balls in a dynamic cage: each ball's orbital angle, speed and spin are states;
     traction at both contacts (regularised Coulomb), cage pockets.  Returns the ball forces on
     the inner and outer ring (x, y) and the pockets' torque on the cage."""
+    p, dint, dflt = m.p, m.dint, m.dflt
+    z, _, _, _, _, theta_s, omega_s = cg
     xi, yi, vxi, vyi = y[0], y[1], y[2], y[3]
     xo, yo, vxo, vyo = y[4], y[5], y[6], y[7]
     pd4 = 0.25 * p[P_PD]
@@ -539,10 +551,7 @@ def _balls_dynamic(y, p, z, phic, theta_s, omega_s, dint, dflt, hbuf, gbuf, dy, 
     ndef = int(p[P_NDEF])
     spin = p[P_SPIN]
     base = 8
-    fix = 0.0
-    fiy = 0.0
-    fox = 0.0
-    foy = 0.0
+    fix = fiy = fox = foy = 0.0
     pocket_torque = 0.0
     for j in range(z):
         phi = y[base + 2 * z + j]
@@ -558,11 +567,11 @@ def _balls_dynamic(y, p, z, phic, theta_s, omega_s, dint, dflt, hbuf, gbuf, dy, 
             ko, relo, reldo = find_zone(0, j, phi, phidot, theta_s, omega_s, spin, ndef, dint, dflt)
             ki, reli, reldi = find_zone(1, j, phi, phidot, theta_s, omega_s, spin, ndef, dint, dflt)
         if ko >= 0:
-            fo = defect_force(ko, relo, reldo, d_o, d_or, p[P_KO], p, dint, dflt, hbuf, gbuf)
+            fo = defect_force(ko, relo, reldo, d_o, d_or, p[P_KO], p, dint, dflt, m.hbuf, m.gbuf)
         else:
             fo = impact(d_o, d_or, p[P_KO], p[P_EXP], p[P_CMAX], p[P_DPEN])
         if ki >= 0:
-            fi = defect_force(ki, reli, reldi, d_i, d_ir, p[P_KI], p, dint, dflt, hbuf, gbuf)
+            fi = defect_force(ki, reli, reldi, d_i, d_ir, p[P_KI], p, dint, dflt, m.hbuf, m.gbuf)
         else:
             fi = impact(d_i, d_ir, p[P_KI], p[P_EXP], p[P_CMAX], p[P_DPEN])
         dy[base + j] = qd
@@ -631,12 +640,13 @@ def _geom_inner(y, zb, j, z, c, s, phidot, pd4, agi):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _balls_kinematic_3d(y, p, z, c0, s0, phic, phidot, theta_s, omega_s, dint, dflt, hbuf, gbuf, dy, fi_out,
-                        fo_out):
+def _balls_kinematic_3d(y, m, cg, dy, fi_out, fo_out):
     """Multibody balls in a kinematic cage, in 3-D: each ball has a radial and an axial position;
     each contact acts along the line through the ball centre and its groove's curvature centre
     (the contact angle), its approach measured along it.  Returns the ball forces on the inner
     and outer ring (x, y, z)."""
+    p, dint, dflt = m.p, m.dint, m.dflt
+    z, phic, c0, s0, phidot, theta_s, omega_s = cg
     pd4 = 0.25 * p[P_PD]
     ko = p[P_KO]
     ki = p[P_KI]
@@ -651,12 +661,7 @@ def _balls_kinematic_3d(y, p, z, c0, s0, phic, phidot, theta_s, omega_s, dint, d
     zb = int(p[P_ZOFF])
     wb = zb + 4
     w2 = phidot * phidot
-    fix = 0.0
-    fiy = 0.0
-    fiz = 0.0
-    fox = 0.0
-    foy = 0.0
-    foz = 0.0
+    fix = fiy = fiz = fox = foy = foz = 0.0
     for j in range(z):
         c, s = _ball_dir(p, z, j, c0, s0)
         ro, zo, lo, ro_r, zo_r = _geom_outer(y, zb, j, z, c, s, phidot, pd4, ago)
@@ -688,8 +693,8 @@ def _balls_kinematic_3d(y, p, z, c0, s0, phic, phidot, theta_s, omega_s, dint, d
         return fix, fiy, fiz, fox, foy, foz
     sp = TWO_PI / z
     spin = p[P_SPIN]
-    for m in range(ndef):
-        kk = ndef - 1 - m
+    for im in range(ndef):
+        kk = ndef - 1 - im
         ja, jb, cnt = _zone_candidates(kk, z, phic, theta_s, dint, dflt)
         outer = dint[kk, D_RACE] % 2 == 0
         for q in range(cnt):
@@ -701,7 +706,7 @@ def _balls_kinematic_3d(y, p, z, c0, s0, phic, phidot, theta_s, omega_s, dint, d
             if outer:
                 ro, zo, lo, ro_r, zo_r = _geom_outer(y, zb, j, z, c, s, phidot, pd4, ago)
                 f = contact_force(kk, rel, reld, lo - ago, (ro * ro_r + zo * zo_r) / lo, ko, cmax, p, dint, dflt,
-                                  hbuf, gbuf)
+                                  m.hbuf, m.gbuf)
                 df = f - fo_out[j]
                 fo_out[j] = f
                 fox += df * ro / lo * c
@@ -712,7 +717,7 @@ def _balls_kinematic_3d(y, p, z, c0, s0, phic, phidot, theta_s, omega_s, dint, d
             else:
                 ri, zi, li, ri_r, zi_r = _geom_inner(y, zb, j, z, c, s, phidot, pd4, agi)
                 f = contact_force(kk, rel, reld, li - agi, (ri * ri_r + zi * zi_r) / li, ki, cmax, p, dint, dflt,
-                                  hbuf, gbuf)
+                                  m.hbuf, m.gbuf)
                 df = f - fi_out[j]
                 fi_out[j] = f
                 fix -= df * ri / li * c
@@ -735,10 +740,11 @@ def _qs_geom(y, zb, c, s, phidot, pd4, a0):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _balls_quasi_static_3d(y, p, z, c0, s0, phic, phidot, theta_s, omega_s, dint, dflt, hbuf, gbuf, fi_out,
-                           fo_out):
+def _balls_quasi_static_3d(y, m, cg, fi_out, fo_out):
     """Massless balls in 3-D: the two contacts in series along the line through both grooves'
     curvature centres (one contact angle per ball).  Returns the forces on the rings (x, y, z)."""
+    p, dint, dflt = m.p, m.dint, m.dflt
+    z, phic, c0, s0, phidot, theta_s, omega_s = cg
     pd4 = 0.25 * p[P_PD]
     keff = p[P_KEFF]
     e = p[P_EXP]
@@ -755,9 +761,9 @@ def _balls_quasi_static_3d(y, p, z, c0, s0, phic, phidot, theta_s, omega_s, dint
     ndef = int(p[P_NDEF])
     sp = TWO_PI / z
     spin = p[P_SPIN]
-    for m in range(2 * ndef):
-        kk = ndef - 1 - (m % ndef)
-        if dint[kk, D_RACE] % 2 != (1 if m < ndef else 0):
+    for im in range(2 * ndef):
+        kk = ndef - 1 - (im % ndef)
+        if dint[kk, D_RACE] % 2 != (1 if im < ndef else 0):
             continue
         ja, jb, cnt = _zone_candidates(kk, z, phic, theta_s, dint, dflt)
         for q in range(cnt):
@@ -767,15 +773,11 @@ def _balls_quasi_static_3d(y, p, z, c0, s0, phic, phidot, theta_s, omega_s, dint
                 continue
             c, s = _ball_dir(p, z, j, c0, s0)
             rho, zeta, ln, rho_r, zeta_r = _qs_geom(y, zb, c, s, phidot, pd4, a0)
-            qd = _qs_ball(kk, rel, reld, ln - a0, (rho * rho_r + zeta * zeta_r) / ln, p, dint, dflt, hbuf, gbuf)
+            qd = _qs_ball(kk, rel, reld, ln - a0, (rho * rho_r + zeta * zeta_r) / ln, p, dint, dflt, m.hbuf,
+                          m.gbuf)
             fi_out[j] = qd
             fo_out[j] = qd
-    fix = 0.0
-    fiy = 0.0
-    fiz = 0.0
-    fox = 0.0
-    foy = 0.0
-    foz = 0.0
+    fix = fiy = fiz = fox = foy = foz = 0.0
     for j in range(z):
         c, s = _ball_dir(p, z, j, c0, s0)
         rho, zeta, ln, _, _ = _qs_geom(y, zb, c, s, phidot, pd4, a0)
@@ -791,22 +793,18 @@ def _balls_quasi_static_3d(y, p, z, c0, s0, phic, phidot, theta_s, omega_s, dint
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _rhs_3d(t, y, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, dy, fi_out, fo_out):
+def _rhs_3d(t, y, m, dy, fi_out, fo_out):
     """dy/dt of the 3-D bearing (rings with an axial translation, contact angles)."""
-    z = int(p[P_Z])
+    p = m.p
     xi, yi, vxi, vyi = y[0], y[1], y[2], y[3]
     xo, yo, vxo, vyo = y[4], y[5], y[6], y[7]
     zb = int(p[P_ZOFF])
-    theta_s, omega_s = shaft_state(t, sp_t, sp_w, sp_th)
-    phic = p[P_PHI0] + p[P_FTF] * theta_s
-    phidot = p[P_FTF] * omega_s
+    cg = cage_at(t, m)
+    z, theta_s, omega_s = cg.z, cg.theta_s, cg.omega_s
     if p[P_FID] > 0.5:
-        fix, fiy, fiz, fox, foy, foz = _balls_quasi_static_3d(y, p, z, math.cos(phic), math.sin(phic), phic, phidot,
-                                                              theta_s, omega_s, dint, dflt, hbuf, gbuf, fi_out, fo_out)
+        fix, fiy, fiz, fox, foy, foz = _balls_quasi_static_3d(y, m, cg, fi_out, fo_out)
     else:
-        fix, fiy, fiz, fox, foy, foz = _balls_kinematic_3d(y, p, z, math.cos(phic), math.sin(phic), phic, phidot,
-                                                           theta_s, omega_s, dint, dflt, hbuf, gbuf, dy, fi_out,
-                                                           fo_out)
+        fix, fiy, fiz, fox, foy, foz = _balls_kinematic_3d(y, m, cg, dy, fi_out, fo_out)
         if t < p[P_TZSET]:  # start transient of the nearly undamped axial ball modes (scene.settle)
             for j in range(zb + 4 + z, zb + 4 + 2 * z):
                 dy[j] -= p[P_ZSET] * (y[j] - 0.5 * (y[zb + 2] + y[zb + 3]))
@@ -843,29 +841,26 @@ def _rhs_3d(t, y, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, dy, fi_out, fo_o
 
 
 @njit(cache=True, error_model="numpy", **NO_REFCOUNT)
-def rhs(t, y, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, dy, fi_out, fo_out):
-    """dy/dt of the bearing model; also writes the ball loads into fi_out/fo_out."""
+def rhs(t, y, m, dy, fi_out, fo_out):
+    """dy/dt of the bearing model :class:`Model` ``m`` at time t, state y (into dy); also writes
+    the ball loads (N) into fi_out/fo_out."""
+    p = m.p
     if p[P_3D] > 0.5:
-        _rhs_3d(t, y, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, dy, fi_out, fo_out)
+        _rhs_3d(t, y, m, dy, fi_out, fo_out)
         return
-    z = int(p[P_Z])
     xi, yi, vxi, vyi = y[0], y[1], y[2], y[3]
     xo, yo, vxo, vyo = y[4], y[5], y[6], y[7]
-    theta_s, omega_s = shaft_state(t, sp_t, sp_w, sp_th)
-    phic = p[P_PHI0] + p[P_FTF] * theta_s
-    phidot = p[P_FTF] * omega_s
+    cg = cage_at(t, m)
+    z, theta_s, omega_s = cg.z, cg.theta_s, cg.omega_s
     qs = p[P_FID] > 0.5
     dyn = p[P_CAGE] > 0.5
     pocket_torque = 0.0
     if dyn and not qs:
-        fix, fiy, fox, foy, pocket_torque = _balls_dynamic(y, p, z, phic, theta_s, omega_s, dint, dflt, hbuf, gbuf,
-                                                           dy, fi_out, fo_out)
+        fix, fiy, fox, foy, pocket_torque = _balls_dynamic(y, m, cg, dy, fi_out, fo_out)
     elif qs:
-        fix, fiy, fox, foy = _balls_quasi_static(y, p, z, math.cos(phic), math.sin(phic), phic, phidot, theta_s,
-                                                 omega_s, dint, dflt, hbuf, gbuf, fi_out, fo_out)
+        fix, fiy, fox, foy = _balls_quasi_static(y, m, cg, fi_out, fo_out)
     else:
-        fix, fiy, fox, foy = _balls_kinematic(y, p, z, math.cos(phic), math.sin(phic), phic, phidot, theta_s,
-                                              omega_s, dint, dflt, hbuf, gbuf, dy, fi_out, fo_out)
+        fix, fiy, fox, foy = _balls_kinematic(y, m, cg, dy, fi_out, fo_out)
     if t >= p[P_TSTEP]:
         lix, liy, lox, loy = p[P_FIX2], p[P_FIY2], p[P_FOX2], p[P_FOY2]
     else:

@@ -30,6 +30,7 @@ import numpy as np
 from numba import njit
 
 from . import _kernels as K  # K: the name sim/_variants.py rebinds in each per-kind copy of these kernels
+from . import _loopargs
 
 TWO_PI = 2.0 * math.pi
 
@@ -121,13 +122,14 @@ def _finish(method, y, k, h, ynew, err):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def step_limit(t, y, h, p, sp_t, sp_w, sp_th, dint, dflt, nsteps_def):
+def step_limit(t, y, h, m, nsteps_def):
     """Bound the step near defects: land on zone entry, then take >= nsteps_def steps inside."""
+    p, dint, dflt = m.p, m.dint, m.dflt
     ndef = int(p[K.P_NDEF])
     if ndef == 0:
         return h
     z = int(p[K.P_Z])
-    theta_s, omega_s = K.shaft_state(t, sp_t, sp_w, sp_th)
+    theta_s, omega_s = K.shaft_state(t, m.sp_t, m.sp_w, m.sp_th)
     phic = p[K.P_PHI0] + p[K.P_FTF] * theta_s
     phidot = p[K.P_FTF] * omega_s
     spin = p[K.P_SPIN]
@@ -187,10 +189,12 @@ def _hermite(y0, y1, f0, f1, h, th):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _dense(t, hstep, y, ynew, f0, f1, vel_idx, vel_sign, fine_t, fine_out, fine_pos, out_t, out_state, out_pos):
-    """Cubic Hermite output on the fine (accelerometer velocity) and output (state) grids."""
+def _dense(t, hstep, y, ynew, f0, f1, o, fine_pos, out_pos):
+    """Cubic Hermite output on the fine (accelerometer velocity) and output (state) grids of
+    :class:`Output` ``o``, from positions ``fine_pos`` and ``out_pos`` on; returns the next ones."""
     tn = t + hstep
     n = y.shape[0]
+    fine_t, fine_out, vel_idx, vel_sign = o.fine_t, o.fine_out, o.vel_idx, o.vel_sign
     while fine_pos < fine_t.shape[0] and fine_t[fine_pos] <= tn:
         th = (fine_t[fine_pos] - t) / hstep
         for ch in range(vel_idx.shape[0]):
@@ -201,6 +205,7 @@ def _dense(t, hstep, y, ynew, f0, f1, vel_idx, vel_sign, fine_t, fine_out, fine_
                     v += vel_sign[ch, r] * _hermite(y[idx], ynew[idx], f0[idx], f1[idx], hstep, th)
             fine_out[fine_pos, ch] = v
         fine_pos += 1
+    out_t, out_state = o.out_t, o.out_state
     while out_pos < out_t.shape[0] and out_t[out_pos] <= tn:
         th = (out_t[out_pos] - t) / hstep
         for m in range(n):
@@ -209,33 +214,26 @@ def _dense(t, hstep, y, ynew, f0, f1, vel_idx, vel_sign, fine_t, fine_out, fine_
     return fine_pos, out_pos
 
 
-def work_arrays(n, z):
-    """The work arrays :func:`integrate` and :func:`loads_at` run on, for ``n`` states and ``z``
-    balls: (stage derivatives 7 × n, three n-vectors, two z-vectors of ball loads)."""
-    return np.zeros((7, n)), np.empty(n), np.empty(n), np.empty(n), np.empty(z), np.empty(z)
-
-
-# Python calls the kernels below directly, on work arrays it allocates (``work_arrays``), and
-# they are compiled without reference counting (they allocate nothing).  No wrapper kernel
+# Python calls the kernels below directly, on work arrays it allocates (``_loopargs.new_work``),
+# and they are compiled without reference counting (they allocate nothing).  No wrapper kernel
 # allocates the work arrays: numba's disk cache would store such a wrapper's machine code with its
 # own copy of the loop, and that copy runs 0.077-0.089 CPU s per simulated second where the loop's
 # own copy runs 0.050-0.062 (same scenes, bitwise the same results, measured).  Called directly,
-# the cached code is the code that was measured.
+# the cached code is the code that was measured.  Their arguments are the named tuples of
+# ``_loopargs``: ``m`` :class:`Model`, ``sol`` :class:`Solver`, ``w`` :class:`Work`, ``o`` :class:`Output`.
 
 
 @njit(cache=True, error_model="numpy", **K.NO_REFCOUNT)
-def integrate(y, t, t_stop, h, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, method, rtol, atol, hmax,
-              nsteps_def, vel_idx, vel_sign, fine_t, fine_out, fine_pos, out_t, out_state, out_pos, stats,
-              ctrl, k, ytmp, ynew, err, fi, fo):
-    """Integrate from t to t_stop, writing dense output on two grids.
+def integrate(t, t_stop, h, m, sol, w, o):
+    """Integrate the state ``w.y`` from t to t_stop, writing the dense output of ``o``.
 
-    fine grid (``fine_t``): the accelerometer velocity channels (sum over ``vel_idx`` rows with
-    ``vel_sign``) for the anti-alias stage; output grid (``out_t``): the whole state.
-    ``ctrl`` carries the step controller's memory across calls (previous error, rejected flag);
-    ``k, ytmp, ynew, err, fi, fo``: the work arrays of :func:`work_arrays` (``k``: the stages'
-    derivatives).
-    Returns (t, h, fine_pos, out_pos, status): status 0 ok, 1 non-finite state, 2 step underflow.
+    fine grid (``o.fine_t``): the accelerometer velocity channels (sum over ``o.vel_idx`` rows
+    with ``o.vel_sign``) for the anti-alias stage; output grid (``o.out_t``): the whole state.
+    ``w.ctrl`` carries the step controller's memory across calls, ``w.stats`` the step counts.
+    Returns (t, h, status): status 0 ok, 1 non-finite state, 2 step underflow.
     """
+    y, k, ytmp, ynew, ctrl, stats = w.y, w.k, w.ytmp, w.ynew, w.ctrl, w.stats
+    method = sol.method
     n = y.shape[0]
     ns = N_STAGES[method]
     fsal = method != 2
@@ -243,29 +241,31 @@ def integrate(y, t, t_stop, h, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, met
     expo = 1.0 / ORDER[method] - 0.75 * BETA[method]
     beta = BETA[method]
     c = C_DP if method == 0 else (C_BS if method == 1 else C_RK)
-    K.rhs(t, y, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, k[0], fi, fo)
+    fine_pos = 0
+    out_pos = 0
+    K.rhs(t, y, m, k[0], w.fi, w.fo)
     while t < t_stop:
         hstep = h
-        if hstep > hmax:
-            hstep = hmax
+        if hstep > sol.hmax:
+            hstep = sol.hmax
         if t + hstep > t_stop:
             hstep = t_stop - t
-        hstep = step_limit(t, y, hstep, p, sp_t, sp_w, sp_th, dint, dflt, nsteps_def)
+        hstep = step_limit(t, y, hstep, m, sol.nsteps_def)
         if hstep < 1e-14:
             hstep = 1e-14
         for st in range(1, ns + 1):
             _stage_input(method, st, y, k, hstep, ytmp)
             if fsal and st == ns:
-                for m in range(n):
-                    ynew[m] = ytmp[m]
-            K.rhs(t + c[st] * hstep, ytmp, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, k[st], fi, fo)
-        _finish(method, y, k, hstep, ynew, err)
+                for i in range(n):
+                    ynew[i] = ytmp[i]
+            K.rhs(t + c[st] * hstep, ytmp, m, k[st], w.fi, w.fo)
+        _finish(method, y, k, hstep, ynew, w.err)
         fac = 1.0
         if adaptive:
             en = 0.0
-            for m in range(n):
-                sc = atol[m] + rtol * max(abs(y[m]), abs(ynew[m]))
-                en += (err[m] / sc) ** 2
+            for i in range(n):
+                sc = sol.atol[i] + sol.rtol * max(abs(y[i]), abs(ynew[i]))
+                en += (w.err[i] / sc) ** 2
             en = math.sqrt(en / n)
             if not math.isfinite(en):
                 en = 1e10
@@ -275,7 +275,7 @@ def integrate(y, t, t_stop, h, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, met
                 ctrl[1] = 1.0
                 stats[1] += 1
                 if h < 1e-13:
-                    return t, h, fine_pos, out_pos, 2
+                    return t, h, 2
                 continue
             # PI: h_new = h 0.9 err^-(1/q - 0.75 beta) err_prev^beta (one exp, one log: the
             # previous error is kept as its logarithm)
@@ -289,31 +289,31 @@ def integrate(y, t, t_stop, h, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, met
         # f at the new point: the FSAL stage, or one more evaluation
         f1 = k[ns]
         if not fsal:
-            K.rhs(t + hstep, ynew, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, ytmp, fi, fo)
+            K.rhs(t + hstep, ynew, m, ytmp, w.fi, w.fo)
             stats[2] += 1
             f1 = ytmp
-        fine_pos, out_pos = _dense(t, hstep, y, ynew, k[0], f1, vel_idx, vel_sign, fine_t, fine_out, fine_pos,
-                                   out_t, out_state, out_pos)
+        fine_pos, out_pos = _dense(t, hstep, y, ynew, k[0], f1, o, fine_pos, out_pos)
         tn = t + hstep
-        for m in range(n):
-            y[m] = ynew[m]
-            k[0, m] = f1[m]
-            if not math.isfinite(y[m]):
-                return tn, h, fine_pos, out_pos, 1
+        for i in range(n):
+            y[i] = ynew[i]
+            k[0, i] = f1[i]
+            if not math.isfinite(y[i]):
+                return tn, h, 1
         t = tn
         stats[0] += 1
         if adaptive:
             h = hstep * fac
-    return t, h, fine_pos, out_pos, 0
+    return t, h, 0
 
 
 @njit(cache=True, error_model="numpy", **K.NO_REFCOUNT)
-def loads_at(out_t, out_state, p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, fi_all, fo_all, dy, fi, fo):
-    """Ball loads (N) at the output samples from the interpolated states (``dy``, ``fi``, ``fo``:
-    work arrays of :func:`work_arrays`)."""
+def loads_at(out_t, out_state, m, fi_all, fo_all, dy, fi, fo):
+    """Ball loads (N) into ``fi_all``, ``fo_all`` (Z × samples) at the output samples from the
+    interpolated states (``dy``, ``fi``, ``fo``: scratch, the loop's ``Work.ytmp``, ``.fi``, ``.fo``;
+    only these three are passed: each array argument costs compile time to unbox)."""
     z = fi.shape[0]
     for i in range(out_t.shape[0]):
-        K.rhs(out_t[i], out_state[i], p, sp_t, sp_w, sp_th, dint, dflt, hbuf, gbuf, dy, fi, fo)
+        K.rhs(out_t[i], out_state[i], m, dy, fi, fo)
         for j in range(z):
             fi_all[j, i] = fi[j]
             fo_all[j, i] = fo[j]
@@ -327,11 +327,12 @@ def _atan2(y, x):
 
 
 @njit(cache=True, error_model="numpy", **K.NO_REFCOUNT)
-def contact_angles_at(out_t, out_state, p, sp_t, sp_w, sp_th, out):
+def contact_angles_at(out_t, out_state, m, out):
     """The 3-D bearing's contact angles (deg) at the output samples: ``out[0]`` outer race, ``out[1]``
     inner race, (Z, n) each, positive when the load line leans as under a +Z force on the outer
     ring; the geometry of :func:`.bearing3d.contact_angles`, in one compiled pass (in numpy it cost
     5-7 ms per simulated second at 20 kHz, now 2-3 ms)."""
+    p = m.p
     z = int(p[K.P_Z])
     zb = int(p[K.P_ZOFF])
     pd4 = 0.25 * p[K.P_PD]
@@ -341,7 +342,7 @@ def contact_angles_at(out_t, out_state, p, sp_t, sp_w, sp_th, out):
     deg = 180.0 / math.pi
     for i in range(out_t.shape[0]):
         y = out_state[i]
-        phic = p[K.P_PHI0] + p[K.P_FTF] * K.shaft_state(out_t[i], sp_t, sp_w, sp_th)[0]
+        phic = p[K.P_PHI0] + p[K.P_FTF] * K.shaft_state(out_t[i], m.sp_t, m.sp_w, m.sp_th)[0]
         c0 = math.cos(phic)
         s0 = math.sin(phic)
         for j in range(z):
@@ -418,4 +419,5 @@ def drop_stale_machine_code(fns, sources) -> None:
             pass
 
 
-drop_stale_machine_code((integrate, loads_at, step_limit, contact_angles_at), (K.__file__, __file__))
+drop_stale_machine_code((integrate, loads_at, step_limit, contact_angles_at),
+                        (K.__file__, _loopargs.__file__, __file__))

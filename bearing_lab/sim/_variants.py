@@ -31,6 +31,7 @@ import types
 from numba import njit
 
 from . import _kernels as K  # the same alias as _stepper.py's, the global a per-kind copy rebinds
+from . import _loopargs
 from . import _stepper as S
 
 #: the ball models of ``rhs`` and ``_rhs_3d``, with the number of values each returns
@@ -79,8 +80,9 @@ def _copy(dispatcher, qualname, *, cache, **glb):
 
 
 def _drop_stale(fns):
-    """These copies also depend on ``_kernels.py``, ``_stepper.py`` and this file."""
-    S.drop_stale_machine_code(fns, (K.__file__, S.__file__, __file__))
+    """These copies also depend on ``_kernels.py``, ``_stepper.py``, ``_loopargs.py`` (their
+    arguments' layout) and this file."""
+    S.drop_stale_machine_code(fns, (K.__file__, S.__file__, _loopargs.__file__, __file__))
 
 
 def _stages_of(method):

@@ -23,6 +23,7 @@ from .bearing3d import (axial_support, groove_offsets, load_zone_angle, needs_3d
 # table builder replaced at run time counts
 from . import defects
 from .defects import contact
+from ._loopargs import Model
 from .hertz import series_stiffness
 from .numerics import brentq
 from .scene import Scene
@@ -55,6 +56,12 @@ class Assembly:
     @property
     def sensor_index(self) -> int:
         return int(self.p[kernels.P_SENSOFF])
+
+    @property
+    def model(self) -> Model:
+        """The arrays the compiled right-hand side reads, as its :class:`._loopargs.Model` (the
+        same arrays, not copies: the run raises the defect tables' reach in ``dflt``)."""
+        return Model(self.p, self.sp_t, self.sp_w, self.sp_th, self.dint, self.dflt, self.hbuf, self.gbuf)
 
 
 def choose_contact_model(defect, requested: str, bearing) -> str:

@@ -33,6 +33,7 @@ from ..errors import BearingLabError, SolverError
 from . import _kernels as kernels
 from . import _stepper as S
 from . import _variants as V
+from ._loopargs import Output, Solver, new_work
 from .assembly import assemble
 from .auto import resolve
 from .budget import check_budget
@@ -93,91 +94,146 @@ def _warm_up(asm=None, method=None):
     return seconds
 
 
-def _loads(kern, out_t, out_state, args, work):
-    """Ball loads (Z × samples, inner and outer) at the output samples: written into new
-    contiguous blocks, so that one compiled signature serves every chunk."""
-    z = work[1].size
-    fi, fo = np.empty((z, out_t.size)), np.empty((z, out_t.size))
-    kern.loads_at(out_t, out_state, *args, fi, fo, *work)
-    return fi, fo
+class _Stream:
+    """The output grids of one run and its records, filled chunk by chunk: nothing finer than the
+    output rate is kept beyond one chunk plus the anti-alias filter's length.
+
+    Fine velocity sample m (m = 0 .. n_fine) sits at base + (m - 1/2) dt_f; the fine-interval mean
+    acceleration m (between velocity samples m and m+1) at base + m dt_f; output k at fine index
+    m_pad + k R.
+    """
+
+    def __init__(self, asm, t_end_override, loads):
+        scene, d = asm.scene, asm.scene.data
+        fs = scene.fs_out
+        self.R = R = int(d["output"]["oversample"])
+        self.taps = anti_alias_taps(fs, R)
+        self.taps_rev = np.ascontiguousarray(self.taps[::-1])
+        self.half = len(self.taps) // 2
+        self.dt_f = dt_f = 1.0 / (fs * R)
+        self.n_out = n_out = int(round(scene.duration * fs)) if t_end_override is None else 1
+        self.t0 = t0 = scene.settle if t_end_override is None else 0.0
+        self.m_pad = m_pad = self.half + 2
+        self.t_end = t0 + (n_out - 1) / fs + m_pad * dt_f if t_end_override is None else t_end_override
+        self.base = t0 - m_pad * dt_f
+        self.n_fine = m_pad + (n_out - 1) * R + m_pad + 1
+        z = asm.n_balls
+        self.three_d = three_d = asm.p[kernels.P_3D] > 0.5
+        self.zb = zb = int(asm.p[kernels.P_ZOFF])
+        self.vel_idx = np.full((3 if three_d else 2, 2), -1, dtype=np.int64)
+        self.vel_sign = np.ones((3 if three_d else 2, 2))
+        self.vel_idx[0, 0], self.vel_idx[1, 0] = 6, 7
+        if three_d:
+            self.vel_idx[2, 0] = zb + 3      # the outer ring's axial velocity (no sensor model along the axis)
+        if d["sensor"]["enabled"]:
+            sb = asm.sensor_index
+            self.vel_idx[0, 1], self.vel_idx[1, 1] = sb + 2, sb + 3
+        self.out_t = t0 + np.arange(n_out) / fs
+        self.acc, self.disp = np.zeros((n_out, 2)), np.zeros((n_out, 4))
+        self.acc_z = np.zeros(n_out) if three_d else None
+        self.disp_z = np.zeros(n_out) if three_d else None
+        self.angles = np.zeros((2, z, n_out)) if three_d else None
+        self.cage_idx = 8 + 5 * z + 1
+        self.cage_speed = np.zeros(n_out) if d["cage"]["model"] == "dynamic" else None
+        self.fi = np.zeros((z, n_out)) if loads else None
+        self.fo = np.zeros((z, n_out)) if loads else None
+        self.m_next = 0    # next fine velocity index to produce
+        self.o_next = 0    # next output index whose state is produced
+        self.k_acc = 0     # next output index whose acceleration is computed
+        self.v_buf = np.zeros((0, self.vel_idx.shape[0]))  # fine velocities [v_start, m_next)
+        self.v_start = 0
+
+    def grids(self, t_stop, n) -> Output:
+        """The fine and output grids of a chunk of the loop ending at t_stop (``n`` states)."""
+        dt_f, base = self.dt_f, self.base
+        m_hi = min(int(math.floor((t_stop - base) / dt_f + 0.5)) + 1, self.n_fine + 1)
+        while m_hi > self.m_next and base + (m_hi - 1 - 0.5) * dt_f > t_stop:
+            m_hi -= 1
+        fine_t = base + (np.arange(self.m_next, max(m_hi, self.m_next)) - 0.5) * dt_f
+        o_hi = self.o_next
+        while o_hi < self.n_out and self.out_t[o_hi] <= t_stop:
+            o_hi += 1
+        out_t = self.out_t[self.o_next:o_hi]
+        return Output(self.vel_idx, self.vel_sign, fine_t, np.zeros((fine_t.size, self.vel_idx.shape[0])),
+                      out_t, np.zeros((out_t.size, n)))
+
+    def states(self, o: Output, kern, m, w) -> None:
+        """Displacements, contact angles, cage speed and ball loads at a chunk's output samples."""
+        lo, hi = self.o_next, self.o_next + o.out_t.size
+        if lo == hi:
+            return
+        self.disp[lo:hi] = o.out_state[:, [0, 1, 4, 5]]
+        if self.three_d:
+            self.disp_z[lo:hi] = o.out_state[:, self.zb + 1]
+            S.contact_angles_at(o.out_t, o.out_state, m, self.angles[:, :, lo:hi])
+        if self.cage_speed is not None:
+            self.cage_speed[lo:hi] = o.out_state[:, self.cage_idx]
+        if self.fi is not None:
+            # written into new contiguous blocks, so that one compiled signature serves every chunk
+            z = w.fi.size
+            fi, fo = np.empty((z, hi - lo)), np.empty((z, hi - lo))
+            kern.loads_at(o.out_t, o.out_state, m, fi, fo, w.ytmp, w.fi, w.fo)
+            self.fi[:, lo:hi], self.fo[:, lo:hi] = fi, fo
+        self.o_next = hi
+
+    def accelerations(self, fine_out) -> None:
+        """The accelerometer: fine-interval mean acceleration, FIR, decimate; keep the tail."""
+        R, half, m_pad = self.R, self.half, self.m_pad
+        self.m_next += fine_out.shape[0]
+        self.v_buf = np.concatenate([self.v_buf, fine_out])
+        a_fine = np.diff(self.v_buf, axis=0) / self.dt_f          # fine index v_start + i
+        # outputs whose whole FIR window is available: centre m_pad + k R + half <= last index
+        last = self.v_start + a_fine.shape[0] - 1
+        k_acc = self.k_acc
+        k_hi = min(self.n_out, (last - half - m_pad) // R + 1) if last - half - m_pad >= 0 else k_acc
+        if k_hi > k_acc:
+            s0 = m_pad + k_acc * R - half - self.v_start
+            if self.three_d:
+                S.fir_decimate3(a_fine, self.taps_rev, s0, R, self.acc[k_acc:k_hi], self.acc_z[k_acc:k_hi])
+            else:
+                S.fir_decimate(a_fine, self.taps_rev, s0, R, self.acc[k_acc:k_hi])
+            self.k_acc = k_acc = k_hi
+        # drop the velocities no later output needs; v_buf[0] is always fine index v_start
+        drop = min(max(m_pad + k_acc * R - half - self.v_start, 0), self.v_buf.shape[0])
+        self.v_buf = self.v_buf[drop:]
+        self.v_start += drop
+
+    def result(self, stats) -> dict:
+        return dict(acc=self.acc, disp=self.disp, fi=self.fi, fo=self.fo, out_t=self.out_t,
+                    cage_speed=self.cage_speed, taps=self.taps, R=self.R, acc_z=self.acc_z, disp_z=self.disp_z,
+                    angles=self.angles, m_pad=self.m_pad, n_out=self.n_out, stats=stats, dt_f=self.dt_f,
+                    t0=self.t0, t_end=self.t_end)
+
+
+def _solver(asm, method, rtol, step, max_step, defect_steps):
+    """The loop's :class:`Solver` settings and its first step (s)."""
+    d = asm.scene.data
+    hmax = max_step if max_step is not None else (d["solver"]["max_step_s"] or 2.5e-5)
+    if method == METHODS["rk4"]:
+        h = float(step if step is not None else d["solver"]["step_s"])
+        hmax = h
+    else:
+        h = min(1e-6, hmax)
+    rtol = float(rtol)
+    return Solver(int(method), rtol, asm.atol_scale * rtol, float(hmax), float(defect_steps)), h
 
 
 def _run(asm, method, rtol, *, progress, t_end_override=None, step=None, max_step=None,
          defect_steps=40, chunk_s=0.05, loads=True, fixed_method=False):
-    """Integrate in chunks and stream the output: nothing finer than the output rate is kept
-    beyond one chunk plus the anti-alias filter's length.
+    """Integrate in chunks and stream the output (:class:`_Stream`).
 
     Returns a dict with ``acc`` (n_out, 2: x, y accelerometer signal), ``disp`` (n_out, 4:
     inner x, inner y, outer x, outer y), ``fi``/``fo`` (Z, n_out ball loads, or None),
     ``out_t`` (absolute output times), ``stats`` (steps, rejected, extra RHS) and ``t0``.
     """
     scene = asm.scene
-    d = scene.data
-    fs = scene.fs_out
-    R = int(d["output"]["oversample"])
-    taps = anti_alias_taps(fs, R)
-    taps_rev = np.ascontiguousarray(taps[::-1])
-    half = len(taps) // 2
-    dt_f = 1.0 / (fs * R)
-    n_out = int(round(scene.duration * fs)) if t_end_override is None else 1
-    t0 = scene.settle if t_end_override is None else 0.0
-    m_pad = half + 2
-    pad = m_pad * dt_f
-    t_end = t0 + (n_out - 1) / fs + pad if t_end_override is None else t_end_override
-    # fine velocity sample m (m = 0 .. n_fine) at base + (m - 1/2) dt_f; the fine-interval mean
-    # acceleration m (between velocity samples m and m+1) sits at base + m dt_f; output k at
-    # fine index m_pad + k R
-    base = t0 - m_pad * dt_f
-    n_fine = m_pad + (n_out - 1) * R + m_pad + 1
-    n = asm.y0.size
-    z = asm.n_balls
-    three_d = asm.p[kernels.P_3D] > 0.5
-    zb = int(asm.p[kernels.P_ZOFF])
-    vel_idx = np.full((3 if three_d else 2, 2), -1, dtype=np.int64)
-    vel_sign = np.ones((3 if three_d else 2, 2))
-    vel_idx[0, 0], vel_idx[1, 0] = 6, 7
-    if three_d:
-        vel_idx[2, 0] = zb + 3      # the outer ring's axial velocity (no sensor model along the axis)
-    if d["sensor"]["enabled"]:
-        sb = asm.sensor_index
-        vel_idx[0, 1], vel_idx[1, 1] = sb + 2, sb + 3
-    out_t_all = t0 + np.arange(n_out) / fs
-    acc = np.zeros((n_out, 2))
-    disp = np.zeros((n_out, 4))
-    acc_z = np.zeros(n_out) if three_d else None
-    disp_z = np.zeros(n_out) if three_d else None
-    angles = np.zeros((2, z, n_out)) if three_d else None
-    dyn = d["cage"]["model"] == "dynamic"
-    cage_idx = 8 + 5 * z + 1
-    cage_speed = np.zeros(n_out) if dyn else None
-    fi_all = np.zeros((z, n_out)) if loads else None
-    fo_all = np.zeros((z, n_out)) if loads else None
-    method = int(method)
-    rtol = float(rtol)
-    defect_steps = float(defect_steps)
-    adaptive = method != METHODS["rk4"]
-    hmax = max_step if max_step is not None else (d["solver"]["max_step_s"] or 2.5e-5)
-    if not adaptive:
-        h = float(step if step is not None else d["solver"]["step_s"])
-        hmax = h
-    else:
-        h = min(1e-6, hmax)
-    hmax = float(hmax)
-    atol = asm.atol_scale * rtol
-    y = asm.y0.copy()
-    t = 0.0
-    stats = np.zeros(3, dtype=np.int64)
-    ctrl = np.array([math.log(1e-4), 0.0])  # step controller memory: log previous error, last step rejected
-    m_next = 0                      # next fine velocity index to produce
-    o_next = 0                      # next output index whose state is produced
-    k_acc = 0                       # next output index whose acceleration is computed
-    v_buf = np.zeros((0, vel_idx.shape[0]))  # fine velocities [v_start, m_next)
-    v_start = 0
-    args = (asm.p, asm.sp_t, asm.sp_w, asm.sp_th, asm.dint, asm.dflt, asm.hbuf, asm.gbuf)
+    out = _Stream(asm, t_end_override, loads)
+    sol, h = _solver(asm, int(method), rtol, step, max_step, defect_steps)
     # the loop compiled for this kind of scene (and with fixed_method, for this method only)
-    kern = V.kernels(V.kind_of(asm.p), int(method) if fixed_method else None)
-    work = S.work_arrays(n, z)      # the loop's stage derivatives, state vectors and ball loads
-    loads_work = (work[1], work[4], work[5])    # a state-size scratch vector and the two ball-load vectors
+    kern = V.kernels(V.kind_of(asm.p), sol.method if fixed_method else None)
+    m = asm.model
+    w = new_work(asm.y0, asm.n_balls)
+    t, t_end = 0.0, out.t_end
     # the progress bar appears once the run has taken 2 s: a shorter run never imports tqdm (0.05 s)
     bar, wall0 = None, _time.perf_counter()
     bar_at = wall0 + 2.0 if progress else math.inf
@@ -190,65 +246,24 @@ def _run(asm, method, rtol, *, progress, t_end_override=None, step=None, max_ste
                            bar_format="{l_bar}{bar}| {n:.3f}/{total:.3f} s sim [{elapsed}<{remaining}]")
                 bar.start_t -= _time.perf_counter() - wall0   # elapsed counts from the run's start
             t_stop = min(t + chunk_s, t_end)
-            m_hi = min(int(math.floor((t_stop - base) / dt_f + 0.5)) + 1, n_fine + 1)
-            while m_hi > m_next and base + (m_hi - 1 - 0.5) * dt_f > t_stop:
-                m_hi -= 1
-            fine_t = base + (np.arange(m_next, max(m_hi, m_next)) - 0.5) * dt_f
-            fine_out = np.zeros((fine_t.size, vel_idx.shape[0]))
-            o_hi = o_next
-            while o_hi < n_out and out_t_all[o_hi] <= t_stop:
-                o_hi += 1
-            out_t = out_t_all[o_next:o_hi]
-            out_state = np.zeros((out_t.size, n))
-            t_new, h, fpos, opos, status = kern.integrate(
-                y, t, t_stop, h, *args, method, rtol, atol, hmax,
-                defect_steps, vel_idx, vel_sign, fine_t, fine_out, 0, out_t, out_state, 0, stats, ctrl, *work)
+            o = out.grids(t_stop, asm.y0.size)
+            t_new, h, status = kern.integrate(t, t_stop, h, m, sol, w, o)
             if status != 0:
                 what = "the state became NaN/Inf" if status == 1 else "the step size underflowed"
                 raise SolverError(f"scene {scene.name!r}: integration failed at t = {t_new:.6g} s: {what} "
-                                  f"(rtol {rtol:g}); the scene may be "
+                                  f"(rtol {sol.rtol:g}); the scene may be "
                                   "unphysical, or try solver.method='dp54' with a smaller solver.max_step_s")
-            # states at the output samples of this chunk: displacements and ball loads
-            if out_t.size:
-                disp[o_next:o_hi] = out_state[:, [0, 1, 4, 5]]
-                if three_d:
-                    disp_z[o_next:o_hi] = out_state[:, zb + 1]
-                    S.contact_angles_at(out_t, out_state, asm.p, asm.sp_t, asm.sp_w, asm.sp_th,
-                                        angles[:, :, o_next:o_hi])
-                if dyn:
-                    cage_speed[o_next:o_hi] = out_state[:, cage_idx]
-                if loads:
-                    fi_all[:, o_next:o_hi], fo_all[:, o_next:o_hi] = _loads(kern, out_t, out_state, args, loads_work)
-                o_next = o_hi
-            # accelerometer: fine-interval mean acceleration, FIR, decimate; keep the tail
-            m_next += fine_t.size
-            v_buf = np.concatenate([v_buf, fine_out])
-            a_fine = np.diff(v_buf, axis=0) / dt_f          # fine index v_start + i
-            # outputs whose whole FIR window is available: centre m_pad + k R + half <= last index
-            last = v_start + a_fine.shape[0] - 1
-            k_hi = min(n_out, (last - half - m_pad) // R + 1) if last - half - m_pad >= 0 else k_acc
-            if k_hi > k_acc:
-                s0 = m_pad + k_acc * R - half - v_start
-                if three_d:
-                    S.fir_decimate3(a_fine, taps_rev, s0, R, acc[k_acc:k_hi], acc_z[k_acc:k_hi])
-                else:
-                    S.fir_decimate(a_fine, taps_rev, s0, R, acc[k_acc:k_hi])
-                k_acc = k_hi
-            # drop the velocities no later output needs; v_buf[0] is always fine index v_start
-            drop = min(max(m_pad + k_acc * R - half - v_start, 0), v_buf.shape[0])
-            v_buf = v_buf[drop:]
-            v_start += drop
+            out.states(o, kern, m, w)
+            out.accelerations(o.fine_out)
             if bar is not None:
                 bar.update(round(t_new - t, 6))
             t = t_new
     finally:
         if bar is not None:
             bar.close()
-    if t_end_override is None and (k_acc != n_out or o_next != n_out):
-        raise SolverError(f"scene {scene.name!r}: output incomplete ({k_acc}/{o_next} of {n_out} samples)")
-    return dict(acc=acc, disp=disp, fi=fi_all, fo=fo_all, out_t=out_t_all, cage_speed=cage_speed, taps=taps, R=R,
-                acc_z=acc_z, disp_z=disp_z, angles=angles,
-                m_pad=m_pad, n_out=n_out, stats=stats, dt_f=dt_f, t0=t0, t_end=t_end)
+    if t_end_override is None and (out.k_acc != out.n_out or out.o_next != out.n_out):
+        raise SolverError(f"scene {scene.name!r}: output incomplete ({out.k_acc}/{out.o_next} of {out.n_out} samples)")
+    return out.result(w.stats)
 
 
 def _bearing_model(d, static):
@@ -292,6 +307,130 @@ def _assemble(sc, delta_top=None):
         raise SolverError(f"scene {sc.name!r}: no static equilibrium found for the initial state "
                           f"({type(exc).__name__}: {exc}); the load, speed, clearance or support "
                           "stiffness are beyond what the model can start from") from exc
+
+
+def _solver_settings(sc, choice) -> dict:
+    """The scene's solver settings (method name, rtol, max_step, step: RK4's step or None), the
+    rule's choice where the method is "auto", the defaults where unset."""
+    d = sc.data["solver"]
+    method, max_step, rtol, step = d["method"], d["max_step_s"], d["rtol"], None
+    if method == "auto":
+        method = choice["method"]
+        max_step = max_step if max_step is not None else choice["max_step_s"]
+        rtol = rtol if rtol is not None else choice["rtol"]
+        if method == "rk4" and choice.get("step_s"):
+            step = choice["step_s"]
+    return dict(method=method, rtol=rtol if rtol is not None else 1e-5,
+                max_step=max_step if max_step is not None else 2.5e-5, step=step)
+
+
+def _run_within_tables(sc, asm, settings, progress):
+    """:func:`_run` with the scene's settings; a run whose balls reached above a defect table is
+    run again on the extended table (:data:`TABLE_EXTENSIONS` times at most).  Returns (asm, res)."""
+    d = sc.data
+    kw = dict(progress=progress, max_step=settings["max_step"], step=settings["step"],
+              defect_steps=d["solver"]["defect_steps"], loads=d["output"]["ball_loads"], fixed_method=True)
+    res = _run(asm, METHODS[settings["method"]], settings["rtol"], **kw)
+    for _ in range(TABLE_EXTENSIONS):
+        over = _tables_exceeded(asm)
+        if not over:
+            break
+        # a force was taken above a table's top (extrapolated): extend those tables, run again
+        top = [max(1.25 * float(asm.dflt[k, kernels.F_REACH]), t.delta_max) if k in over else None
+               for k, t in enumerate(asm.tables)]
+        table_s = asm.table_time_s
+        asm = _assemble(sc, delta_top=top)
+        asm.table_time_s += table_s
+        res = _run(asm, METHODS[settings["method"]], settings["rtol"], **kw)
+    over = _tables_exceeded(asm)
+    if over:
+        raise SolverError(f"scene {sc.name!r}: the balls' approach on defect table(s) {sorted(over)} "
+                          f"kept rising above the table after {TABLE_EXTENSIONS} extensions (reached "
+                          + ", ".join(f"{1e6 * asm.dflt[k, kernels.F_REACH]:.3g} um over a "
+                                      f"{1e6 * asm.tables[k].delta_max:.3g} um table" for k in sorted(over))
+                          + "); the defect is deeper or the load larger than the contact law covers")
+    return asm, res
+
+
+def _dataset(sc, asm, res, acc, fi, fo) -> xr.Dataset:
+    """The contract variables of a run (accelerometer signal ``acc``, ball loads ``fi``, ``fo``)."""
+    disp = res["disp"]
+    time = res["out_t"] - res["t0"]
+    coords = {"time": ("time", time, {"units": "s", "long_name": "time from the record start"}),
+              "ball": ("ball", np.arange(asm.n_balls), {"long_name": "ball index (cage order)"})}
+    def v(data, units, long):
+        return (("time",), data, {"units": units, "long_name": long, "quantity": QUANTITY_OF_UNITS[units]})
+    ds = xr.Dataset(
+        {
+            "outer_ring_acc_y": v(acc[:, 1], "m s-2", "outer-ring acceleration Y (accelerometer signal)"),
+            "outer_ring_acc_x": v(acc[:, 0], "m s-2", "outer-ring acceleration X (accelerometer signal)"),
+            "outer_ring_disp_y": v(disp[:, 3], "m", "outer-ring displacement Y"),
+            "outer_ring_disp_x": v(disp[:, 2], "m", "outer-ring displacement X"),
+            "inner_ring_disp_y": v(disp[:, 1], "m", "inner-ring displacement Y"),
+            "inner_ring_disp_x": v(disp[:, 0], "m", "inner-ring displacement X"),
+        },
+        coords=coords,
+    )
+    if res["angles"] is not None:
+        ds["outer_ring_acc_z"] = v(res["acc_z"], "m s-2", "outer-ring acceleration Z (along the axis)")
+        ds["outer_ring_disp_z"] = v(res["disp_z"], "m", "outer-ring displacement Z (along the axis)")
+        for k, race in enumerate(("outer", "inner")):
+            ds[f"contact_angle_{race}_deg"] = (("ball", "time"), res["angles"][k], {
+                "units": "degree", "quantity": "angle",
+                "long_name": f"ball-{race} race contact angle (positive: the load line leans as under a +Z "
+                             "force on the outer ring)"})
+    if res["cage_speed"] is not None:
+        ds["cage_speed"] = (("time",), res["cage_speed"], {"units": "rad s-1", "long_name": "cage angular speed",
+                                                           "quantity": "angular velocity"})
+    if sc.data["output"]["ball_loads"]:
+        ds["ball_load_outer"] = (("ball", "time"), fo, {"units": "N", "long_name": "ball-outer race normal load",
+                                                        "quantity": "force"})
+        ds["ball_load_inner"] = (("ball", "time"), fi, {"units": "N", "long_name": "ball-inner race normal load",
+                                                        "quantity": "force"})
+    return ds
+
+
+def _attrs(sc, asm, res, choice, settings, wall, compile_s) -> dict:
+    """The Dataset attributes of a run (``docs/architecture.md``)."""
+    d = sc.data
+    stats = res["stats"]
+    three_d = res["angles"] is not None
+    return {
+        "title": f"bearing_lab simulation of scene {sc.name!r}",
+        "sampling_rate_hz": float(sc.fs_out),
+        "bearing_lab_version": __version__,
+        "shaft_speed_rpm": float(sc.nominal_rpm),
+        "bearing": sc.bearing.name,
+        "default_channel": DEFAULT_CHANNEL,
+        "fidelity": asm.fidelity,
+        "scene_name": sc.name,
+        "scene_toml": sc.to_toml(),
+        "defect_contact_models": ",".join(asm.contact_models) if asm.contact_models else "none",
+        "wall_time_s": float(wall),
+        "table_time_s": float(asm.table_time_s),
+        "compile_time_s": float(compile_s),
+        "solver_method": settings["method"],
+        "solver_rtol": float(settings["rtol"]),
+        "solver_max_step_s": float(settings["max_step"]),
+        "fidelity_requested": sc.fidelity,
+        "auto_choice": (choice["reason"] + f"; kind {choice['kind']}, decided on the {choice['track']}; expected "
+                        f"peak-acceleration error {choice['expected_peak_error']}")
+        if "auto" in (sc.fidelity, d["solver"]["method"]) else "",
+        "bearing_model": _bearing_model(d, asm.static) if three_d else "planar (no axial load)",
+        **({"axial_force_n": float(asm.static["axial_force_n"])} if three_d else {}),
+        "defect_table_top_um": ",".join(f"{1e6 * t.delta_max:.4g}" for t in asm.tables) if asm.tables else "none",
+        "defect_table_reach_um": (",".join(f"{1e6 * asm.dflt[k, kernels.F_REACH]:.4g}" for k in range(len(asm.tables)))
+                                  if asm.tables else "none"),
+        "solver_steps": int(stats[0]),
+        "solver_rejected_steps": int(stats[1]),
+        "settle_time_s": float(sc.settle),
+        "load_zone_angle_deg": float(math.degrees(asm.load_zone_angle) % 360),
+        "load_path": d["load"]["path"],
+        "anti_alias": f"Kaiser FIR {len(res['taps'])} taps at {d['output']['oversample']}x, -6 dB at fs/2",
+        "sensor_resonator": "on" if d["sensor"]["enabled"] else "off",
+        "cage_model": d["cage"]["model"],
+        "Conventions": "CF-1.8",
+    }
 
 
 @fill_doc
@@ -358,120 +497,20 @@ def simulate(scene, *, fidelity: str | None = None, duration: float | None = Non
     asm = _assemble(sc)
     d = sc.data
     choice = resolve(sc)
-    method_name = d["solver"]["method"]
-    max_step = d["solver"]["max_step_s"]
-    rtol_ = d["solver"]["rtol"]
-    step_ = None
-    if method_name == "auto":
-        method_name = choice["method"]
-        max_step = max_step if max_step is not None else choice["max_step_s"]
-        rtol_ = rtol_ if rtol_ is not None else choice["rtol"]
-        if method_name == "rk4" and choice.get("step_s"):
-            step_ = choice["step_s"]
-    rtol_ = rtol_ if rtol_ is not None else 1e-5
-    max_step = max_step if max_step is not None else 2.5e-5
-    compile_s = _warm_up(asm, METHODS[method_name])  # this scene's kind and method only
-    res = _run(asm, METHODS[method_name], rtol_, progress=progress, max_step=max_step, step=step_,
-               defect_steps=d["solver"]["defect_steps"], loads=d["output"]["ball_loads"], fixed_method=True)
-    for _ in range(TABLE_EXTENSIONS):
-        over = _tables_exceeded(asm)
-        if not over:
-            break
-        # a force was taken above a table's top (extrapolated): extend those tables, run again
-        top = [max(1.25 * float(asm.dflt[k, kernels.F_REACH]), t.delta_max) if k in over else None
-               for k, t in enumerate(asm.tables)]
-        table_s = asm.table_time_s
-        asm = _assemble(sc, delta_top=top)
-        asm.table_time_s += table_s
-        res = _run(asm, METHODS[method_name], rtol_, progress=progress, max_step=max_step, step=step_,
-                   defect_steps=d["solver"]["defect_steps"], loads=d["output"]["ball_loads"], fixed_method=True)
-    over = _tables_exceeded(asm)
-    if over:
-        raise SolverError(f"scene {sc.name!r}: the balls' approach on defect table(s) {sorted(over)} "
-                          f"kept rising above the table after {TABLE_EXTENSIONS} extensions (reached "
-                          + ", ".join(f"{1e6 * asm.dflt[k, kernels.F_REACH]:.3g} um over a "
-                                      f"{1e6 * asm.tables[k].delta_max:.3g} um table" for k in sorted(over))
-                          + "); the defect is deeper or the load larger than the contact law covers")
+    settings = _solver_settings(sc, choice)
+    compile_s = _warm_up(asm, METHODS[settings["method"]])  # this scene's kind and method only
+    asm, res = _run_within_tables(sc, asm, settings, progress)
     acc = res["acc"]
     if d["sensor"]["enabled"]:
         acc = acc * d["sensor"]["gain"]
-    disp = res["disp"]
-    z = asm.n_balls
     fi, fo = res["fi"], res["fo"]
     if fi is None:
-        fi = fo = np.zeros((z, 0))
+        fi = fo = np.zeros((asm.n_balls, 0))
     # the time loop alone: the defect tables (built once per defect, then cached) apart
     wall = _time.perf_counter() - t_start - asm.table_time_s - compile_s
-    for name, arr in (("acceleration", acc), ("displacements", disp), ("ball loads", fi), ("ball loads", fo)):
+    for name, arr in (("acceleration", acc), ("displacements", res["disp"]), ("ball loads", fi), ("ball loads", fo)):
         if not np.all(np.isfinite(arr)):
             raise SolverError(f"scene {sc.name!r}: the {name} hold NaN/Inf; the solve diverged")
-    time = res["out_t"] - res["t0"]
-    coords = {"time": ("time", time, {"units": "s", "long_name": "time from the record start"}),
-              "ball": ("ball", np.arange(z), {"long_name": "ball index (cage order)"})}
-    def v(data, units, long):
-        return (("time",), data, {"units": units, "long_name": long, "quantity": QUANTITY_OF_UNITS[units]})
-    ds = xr.Dataset(
-        {
-            "outer_ring_acc_y": v(acc[:, 1], "m s-2", "outer-ring acceleration Y (accelerometer signal)"),
-            "outer_ring_acc_x": v(acc[:, 0], "m s-2", "outer-ring acceleration X (accelerometer signal)"),
-            "outer_ring_disp_y": v(disp[:, 3], "m", "outer-ring displacement Y"),
-            "outer_ring_disp_x": v(disp[:, 2], "m", "outer-ring displacement X"),
-            "inner_ring_disp_y": v(disp[:, 1], "m", "inner-ring displacement Y"),
-            "inner_ring_disp_x": v(disp[:, 0], "m", "inner-ring displacement X"),
-        },
-        coords=coords,
-    )
-    if res["angles"] is not None:
-        ds["outer_ring_acc_z"] = v(res["acc_z"], "m s-2", "outer-ring acceleration Z (along the axis)")
-        ds["outer_ring_disp_z"] = v(res["disp_z"], "m", "outer-ring displacement Z (along the axis)")
-        for k, race in enumerate(("outer", "inner")):
-            ds[f"contact_angle_{race}_deg"] = (("ball", "time"), res["angles"][k], {
-                "units": "degree", "quantity": "angle",
-                "long_name": f"ball-{race} race contact angle (positive: the load line leans as under a +Z "
-                             "force on the outer ring)"})
-    if res["cage_speed"] is not None:
-        ds["cage_speed"] = (("time",), res["cage_speed"], {"units": "rad s-1", "long_name": "cage angular speed",
-                                                           "quantity": "angular velocity"})
-    if d["output"]["ball_loads"]:
-        ds["ball_load_outer"] = (("ball", "time"), fo, {"units": "N", "long_name": "ball-outer race normal load",
-                                                        "quantity": "force"})
-        ds["ball_load_inner"] = (("ball", "time"), fi, {"units": "N", "long_name": "ball-inner race normal load",
-                                                        "quantity": "force"})
-    stats = res["stats"]
-    ds.attrs.update({
-        "title": f"bearing_lab simulation of scene {sc.name!r}",
-        "sampling_rate_hz": float(sc.fs_out),
-        "bearing_lab_version": __version__,
-        "shaft_speed_rpm": float(sc.nominal_rpm),
-        "bearing": sc.bearing.name,
-        "default_channel": DEFAULT_CHANNEL,
-        "fidelity": asm.fidelity,
-        "scene_name": sc.name,
-        "scene_toml": sc.to_toml(),
-        "defect_contact_models": ",".join(asm.contact_models) if asm.contact_models else "none",
-        "wall_time_s": float(wall),
-        "table_time_s": float(asm.table_time_s),
-        "compile_time_s": float(compile_s),
-        "solver_method": method_name,
-        "solver_rtol": float(rtol_),
-        "solver_max_step_s": float(max_step),
-        "fidelity_requested": sc.fidelity,
-        "auto_choice": (choice["reason"] + f"; kind {choice['kind']}, decided on the {choice['track']}; expected "
-                        f"peak-acceleration error {choice['expected_peak_error']}")
-        if "auto" in (sc.fidelity, d["solver"]["method"]) else "",
-        "bearing_model": _bearing_model(d, asm.static) if res["angles"] is not None else "planar (no axial load)",
-        **({"axial_force_n": float(asm.static["axial_force_n"])} if res["angles"] is not None else {}),
-        "defect_table_top_um": ",".join(f"{1e6 * t.delta_max:.4g}" for t in asm.tables) if asm.tables else "none",
-        "defect_table_reach_um": (",".join(f"{1e6 * asm.dflt[k, kernels.F_REACH]:.4g}" for k in range(len(asm.tables)))
-                                  if asm.tables else "none"),
-        "solver_steps": int(stats[0]),
-        "solver_rejected_steps": int(stats[1]),
-        "settle_time_s": float(sc.settle),
-        "load_zone_angle_deg": float(math.degrees(asm.load_zone_angle) % 360),
-        "load_path": d["load"]["path"],
-        "anti_alias": f"Kaiser FIR {len(res['taps'])} taps at {d['output']['oversample']}x, -6 dB at fs/2",
-        "sensor_resonator": "on" if d["sensor"]["enabled"] else "off",
-        "cage_model": d["cage"]["model"],
-        "Conventions": "CF-1.8",
-    })
+    ds = _dataset(sc, asm, res, acc, fi, fo)
+    ds.attrs.update(_attrs(sc, asm, res, choice, settings, wall, compile_s))
     return ds

@@ -235,7 +235,7 @@ def test_the_compiled_contact_angles_follow_the_geometry(fidelity):
     t = np.linspace(0.0, 0.01, 7)
     states = asm.y0[None, :] + 20e-6 * rng.standard_normal((t.size, asm.y0.size))
     out = np.zeros((2, z, t.size))
-    S.contact_angles_at(t, states, p, asm.sp_t, asm.sp_w, asm.sp_th, out)
+    S.contact_angles_at(t, states, asm.model, out)
     rpm = asm.scene.speed_profile()[1][0]
     phis = p[K.P_PHI0] + p[K.P_FTF] * rpm * 2 * np.pi / 60 * t[:, None] + 2 * np.pi * np.arange(z) / z
     a_i, a_o = groove_offsets(asm.scene.bearing)

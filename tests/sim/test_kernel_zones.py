@@ -96,11 +96,10 @@ def _naive_step_limit(asm, t, h, nsteps):
 @pytest.mark.parametrize("race", ["outer", "inner"])
 def test_step_limit_lands_on_zone_entry_like_a_loop_over_all_balls(race):
     asm = _asm(race)
-    args = (asm.p, asm.sp_t, asm.sp_w, asm.sp_th, asm.dint, asm.dflt)
     y = asm.y0.copy()
     bounded = 0
     for t in np.linspace(0.0, 0.05, 4001):
-        got = S.step_limit(t, y, 2.5e-5, *args, 40.0)
+        got = S.step_limit(t, y, 2.5e-5, asm.model, 40.0)
         want = _naive_step_limit(asm, t, 2.5e-5, 40.0)
         assert got == pytest.approx(want, rel=1e-6, abs=1e-13), t
         bounded += got < 2.5e-5

@@ -175,12 +175,12 @@ def test_streaming_output_equals_whole_record_and_scipy():
     n_out = len(whole)
     m_pad = half + 2
     fine_t = sc.settle - m_pad * dt_f + (np.arange(m_pad + (n_out - 1) * 8 + m_pad + 2) - 0.5) * dt_f
-    args = (asm.p, asm.sp_t, asm.sp_w, asm.sp_th, asm.dint, asm.dflt, asm.hbuf, asm.gbuf)
+    model = asm.model
     fi, fo = np.empty(8), np.empty(8)
 
     def f(t, y):
         dy = np.empty_like(y)
-        K.rhs(t, y, *args, dy, fi, fo)
+        K.rhs(t, y, model, dy, fi, fo)
         return dy
     sol = solve_ivp(f, (0, fine_t[-1] + 1e-9), asm.y0.copy(), method="LSODA", rtol=1e-8,
                     atol=asm.atol_scale * 1e-8, max_step=2.5e-5, dense_output=True)

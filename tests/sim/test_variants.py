@@ -23,8 +23,7 @@ def _eval(rhs, asm, t=1.3e-3):
     y = asm.y0.copy()
     y[:8] += 1e-7 * np.arange(1, 9)  # off the equilibrium, rings moving
     dy, fi, fo = np.zeros_like(y), np.zeros(asm.n_balls), np.zeros(asm.n_balls)
-    rhs(t, y, asm.p, asm.sp_t, asm.sp_w, asm.sp_th, asm.dint, asm.dflt, asm.hbuf.copy(), asm.gbuf.copy(), dy, fi,
-        fo)
+    rhs(t, y, asm.model._replace(hbuf=asm.hbuf.copy(), gbuf=asm.gbuf.copy()), dy, fi, fo)
     return dy, fi, fo
 
 
