@@ -30,10 +30,9 @@ from ..analysis.background import estimate_background
 from ..analysis.impacts import impact_times
 from ..analysis.structural_path import Resonance, StructuralPath, fit_structural_path
 from ..errors import AnalysisError, ValidationCaseError
-from . import simulation
 from .case import shipped_cases
 from .load import load_case
-from .recording_case import comparison_band, comparison_overrides, impact_period, prepare
+from .recording_case import comparison_band, impact_period, prepare
 from .signature import impact_signature, shape_residual
 
 __all__ = ["identify_path", "path_for", "background_for", "PATH_DEFAULT_BOUNDS"]
@@ -143,21 +142,17 @@ def _fit_or_fail(case, rec, measured, sim_x) -> StructuralPath:
 
 
 def identify_path(case, *, mirror=None, prep=None) -> StructuralPath:
-    """The path a case fits on its own recording (simulating its declared scene); one fit per case.
+    """The path a case fits on its own recording against its declared scene; one fit per case.
 
     The same fit serves the case's own comparison and every case that names it (``from_case``), so a
-    path "identified by case X" is the one X's own report shows, whichever case runs first.  The
-    declared scene is simulated for the fit at the comparisons' solver tolerance: on a calibration
-    stand-in (known gain 1) the gain came out 1.016 against a model at a loose tolerance (rtol 1e-4)
-    and 0.999 at the comparisons' 1e-6.  ``prep``: the case's prepared recording, when the caller has it.
+    path "identified by case X" is the one X's own report shows, whichever case runs first.  It is
+    fitted on the simulation the case itself compares (so a recording the model made is explained by
+    a gain of 1 and no background).  ``prep``: the case's prepared recording, when the caller has it.
     """
     key = (case.source, mirror)
     if key not in _CACHE:
         prep = prep if prep is not None else prepare(case, mirror=mirror)
-        scene = simulation.build_scene(case, rpm=prep.speed.rpm, fs=prep.fs, duration=prep.n / prep.fs,
-                                       overrides=comparison_overrides(case))
-        sim = simulation.signal(simulation.run(scene))[: prep.n]
-        _CACHE[key] = _fit_or_fail(case, prep.recording, prep.measured["record"], sim)
+        _CACHE[key] = _fit_or_fail(case, prep.recording, prep.measured["record"], prep.simulated["model"])
     return _CACHE[key]
 
 
