@@ -387,7 +387,7 @@ def _setting(case, mirror, level_weight):
     of a loaded case."""
     prep = prepare(case, mirror=mirror)
     m = prep.measured["record"]
-    path = path_for(case, prep.recording, m, prep.simulated["model"], mirror=mirror)
+    path = path_for(case, prep, mirror=mirror)
     reference = open_spec(case.reference, case.name, mirror) if case.reference is not None else None
     bg = background_for(case, prep.recording, m, reference, band=comparison_band(prep.fs))
     st = setting_for(prep, path, bg, level_weight=level_weight)

@@ -200,7 +200,7 @@ def run_recording_case(case, *, steps, mirror=None) -> CaseResult:
     """Run a recording case (see the module docstring); the report is assembled by the caller."""
     prep = prepare(case, mirror=mirror)
     steps.step("recording and declared scene")
-    path = path_for(case, prep.recording, prep.measured["record"], prep.simulated["model"], mirror=mirror)
+    path = path_for(case, prep, mirror=mirror)
     reference = open_spec(case.reference, case.name, mirror) if case.reference is not None else None
     model = path.apply(prep.simulated["model"], prep.fs) if path.status in ("ok", "given") else None
     background = background_for(case, prep.recording, prep.measured["record"], reference, model=model,

@@ -15,8 +15,8 @@ geometry shows as a different result instead of being absorbed by a re-fit.
 
 Public API
 ----------
-identify_path(case, *, mirror=None) -> StructuralPath   -- (cached per case) the fitted path of a case
-path_for(case, rec, measured, sim_x, *, mirror=None) -> StructuralPath
+identify_path(case, *, mirror=None, prep=None) -> StructuralPath   -- (one per case) the fitted path of a case
+path_for(case, prep, *, mirror=None) -> StructuralPath
 background_for(case, rec, measured, reference=None, *, model=None, band=None) -> Background | None
 """
 from __future__ import annotations
@@ -30,10 +30,9 @@ from ..analysis.background import estimate_background
 from ..analysis.impacts import impact_times
 from ..analysis.structural_path import Resonance, StructuralPath, fit_structural_path
 from ..errors import AnalysisError, ValidationCaseError
-from . import simulation
 from .case import shipped_cases
 from .load import load_case
-from .recording_case import comparison_band, comparison_overrides, impact_period, prepare
+from .recording_case import comparison_band, impact_period, prepare
 from .signature import impact_signature, shape_residual
 
 __all__ = ["identify_path", "path_for", "background_for", "PATH_DEFAULT_BOUNDS"]
@@ -142,25 +141,24 @@ def _fit_or_fail(case, rec, measured, sim_x) -> StructuralPath:
                                      f"fit on {rec.path.name} ({rec.channel}) for case {case.name!r}")
 
 
-def identify_path(case, *, mirror=None) -> StructuralPath:
-    """The path a case fits on its own recording (simulating its declared scene); cached per case.
+def identify_path(case, *, mirror=None, prep=None) -> StructuralPath:
+    """The path a case fits on its own recording against its declared scene; one fit per case.
 
-    This path is reused by other recordings' comparisons, so the declared scene is simulated at the
-    comparisons' solver tolerance: on a calibration stand-in (known gain 1) the gain came out 1.016
-    against a model at the default tolerance and 0.999 at the comparisons' 1e-6.
+    The same fit serves the case's own comparison and every case that names it (``from_case``), so a
+    path "identified by case X" is the one X's own report shows, whichever case runs first.  It is
+    fitted on the simulation the case itself compares (so a recording the model made is explained by
+    a gain of 1 and no background).  ``prep``: the case's prepared recording, when the caller has it.
     """
     key = (case.source, mirror)
     if key not in _CACHE:
-        prep = prepare(case, mirror=mirror)
-        scene = simulation.build_scene(case, rpm=prep.speed.rpm, fs=prep.fs, duration=prep.n / prep.fs,
-                                       overrides=comparison_overrides(case))
-        sim = simulation.signal(simulation.run(scene))[: prep.n]
-        _CACHE[key] = _fit_or_fail(case, prep.recording, prep.measured["record"], sim)
+        prep = prep if prep is not None else prepare(case, mirror=mirror)
+        _CACHE[key] = _fit_or_fail(case, prep.recording, prep.measured["record"], prep.simulated["model"])
     return _CACHE[key]
 
 
-def path_for(case, rec, measured, sim_x, *, mirror=None) -> StructuralPath:
-    """The structural path this case compares through (see the module docstring)."""
+def path_for(case, prep, *, mirror=None) -> StructuralPath:
+    """The structural path this case compares through (see the module docstring); ``prep``: the case's
+    prepared recording (:func:`~bearing_lab.validation.recording_case.prepare`)."""
     sp = case.section("structural_path")
     method = sp.get("method", "fit")
     if method == "none":
@@ -182,9 +180,7 @@ def path_for(case, rec, measured, sim_x, *, mirror=None) -> StructuralPath:
         path = identify_path(other, mirror=mirror)
         return StructuralPath(path.resonances, path.gain, f"identified by case {other.name!r}: {path.source}",
                               dict(path.fit), dict(path.curves))
-    path = _fit_or_fail(case, rec, measured, sim_x)
-    _CACHE[(case.source, mirror)] = path
-    return path
+    return identify_path(case, mirror=mirror, prep=prep)
 
 
 def background_for(case, rec, measured, reference=None, *, model=None, band=None):

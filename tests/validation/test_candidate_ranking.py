@@ -43,7 +43,7 @@ def _scores(rig, scene, h, th, seed):
     d, calib = rig
     case = load_case(hidden(d, scene, h, th, seed=seed, calib=calib))
     prep = prepare(case)
-    path = path_for(case, prep.recording, prep.measured["record"], prep.simulated["model"])
+    path = path_for(case, prep)
     assert path.status == "ok", path.problems
     bg = background_for(case, prep.recording, prep.measured["record"])
     return score_candidates(prep, path, bg, _candidates(scene, h, th))
@@ -67,7 +67,7 @@ def test_break_it_swapped_truth_ranks_the_wrong_geometry_first(rig):
     swapped = {"true": {"defect.offset_mm": 0.3, "defect.skew_deg": 0.0}}
     case = load_case(d / "O2_H0.3_t30.toml")
     prep = prepare(case)
-    path = path_for(case, prep.recording, prep.measured["record"], prep.simulated["model"])
+    path = path_for(case, prep)
     bg = background_for(case, prep.recording, prep.measured["record"])
     wrong = score_candidates(prep, path, bg, {**swapped, "actually true": {"defect.offset_mm": 0.3,
                                                                           "defect.skew_deg": 30.0}})
@@ -123,7 +123,7 @@ def test_the_valley_geometry_is_told_from_the_truth_through_the_fitted_path(rig)
     d, calib = rig
     case = load_case(hidden(d, "paper-O2", 0.3, 30.0, seed=23, calib=calib, name="valley", duration_s=0.5))
     prep = prepare(case)
-    path = path_for(case, prep.recording, prep.measured["record"], prep.simulated["model"])
+    path = path_for(case, prep)
     assert 0 < path.fit["signature_residual_rms_db"] < 0.1
     bg = background_for(case, prep.recording, prep.measured["record"])
     cands = {"valley": {"defect.length_mm": 3.56, "defect.offset_mm": 0.5, "defect.skew_deg": 31.3},

@@ -139,5 +139,5 @@ def test_from_case_file_is_read_beside_the_case(tmp_path, monkeypatch):
     monkeypatch.setattr(rig, "identify_path",
                         lambda other, mirror=None: seen.append(other.name) or StructuralPath.identity())
     monkeypatch.chdir(elsewhere)
-    path = rig.path_for(load_case(str(rigdir / "run2.toml")), None, None, None)
+    path = rig.path_for(load_case(str(rigdir / "run2.toml")), None)
     assert seen == ["calib"] and "calib" in path.source

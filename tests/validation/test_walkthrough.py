@@ -103,7 +103,7 @@ def test_break_it_a_wrong_geometry_fails_through_the_fixed_path_but_passes_with_
     from bearing_lab.validation.rig import background_for, path_for
     case = load_case(walked / "rig.toml")
     prep = prepare(case)
-    path = path_for(case, prep.recording, prep.measured["record"], prep.simulated["model"])
+    path = path_for(case, prep)
     bg = background_for(case, prep.recording, prep.measured["record"])
     got = compare_candidates(prep, path, bg, {"true": {}, "wrong skew": {"defect.skew_deg": 0.0}})
     amp = ("rms", "peak", "impulse_strength")
