@@ -221,7 +221,9 @@ def resolve(scene) -> dict:
         out["reason"] += (f"; {said}: the defect rules do not hold there (a grazed pit's peak came out at 1.66 and 11 "
                           "times the converged one at bs32 rtol 1e-5 and 1e-4), so dp54 rtol 1e-6 is taken (within 0.04 %, "
                           "at the same cost)")
-        if scene.data["solver"]["method"] != "auto":
+        solver = scene.data["solver"]
+        tight = solver["method"] == GRAZED["method"] and (solver["rtol"] or 1.0) <= GRAZED["rtol"]
+        if solver["method"] != "auto" and not tight:
             warnings.warn(f"scene {scene.name!r}: {said}: the solver set by the scene may miss the impacts (the "
                           "automatic choice for a grazed defect is solver.method = 'dp54', solver.rtol = 1e-6)",
                           SceneWarning, stacklevel=3)
