@@ -6,7 +6,10 @@ script runs the shipped cases cwru-130 (which identifies the rig's structural pa
 cwru-234 and cwru-105 with ``load.axial_n`` set on every scene they simulate, and prints one table
 per case: each row's simulated value and status per preload, and the bearing model alone (before the
 structural path) in RMS and impulse strength.  Usage: python benchmarks/cwru_preload.py [N ...]
+[--rtol R] (``--rtol``: every scene at dp54 with that tolerance instead of the ``auto`` rule, to check
+the columns converged; the scenes then warn that they set their own solver).
 """
+import argparse
 import json
 import sys
 import tempfile
@@ -15,7 +18,7 @@ from pathlib import Path
 CASES = ["cwru-130", "cwru-144", "cwru-234", "cwru-105"]
 
 
-def run(preload, out):
+def run(preload, out, rtol=None):
     from bearing_lab.validation import run_validation, simulation
     orig = simulation.build_scene
 
@@ -23,6 +26,8 @@ def run(preload, out):
         ov = dict(kw.pop("overrides", None) or {})
         if preload:
             ov["load.axial_n"] = float(preload)
+        if rtol is not None:
+            ov.update({"solver.method": "dp54", "solver.rtol": float(rtol)})
         return orig(case, overrides=ov, **kw)
     simulation.build_scene = build
     try:
@@ -33,11 +38,19 @@ def run(preload, out):
 
 
 def main(argv):
-    loads = [float(a) for a in argv] or [0.0, 125.0, 188.0, 250.0]
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("loads", nargs="*", type=float, help="axial preloads, N (default 0 125 188 250)")
+    ap.add_argument("--rtol", type=float, help="dp54 at this tolerance on every scene instead of the auto rule")
+    a = ap.parse_args(argv)
+    if a.rtol is not None and not 0 < a.rtol < 1:
+        ap.error(f"--rtol {a.rtol:g}: a relative tolerance between 0 and 1 is needed")
+    loads = a.loads or [0.0, 125.0, 188.0, 250.0]
+    if a.rtol is not None:
+        print(f"every scene at dp54 rtol {a.rtol:g} (not the auto rule)")
     res = {}
     for f in loads:
         with tempfile.TemporaryDirectory() as tmp:
-            res[f] = run(f, tmp)
+            res[f] = run(f, tmp, a.rtol)
         print(f"preload {f:g} N done", file=sys.stderr, flush=True)
     for case in CASES:
         rows = [r["quantity"] for r in res[loads[0]][case]["rows"]]
