@@ -107,3 +107,31 @@ def test_dask_still_works_through_xarray_after_the_hooks(tmp_path):
     p = to_netcdf(ds, tmp_path / "chunked.nc")
     back = xr.load_dataset(p)
     np.testing.assert_array_equal(back["a"].values, np.arange(1000.0))
+
+
+def test_a_lazily_loaded_submodule_stays_reachable_from_its_package():
+    """A ``lazy.load("pkg.sub")`` stand-in sits in ``sys.modules`` before ``pkg.sub`` is the package's
+    attribute: for a package without a module ``__getattr__`` (dask), a later ``import pkg.sub`` in the
+    same process then finds no ``pkg.sub``.  Every dotted name the package loads lazily must stay
+    reachable after all of bearing_lab's modules are imported."""
+    import ast
+    from pathlib import Path
+    pkg = Path(__file__).resolve().parents[1] / "bearing_lab"
+    names = sorted({n.args[0].value for p in pkg.rglob("*.py") for n in ast.walk(ast.parse(p.read_text()))
+                    if isinstance(n, ast.Call) and getattr(n.func, "attr", "") == "load"
+                    and getattr(n.func.value, "id", "") == "lazy" and n.args
+                    and isinstance(n.args[0], ast.Constant) and "." in str(n.args[0].value)})
+    assert "scipy.optimize" in names                        # the scan finds them
+    code = ("import importlib, pkgutil, bearing_lab\n"
+            "for m in pkgutil.walk_packages(bearing_lab.__path__, 'bearing_lab.'):\n"
+            "    if '_fuzz' not in m.name and not m.name.endswith('__main__'):\n"
+            "        importlib.import_module(m.name)\n"
+            f"for name in {names!r}:\n"
+            "    parent, child = name.rsplit('.', 1)\n"
+            "    exec(f'import {name}')\n"
+            "    assert getattr(importlib.import_module(parent), child) is not None, name\n"
+            "import dask\n"
+            "import dask.distributed\n"
+            "assert dask.distributed.LocalCluster\n")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600)
+    assert r.returncode == 0, r.stderr[-2000:]

@@ -26,7 +26,6 @@ from dataclasses import dataclass, field
 import itertools
 import time
 
-import lazy_loader as lazy
 import numpy as np
 
 from ..errors import ValidationCaseError
@@ -41,9 +40,6 @@ from .load import load_case
 from .recording import open_spec
 from .recording_case import comparison_band, comparison_overrides, prepare
 from .rig import background_for, path_for
-
-# a local Dask cluster (``scheduler="local"``): loaded when one is started
-_distributed = lazy.load("dask.distributed", suppress_warning=True)
 
 __all__ = ["Identification", "IdentificationInterrupted", "default_grid", "identify", "PARAMS"]
 
@@ -452,9 +448,13 @@ def _refinement(st, base, grid, points, run, thr, widen):
 
 def _client(scheduler, n_workers):
     if scheduler in (None, "local"):
-        cluster = _distributed.LocalCluster(n_workers=n_workers or 2, threads_per_worker=1, processes=True,
+        # dask loads when a cluster starts; not a lazy.load stand-in: that would sit in sys.modules as
+        # "dask.distributed" without being the package's attribute, so a later `import dask.distributed`
+        # in the same process would find no dask.distributed
+        from dask.distributed import Client, LocalCluster
+        cluster = LocalCluster(n_workers=n_workers or 2, threads_per_worker=1, processes=True,
                                dashboard_address=None)
-        return _distributed.Client(cluster), True
+        return Client(cluster), True
     return scheduler, False
 
 
