@@ -1,18 +1,6 @@
 """Speed against error: the work-precision study behind ``bearing-lab bench``.
 
-For each benchmark scene every solver setting (fixed steps, adaptive tolerances),
-every fidelity (quasi-static balls, ball inertia, ball inertia with a dynamic
-cage) and every defect-contact model
-(along-track profile, rigid 2-D drop, 2-D local law, elastic half-space) runs the same record; each
-is scored by its compute seconds per simulated second and its error in peak
-acceleration, RMS, excitation period and impulse duration against ONE converged
-reference per scene: the most complete model (multibody, "halfspace" contact) with dp54 at
-rtol 1e-9 and a 2 µs step ceiling.  Convergence of that reference is established by
-a second run at rtol 1e-10 with a 1 µs ceiling; their difference is reported as the
-reference's own error.  Cost is CPU time (``time.process_time``) per simulated second.
-Speed at equal accuracy (:mod:`bearing_lab.studies.bench_speed`): each of our methods and scipy's
-``solve_ivp`` (LSODA, RK45, BDF, Radau on the same compiled right-hand side) at its cheapest
-setting within the tolerance, on a 0.1 s record with its own converged reference.
+What it measures: :data:`MEASURED` (the text its page opens with).
 
 Outputs (``reports/performance/``): ``index.html`` (table and figures),
 ``work_precision_<scene>.png`` (log cost against log error), ``performance.nc``
@@ -83,6 +71,23 @@ MB_SETTINGS = ([("dp54", r, None, None) for r in (1e-3, 1e-4, 1e-5, 1e-6)]
                + [("rk4", 0.0, h, None) for h in (1e-5, 5e-6, 2e-6)])
 QS_SETTINGS = ([("dp54", r, None, m) for r in (1e-4, 1e-5) for m in (2.5e-5, 1e-4)]
                + [("bs32", r, None, m) for r in (1e-3, 1e-4) for m in (2.5e-5, 1e-4)])
+
+#: what the study measures (its page opens with it)
+MEASURED = """\
+For each benchmark scene every solver setting (fixed steps, adaptive tolerances),
+every fidelity (quasi-static balls, ball inertia, ball inertia with a dynamic
+cage) and every defect-contact model
+(along-track profile, rigid 2-D drop, 2-D local law, elastic half-space) runs the same record; each
+is scored by its compute seconds per simulated second and its error in peak
+acceleration, RMS, excitation period and impulse duration against ONE converged
+reference per scene: the most complete model (multibody, "halfspace" contact) with dp54 at
+rtol 1e-9 and a 2 µs step ceiling.  Convergence of that reference is established by
+a second run at rtol 1e-10 with a 1 µs ceiling; their difference is reported as the
+reference's own error.  Cost is CPU time (time.process_time) per simulated second.
+Speed at equal accuracy (bearing_lab.studies.bench_speed): each of our methods and scipy's
+solve_ivp (LSODA, RK45, BDF, Radau on the same compiled right-hand side) at its cheapest
+setting within the tolerance, on a 0.1 s record with its own converged reference.
+"""
 
 
 def _timed(asm, method, rtol, step, max_step):
@@ -370,7 +375,7 @@ def _report(out, rows, notes, speed_md=""):
     """The benchmark's page through the report layer: per scene the reference's self-check, the
     fastest setting within tolerance, the work-precision figure and every row."""
     rep = Report("Speed against error", verdict=False)
-    rep.add_html(f"<p>{esc(__doc__.split('Outputs')[0])}</p>"
+    rep.add_html(f"<p>{esc(MEASURED)}</p>"
                  f"<p>Tolerance: {TOL_PEAK:.0%} in peak acceleration, {TOL_PERIOD:.1%} in excitation period. "
                  "Cost: CPU seconds (process time) per simulated second, one core, including the settling "
                  "time.</p>", "What is measured")

@@ -10,30 +10,7 @@ pulses of one defect passage (like the paper's Figs 13, 15, 17, 18), ``mechanism
 its contact carries, and the intact fraction of the Hertz ellipse), ``studies.nc``
 (tables and pulses) and ``index.html``.
 
-Measurement (the same everywhere):
-
-- runs are simulated at 100 kHz output (4× internal oversampling before the
-  anti-alias filter) so a 0.35 ms passage has 35 samples; 0.1 s is recorded
-  after the scene's settling time, with the scene's default contact model
-  ("halfspace") unless the study varies it;
-- the passage analysed is the last one in the record whose window fits: the
-  window spans ±(L_eff/v + 1 ms) around the instant the ball centre crosses the
-  defect centre (L_eff = the defect's extent along the track, v the ball's
-  surface speed);
-- *pulse*: displacement minus its median over the window;
-- *peak displacement*: max |pulse| (µm); *peak acceleration*: max |a| in the
-  window (g, sampled at 100 kHz); *acceleration peak-to-peak*: max a − min a in
-  the window (g);
-- *excitation duration*: :func:`bearing_lab.analysis.excitation_duration`
-  (width at 10 % of the height) of the displacement pulse's main lobe — the
-  stretch between the zero crossings around its peak, so that the ring's
-  rebound after the passage (a structural response, not the excitation) is not
-  counted;
-- *carried share* and *intact fraction* (mechanism figure, pure geometry and
-  elasticity, no dynamics): from the defect's contact table at the static approach
-  δ_s of the most loaded ball, K·G(ψ, δ_s)/(K·δ_s^1.5) and the share of the Hertz
-  ellipse at δ_s that lies outside the outline; *minimum load*: the defected ball's
-  smallest outer-race load in the window (N).
+How every run is measured: :data:`MEASUREMENT` (also the ``measurement`` attribute of ``studies.nc``).
 """
 from __future__ import annotations
 
@@ -54,6 +31,32 @@ from ..sim.assembly import assemble
 from ..units import G
 from ..utils._files import savefig
 from ..utils.figures import new_figure
+
+#: how every run of the studies is measured (written to ``studies.nc`` as its ``measurement`` attribute)
+MEASUREMENT = """\
+- runs are simulated at 100 kHz output (4× internal oversampling before the
+  anti-alias filter) so a 0.35 ms passage has 35 samples; 0.1 s is recorded
+  after the scene's settling time, with the scene's default contact model
+  ("halfspace") unless the study varies it;
+- the passage analysed is the last one in the record whose window fits: the
+  window spans ±(L_eff/v + 1 ms) around the instant the ball centre crosses the
+  defect centre (L_eff = the defect's extent along the track, v the ball's
+  surface speed);
+- pulse: displacement minus its median over the window;
+- peak displacement: max |pulse| (µm); peak acceleration: max |a| in the
+  window (g, sampled at 100 kHz); acceleration peak-to-peak: max a − min a in
+  the window (g);
+- excitation duration: bearing_lab.analysis.excitation_duration
+  (width at 10 % of the height) of the displacement pulse's main lobe — the
+  stretch between the zero crossings around its peak, so that the ring's
+  rebound after the passage (a structural response, not the excitation) is not
+  counted;
+- carried share and intact fraction (mechanism figure, pure geometry and
+  elasticity, no dynamics): from the defect's contact table at the static approach
+  δ_s of the most loaded ball, K·G(ψ, δ_s)/(K·δ_s^1.5) and the share of the Hertz
+  ellipse at δ_s that lies outside the outline; minimum load: the defected ball's
+  smallest outer-race load in the window (N).
+"""
 
 STUDY_FS = 100_000.0
 
@@ -291,7 +294,7 @@ def _table(rows, total):
                 "label": ("case", [r["label"] for r in rows]),
                 "contact_model": ("case", [r["contact_model"] for r in rows])},
         attrs={"sampling_rate_hz": STUDY_FS, "total_wall_time_s": total,
-               "measurement": __doc__.split("Measurement (the same everywhere):")[1].strip()})
+               "measurement": MEASUREMENT})
 
 
 def _findings(s, rs):
