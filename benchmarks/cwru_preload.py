@@ -4,10 +4,9 @@ The motor's wave spring preloads the bearings axially; SKF's rule for deep-groov
 electric motors, F = k d with k = 0.005-0.01 kN/mm and d = 25 mm (6205 bore), gives 125-250 N.  This
 script runs the shipped cases cwru-130 (which identifies the rig's structural path), cwru-144,
 cwru-234 and cwru-105 with ``load.axial_n`` set on every scene they simulate, and prints one table
-per case: each row's simulated value and status per preload, and the bearing model alone (before the
-structural path) in RMS and impulse strength.  Usage: python benchmarks/cwru_preload.py [N ...]
+per case: each row's simulated value and status per preload.  Usage: python benchmarks/cwru_preload.py [N ...]
 [--rtol R] (``--rtol``: every scene at dp54 with that tolerance instead of the ``auto`` rule, to check
-the columns converged; the scenes then warn that they set their own solver).
+the columns converged).
 """
 import argparse
 import json
