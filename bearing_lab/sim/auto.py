@@ -217,15 +217,16 @@ def resolve(scene) -> dict:
         said = ", ".join(f"defect {k} is only grazed ({gap * 1e6:.3g} um of approach before the ball reaches it)"
                          for k, gap in grazed)
         out.update(GRAZED)
+        setting = f"solver.method = '{GRAZED['method']}', solver.rtol = {GRAZED['rtol']:g}"
         out["expected_peak_error"] = GRAZED_PEAK_ERROR
         out["reason"] += (f"; {said}: the defect rules do not hold there (a grazed pit's peak came out at 1.66 and 11 "
-                          "times the converged one at bs32 rtol 1e-5 and 1e-4), so dp54 rtol 1e-6 is taken (within 0.04 %, "
-                          "at the same cost)")
+                          "times the converged one at bs32 rtol 1e-5 and 1e-4), so the grazed-defect setting is taken: "
+                          f"{setting} (peak within {GRAZED_PEAK_ERROR * 100:.2g} % of a converged run, at the same cost)")
         solver = scene.data["solver"]
         tight = solver["method"] == GRAZED["method"] and (solver["rtol"] or 1.0) <= GRAZED["rtol"]
         if solver["method"] != "auto" and not tight:
             warnings.warn(f"scene {scene.name!r}: {said}: the solver set by the scene may miss the impacts (the "
-                          "automatic choice for a grazed defect is solver.method = 'dp54', solver.rtol = 1e-6)",
+                          f"automatic choice for a grazed defect is {setting})",
                           SceneWarning, stacklevel=3)
     out["kind"] = kind
     out["track"] = track
