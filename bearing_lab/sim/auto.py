@@ -221,7 +221,8 @@ def resolve(scene) -> dict:
         out["expected_peak_error"] = GRAZED_PEAK_ERROR
         out["reason"] += (f"; {said}: the defect rules do not hold there (a grazed pit's peak came out at 1.66 and 11 "
                           "times the converged one at bs32 rtol 1e-5 and 1e-4), so the grazed-defect setting is taken: "
-                          f"{setting} (peak within {GRAZED_PEAK_ERROR * 100:.2g} % of a converged run, at the same cost)")
+                          f"{setting} (peak within {GRAZED_PEAK_ERROR * 100:.2g} % of a converged run, "
+                          "at the same cost)")
         solver = scene.data["solver"]
         tight = solver["method"] == GRAZED["method"] and (solver["rtol"] or 1.0) <= GRAZED["rtol"]
         if solver["method"] != "auto" and not tight:
