@@ -12,7 +12,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 os.environ.setdefault("MPLBACKEND", "Agg")      # autodoc imports matplotlib users: never open a window
 
-from bearing_lab import __version__  # noqa: E402
+from bearing_lab._version import __version__  # noqa: E402
 
 project = "bearing_lab"
 author = "the bearing_lab authors"

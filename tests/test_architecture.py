@@ -363,3 +363,22 @@ def test_the_public_face_serves_what_all_says():
         assert getattr(bearing_lab, name) is not None, name
     with pytest.raises(AttributeError):
         bearing_lab.no_such_name  # noqa: B018
+
+
+def test_the_version_is_written_once_and_read_from_version_py():
+    """``__version__`` is imported from ``_version.py`` (never the package root), pyproject reads it there,
+    and the pages' provenance reports that version, not whatever an installed package's metadata says."""
+    import re
+    import tomllib
+    from bearing_lab.report.provenance import software_versions
+    written = re.search(r'__version__ = "([^"]+)"', (PKG / "_version.py").read_text()).group(1)
+    pyproject = tomllib.loads((ROOT / "pyproject.toml").read_text())
+    assert pyproject["tool"]["setuptools"]["dynamic"]["version"] == {"attr": "bearing_lab._version.__version__"}
+    assert software_versions()["bearing_lab"] == written
+    wrong = []
+    for path in sorted(PKG.rglob("*.py")) + [ROOT / "docs" / "conf.py"]:
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.ImportFrom) and any(a.name == "__version__" for a in node.names) \
+                    and not (node.module or "").endswith("_version"):
+                wrong.append(f"{path.relative_to(ROOT)}:{node.lineno}")
+    assert not wrong, "__version__ imported from elsewhere than _version.py: " + ", ".join(wrong)

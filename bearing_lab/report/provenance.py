@@ -26,8 +26,10 @@ PAPER_CITATION = ("Liu, Xu, Wang, Xu, Tang: Influence of the local defect distri
 
 
 def software_versions() -> dict:
-    out = {"python": platform.python_version()}
-    for pkg in ("bearing_lab", "numpy", "scipy", "numba", "xarray", "netCDF4", "matplotlib"):
+    """``{package: version}``: Python, bearing_lab (its ``_version.py``, the one place the version is
+    written) and the installed libraries its numbers depend on ("not installed" for one that is not)."""
+    out = {"python": platform.python_version(), "bearing_lab": __version__}
+    for pkg in ("numpy", "scipy", "numba", "xarray", "netCDF4", "matplotlib"):
         try:
             out[pkg] = md.version(pkg)
         except md.PackageNotFoundError:
@@ -51,12 +53,14 @@ def source_revision() -> str:
 
 
 def environment() -> dict:
+    """The page's provenance: :func:`software_versions`, :func:`source_revision`, the date (UTC) and the host."""
     return {"versions": software_versions(), "source revision": source_revision() or "installed package",
             "date": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
             "host": f"{platform.system()} {platform.machine()}, {os.cpu_count()} cores"}
 
 
 def citation() -> dict:
+    """How to cite a result: ``{"software": bearing_lab's version and source revision, "paper": the reference}``."""
     rev = source_revision()
     software = (f"bearing_lab {__version__}" + (f" (source revision {rev})" if rev else "")
                 + ": rolling-bearing simulation, analysis and validation toolkit.")
