@@ -27,6 +27,7 @@ Public API
     enhanced_envelope_spectrum(x, fs, *, alpha_max, nw)     -- (alpha, EES): cyclic spectral coherence averaged over f
     fault_line(f, ses, expected_hz, *, shaft_hz, tolerance, ...) -- dict: measured_hz, snr_db, harmonics, sidebands
     diagnose_ses(f, ses, fault_hz, *, shaft_hz, tolerance)  -- (diagnosis, families): the family rule on one SES
+    coincidences(fault_hz, shaft_hz, df, *, tolerance, bins)  -- fault lines a shaft or cage harmonic can mimic
     excitation_period(x, fs, *, frequency_range, band, method) -- (period s, lines or impulses used)
     excitation_duration(x, fs, *, level=0.1, baseline="median", axis=-1) -- (duration s, entry s, exit s) of one pulse
     impulses(x, fs, *, band, threshold, min_separation, level) -- Impulses(time, peak, duration, entry, exit, resolved)
@@ -40,6 +41,7 @@ from ._spectral import (amplitude_spectrum, bandpass, cepstral_prewhitening, env
                         fast_kurtogram, Kurtogram, squared_envelope, squared_envelope_spectrum, welch_psd)
 from ._speed import interpolated_peak, shaft_frequency  # noqa: F401
 from ._faults import diagnose_ses, fault_line  # noqa: F401
+from ._diagnosis import coincidences  # noqa: F401
 from ._impulse import excitation_duration, excitation_period, impulses, Impulses  # noqa: F401
 from ._metrics import (clearance_factor, crest_factor, impulse_factor, kurtosis, metrics,  # noqa: F401
                        peak, peak_to_peak, rms, shape_factor)
@@ -51,7 +53,7 @@ from . import xr  # noqa: F401
 
 __all__ = ["amplitude_spectrum", "welch_psd", "cepstral_prewhitening", "bandpass", "squared_envelope",
            "squared_envelope_spectrum", "fast_kurtogram", "Kurtogram", "envelope_band",
-           "interpolated_peak", "shaft_frequency", "fault_line", "diagnose_ses", "excitation_period",
+           "interpolated_peak", "shaft_frequency", "fault_line", "diagnose_ses", "coincidences", "excitation_period",
            "excitation_duration", "impulses", "Impulses", "rms", "peak", "peak_to_peak", "crest_factor",
            "kurtosis", "impulse_factor", "clearance_factor", "shape_factor", "metrics", "analyze",
            "plot_analysis", "xr", "shaft_speed", "tacho_pulses", "tacho_speed", "order_track",

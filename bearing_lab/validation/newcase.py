@@ -18,7 +18,7 @@ import os
 from pathlib import Path
 
 from .._version import __version__
-from ..analysis._diagnosis import coincidences
+from ..analysis import coincidences
 from ..bearings import get_bearing
 from ..errors import BearingLabError
 from ..io import open_recording
@@ -97,7 +97,7 @@ def _speed_lines(ds, speed) -> list:
 def resolution_limits(bearing, rpm, duration_s) -> list:
     """What a record of ``duration_s`` s cannot resolve at ``rpm`` r/min: the fault fundamentals (BPFO, BPFI)
     that lie within two bins (1 / duration) of a shaft harmonic, where the line search cannot tell them apart
-    (:func:`bearing_lab.analysis._diagnosis.coincidences`).  Each entry: ``family``, ``text`` and
+    (:func:`bearing_lab.analysis.coincidences`).  Each entry: ``family``, ``text`` and
     ``min_duration_s``, the shortest record that separates the two lines by two bins."""
     geo = get_bearing(bearing) if isinstance(bearing, str) else bearing
     fr = float(rpm) / 60.0
