@@ -1,32 +1,124 @@
-"""What to analyse in a Dataset: the signal channel, the tacho channel and the catalog bearing.
+"""What to analyse in a Dataset: the signal channel, its rate, the tacho channel, the speed and the bearing.
 
 A recording or a simulation Dataset holds several variables; :func:`bearing_lab.analysis.analyze`
-takes one signal, an optional tacho signal and a bearing name.  These functions choose them
-from the Dataset the same way for every caller (``bearing-lab analyze`` among them), and say
-what is missing with the input named.
+takes one signal and its sampling rate, an optional tacho signal, a speed prior and a bearing name.
+These functions choose them from the file and the Dataset the same way for every caller
+(``bearing-lab analyze`` among them), and say what is missing with the input named.
 
 Public API
 ----------
-time_channels(ds)                          -- names of the 1-D variables along ``time``
-pick_channel(ds, name=None, *, source="")  -- the channel to analyse (given, the default one, else the first)
-pick_tacho(ds, name=None, *, channel=None, source="") -- the tacho channel (given, found by name, or None)
-bearing_name(ds, given=None, *, source="") -- the catalog bearing the Dataset names
-not_an_acceleration(da, name, units)       -- a warning when the channel is not an acceleration ("" if it is)
-TACHO_NAME                                 -- the channel names taken for a tacho
+::
+
+    open_at_rate(path, fs=None, *, name="fs")  -- (Dataset, rate given or None, note): a file read at a given rate
+    signal_rate(ds, channel)                   -- the channel's sampling rate, Hz (the file's, else its time axis)
+    shaft_rpm(ds, value=None, *, source="", name="rpm") -- (r/min or None, speed source) from a value or the file
+    time_channels(ds)                          -- names of the 1-D variables along ``time``
+    pick_channel(ds, name=None, *, source="")  -- the channel to analyse (given, the default one, else the first)
+    pick_tacho(ds, name=None, *, channel=None, source="") -- the tacho channel (given, found by name, or None)
+    bearing_name(ds, given=None, *, source="") -- the catalog bearing the Dataset names
+    not_an_acceleration(da, name, units)       -- a warning when the channel is not an acceleration ("" if it is)
+    TACHO_NAME                                 -- the channel names taken for a tacho
+    QUANTITY_WORDS                             -- what a channel in a unit other than acceleration is, in words
 """
 from __future__ import annotations
 
 import re
 
-from ..bearings import CATALOG
-from ..errors import AnalysisError
+from pathlib import Path
 
-__all__ = ["time_channels", "pick_channel", "pick_tacho", "bearing_name", "not_an_acceleration", "TACHO_NAME",
-           "QUANTITY_WORDS"]
+from ..bearings import CATALOG
+from ..errors import AnalysisError, RecordingError, RecordingOptionError
+from ..io import open_recording
+from .xr import sampling_rate
+
+__all__ = ["open_at_rate", "signal_rate", "shaft_rpm", "time_channels", "pick_channel", "pick_tacho",
+           "bearing_name", "not_an_acceleration", "TACHO_NAME", "QUANTITY_WORDS"]
 
 #: channel names taken for a once-per-rev tacho (tacho, tach, keyphasor, once-per-rev, 1/rev ...)
 TACHO_NAME = re.compile(r"^(tacho?|tach|tachometer|keyphasor|key_phasor|kph|once[-_ ]?per[-_ ]?rev|1/rev)\d*$",
                         re.IGNORECASE)
+
+
+def open_at_rate(path, fs=None, *, name="fs"):
+    """A recording read at a sampling rate the caller gives, for a file that stores none or to override it.
+
+    Parameters
+    ----------
+    path : str or path
+        Any file :func:`bearing_lab.io.open_recording` reads.
+    fs : float, optional
+        Sampling rate, Hz.  Passed to the reader when it takes an ``fs`` option (bare text, a CWRU
+        record outside the registry); a reader that takes none (it reads the rate from the file, as
+        bearing_lab's netCDF) reads the file as it is, and ``fs`` then overrides the stored rate.
+    name : str
+        How the caller calls ``fs`` in its messages (``"--fs"`` on the command line).
+
+    Returns
+    -------
+    ds : xarray.Dataset
+        The recording.
+    fs : float or None
+        ``fs`` as given (None when not given: see :func:`signal_rate`).
+    note : str
+        ``""``, or the override in words when ``fs`` replaces the file's rate.
+
+    Raises
+    ------
+    RecordingError
+        No such file, or the reader refuses it.
+    AnalysisError
+        ``fs`` is not a positive number.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise RecordingError(f"{path}: no such file")
+    if fs is None:
+        return open_recording(path), None, ""
+    if not fs > 0:
+        raise AnalysisError(f"{name} {fs!r} must be a positive sampling rate in Hz")
+    try:
+        return open_recording(path, fs=fs), fs, ""
+    except RecordingOptionError as exc:   # a reader without an fs option: the rate is set after reading
+        if "fs" not in exc.unknown:
+            raise
+    ds = open_recording(path)
+    return ds, fs, f"{name} {fs:g} Hz overrides the file's {ds.attrs.get('sampling_rate_hz')} Hz"
+
+
+def signal_rate(ds, channel) -> float:
+    """The sampling rate of ``ds[channel]``, Hz: the Dataset's ``sampling_rate_hz``, else the
+    channel's own attribute or time axis (:func:`bearing_lab.analysis.xr.sampling_rate`)."""
+    if "sampling_rate_hz" in ds.attrs:
+        return float(ds.attrs["sampling_rate_hz"])
+    return sampling_rate(ds[channel])
+
+
+def shaft_rpm(ds, value=None, *, source="", name="rpm"):
+    """The shaft speed prior of an analysis and where it comes from: ``(r/min or None, rpm_source)``.
+
+    ``value`` None: the Dataset's ``shaft_speed_rpm`` ("file"), else none ("given": a blind
+    estimate).  ``"none"`` (any case): none, whatever the file stores.  ``"file"``: the stored speed,
+    an :class:`~bearing_lab.errors.AnalysisError` when there is none.  A number: that speed
+    ("given"), which must be positive.  ``source`` (the file) and ``name`` (how the caller calls
+    ``value``, ``"--rpm"`` on the command line) start the messages.
+    """
+    stored = ds.attrs.get("shaft_speed_rpm")
+    if value is None:
+        return (float(stored), "file") if stored else (None, "given")
+    text = str(value).lower()
+    if text == "none":
+        return None, "given"
+    if text == "file":
+        if not stored:
+            raise AnalysisError(f"{source}: {name} file given but the file stores no shaft_speed_rpm")
+        return float(stored), "file"
+    try:
+        rpm = float(value)
+    except ValueError:
+        raise AnalysisError(f"{name} {value!r} is not a number (r/min), 'file' nor 'none'") from None
+    if not rpm > 0:
+        raise AnalysisError(f"{name} {value!r} must be a positive speed in r/min")
+    return rpm, "given"
 
 
 def time_channels(ds) -> list:

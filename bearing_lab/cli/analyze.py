@@ -16,7 +16,6 @@ import sys
 from pathlib import Path
 import warnings
 
-from ..errors import AnalysisError, RecordingError, RecordingOptionError
 from . import check_output_path
 from ..utils._json import dumps
 
@@ -45,7 +44,8 @@ def register(subparsers):
                    help="tacho channel (once-per-rev pulses) giving the speed; 'none' ignores one "
                         "(default: a channel named tacho, tach, keyphasor or once-per-rev)")
     p.add_argument("--pulses-per-rev", type=int, default=1, help="tacho pulses per revolution (default 1)")
-    p.add_argument("--json", action="store_true", help="print the result as JSON (fields described in the analysis documentation, docs/analysis.md)")
+    p.add_argument("--json", action="store_true",
+                   help="print the result as JSON (fields described in the analysis documentation, docs/analysis.md)")
     p.add_argument("-q", "--quiet", action="store_true",
                    help="print nothing but warnings and errors (--json and --plot still write their output)")
     p.add_argument("--plot", metavar="FILE.png", default=None,
@@ -59,64 +59,22 @@ def register(subparsers):
 PLOT_SUFFIXES = (".png", ".svg", ".pdf")
 
 
-def _open(path: Path, fs):
-    """(Dataset, sampling rate, note) with ``--fs`` passed to the reader or overriding the file."""
-    from ..io import open_recording  # the command's imports load when it runs
-    if not path.is_file():
-        raise RecordingError(f"{path}: no such file")
-    if fs is None:
-        ds = open_recording(path)
-        return ds, None, ""
-    if not fs > 0:
-        raise AnalysisError(f"--fs {fs!r} must be a positive sampling rate in Hz")
-    try:
-        return open_recording(path, fs=fs), fs, ""
-    except RecordingOptionError as exc:   # a reader without an fs option: the rate is set after reading
-        if "fs" not in exc.unknown:
-            raise
-    ds = open_recording(path)
-    stored = ds.attrs.get("sampling_rate_hz")
-    return ds, fs, f"--fs {fs:g} Hz overrides the file's {stored} Hz"
-
-
-def _rpm(ds, value, path):
-    """(rpm or None, rpm_source)."""
-    stored = ds.attrs.get("shaft_speed_rpm")
-    if value is None:
-        return (float(stored), "file") if stored else (None, "given")
-    text = str(value).lower()
-    if text == "none":
-        return None, "given"
-    if text == "file":
-        if not stored:
-            raise AnalysisError(f"{path}: --rpm file given but the file stores no shaft_speed_rpm")
-        return float(stored), "file"
-    try:
-        rpm = float(value)
-    except ValueError:
-        raise AnalysisError(f"--rpm {value!r} is not a number (r/min), 'file' nor 'none'") from None
-    if not rpm > 0:
-        raise AnalysisError(f"--rpm {value!r} must be a positive speed in r/min")
-    return rpm, "given"
-
-
 def run(args) -> int:
     import numpy as np  # the command's imports load when it runs
 
     from ..analysis import analyze, plot_analysis
-    from ..analysis.inputs import bearing_name, not_an_acceleration, pick_channel, pick_tacho
-    from ..analysis.xr import sampling_rate
+    from ..analysis.inputs import (bearing_name, not_an_acceleration, open_at_rate, pick_channel, pick_tacho,
+                                   shaft_rpm, signal_rate)
 
     path = Path(args.file)
     if args.plot:  # before reading: a bad or existing figure path is said at once
         check_output_path(args.plot, force=args.force, suffixes=PLOT_SUFFIXES, flag="--plot")
-    ds, fs, note = _open(path, args.fs)
+    ds, fs, note = open_at_rate(path, args.fs, name="--fs")
     name = pick_channel(ds, args.channel, source=path)
     da = ds[name]
-    if fs is None:
-        fs = float(ds.attrs["sampling_rate_hz"]) if "sampling_rate_hz" in ds.attrs else sampling_rate(da)
+    fs = signal_rate(ds, name) if fs is None else fs
     bearing = bearing_name(ds, args.bearing, source=path)
-    rpm, rpm_source = _rpm(ds, args.rpm, path)
+    rpm, rpm_source = shaft_rpm(ds, args.rpm, source=path, name="--rpm")
     tacho_name = pick_tacho(ds, args.tacho, channel=name, source=path)
     x = np.asarray(da.values, dtype=float)
     units = da.attrs.get("units", "1")
@@ -146,14 +104,15 @@ def run(args) -> int:
         return 0
     if args.quiet:
         return 0
-    _print(result, path, name, fs, bearing, units, tacho_name, note, args.plot)
+    print(f"{path.name} [{name}]  fs {fs:g} Hz  bearing {bearing}" + (f"  ({note})" if note else ""))
+    _print(result, units, tacho_name, args.plot)
     return 0
 
 
-def _print(result, path, name, fs, bearing, units, tacho_name, note, plot):
+def _print(result, units, tacho_name, plot):
+    """The result in words, after the line naming the file, channel, rate and bearing."""
     sp = result["speed"]
     ev = result["evidence"]
-    print(f"{path.name} [{name}]  fs {fs:g} Hz  bearing {bearing}" + (f"  ({note})" if note else ""))
     if result["speed_source"] == "unresolved":
         print(f"shaft speed unresolved (speed_source unresolved): {sp['note']}")
     else:

@@ -5,11 +5,13 @@ Works on a recording, a simulation output or a sweep, and on the plain arrays
 
 Public API
 ----------
-describe(ds, path=None)  -- dict: file, kind, reader, rate, samples, duration, speed, bearing,
-                            default channel, per channel its units, quantity, dims and RMS, warnings
-dataset_kind(ds)         -- "recording", "simulation", "sweep" or "dataset"
-channel_rms(values)      -- RMS of any array without overflow (None when empty)
-QUANTITY_OF_UNITS        -- the quantity a channel's SI unit implies, where it says none
+::
+
+    describe(ds, path=None)  -- dict: file, kind, reader, rate, samples, duration, speed, bearing,
+                                default channel, per channel its units, quantity, dims and RMS, warnings
+    dataset_kind(ds)         -- "recording", "simulation", "sweep" or "dataset"
+    channel_rms(values)      -- RMS of any array without overflow (None when empty)
+    QUANTITY_OF_UNITS        -- the quantity a channel's SI unit implies, where it says none
 """
 from __future__ import annotations
 

@@ -64,3 +64,61 @@ def test_a_channel_that_is_not_an_acceleration_is_said():
     odd = xr.DataArray(np.zeros(4), dims="time", attrs={"quantity": "strain"})
     assert "channel 'e' is a strain, not an acceleration" in not_an_acceleration(odd, "e", "1")
     assert not_an_acceleration(mic, "x", "1") == ""          # a bare number says nothing of its quantity
+
+
+def _nc(tmp_path, fs=1000.0, **attrs):
+    from bearing_lab.io.export import to_netcdf
+    t = np.arange(64) / fs
+    ds = xr.Dataset({"acc": ("time", np.sin(2 * np.pi * 50 * t), {"units": "m s-2"})},
+                    coords={"time": ("time", t, {"units": "s"})},
+                    attrs={"sampling_rate_hz": fs, "bearing_lab_version": "0", **attrs})
+    return to_netcdf(ds, tmp_path / "r.nc")
+
+
+def test_open_at_rate_passes_fs_to_a_reader_that_takes_it(tmp_path):
+    from bearing_lab.analysis.inputs import open_at_rate
+    path = tmp_path / "bare.csv"
+    path.write_text("acc[g]\n" + "\n".join(str(v) for v in np.arange(40.0)) + "\n")
+    ds, fs, note = open_at_rate(path, 2500.0)
+    assert (fs, note) == (2500.0, "")
+    assert float(ds.attrs["sampling_rate_hz"]) == 2500.0
+    assert float(ds["time"].values[1] - ds["time"].values[0]) == pytest.approx(1 / 2500.0)
+
+
+def test_open_at_rate_overrides_the_rate_of_a_reader_without_an_fs_option(tmp_path):
+    from bearing_lab.analysis.inputs import open_at_rate, signal_rate
+    path = _nc(tmp_path, fs=1000.0)
+    ds, fs, note = open_at_rate(path)
+    assert fs is None and note == "" and signal_rate(ds, "acc") == 1000.0
+    ds, fs, note = open_at_rate(path, 3000.0, name="--fs")
+    assert fs == 3000.0 and float(ds.attrs["sampling_rate_hz"]) == 1000.0
+    assert note == "--fs 3000 Hz overrides the file's 1000.0 Hz"
+    with pytest.raises(AnalysisError, match=r"^--fs -1.0 must be a positive sampling rate in Hz$"):
+        open_at_rate(path, -1.0, name="--fs")
+    from bearing_lab.errors import RecordingError
+    with pytest.raises(RecordingError, match="missing.nc: no such file"):
+        open_at_rate(tmp_path / "missing.nc", 3000.0)
+
+
+def test_signal_rate_falls_back_on_the_time_axis():
+    t = np.arange(10) / 400.0
+    ds = xr.Dataset({"acc": ("time", np.zeros(10))}, coords={"time": t})
+    from bearing_lab.analysis.inputs import signal_rate
+    assert signal_rate(ds, "acc") == 400.0
+    assert signal_rate(ds.assign_attrs(sampling_rate_hz=512.0), "acc") == 512.0
+
+
+def test_shaft_rpm_from_a_value_or_the_file():
+    from bearing_lab.analysis.inputs import shaft_rpm
+    stored, bare = _ds(["a"], shaft_speed_rpm=1797.0), _ds(["a"])
+    assert shaft_rpm(stored) == (1797.0, "file")
+    assert shaft_rpm(bare) == (None, "given")
+    assert shaft_rpm(stored, "None") == (None, "given")
+    assert shaft_rpm(stored, "file") == (1797.0, "file")
+    assert shaft_rpm(bare, "1750") == (1750.0, "given")
+    with pytest.raises(AnalysisError, match=r"^f.nc: --rpm file given but the file stores no shaft_speed_rpm$"):
+        shaft_rpm(bare, "file", source="f.nc", name="--rpm")
+    with pytest.raises(AnalysisError, match=r"'fast' is not a number \(r/min\), 'file' nor 'none'"):
+        shaft_rpm(bare, "fast")
+    with pytest.raises(AnalysisError, match="must be a positive speed"):
+        shaft_rpm(bare, "-3")
