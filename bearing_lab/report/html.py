@@ -18,7 +18,7 @@ from string import Template
 from .._docdict import fill_doc
 from ..utils.figures import figure_png
 
-__all__ = ["template", "css", "esc", "fmt", "figure_html", "table_html", "rows_table",
+__all__ = ["template", "css", "esc", "fmt", "figure_html", "text_html", "table_html", "rows_table",
            "index_rows", "kv_html", "notice_html"]
 
 _TEMPLATES = Path(__file__).with_name("templates")
@@ -85,6 +85,40 @@ def fmt(v, digits=5) -> str:
 
 def figure_html(fig, alt, caption="", dpi=80) -> str:
     return template("figure.html").substitute(alt=esc(alt), png=figure_png(fig, dpi=dpi), caption=esc(caption))
+
+
+def text_html(text, *, lead="", note=False, preformatted=False) -> str:
+    """Text for a page: each paragraph escaped, through the ``text.html`` template (``pre.html`` when
+    ``preformatted``).
+
+    Parameters
+    ----------
+    text : str or sequence of str
+        One paragraph, or several.
+    lead : str
+        Words shown in bold before the first paragraph.
+    note : bool
+        Set the paragraphs in the small grey style of the page's notes.
+    preformatted : bool
+        Keep the text's line breaks and spacing (a Markdown table, a log), in one block.
+
+    See Also
+    --------
+    Report.add_text : adds it to a page.
+
+    Examples
+    --------
+    >>> print(text_html(["Cost: CPU s per simulated s.", "Tolerance: 5 % & 0.5 %."], lead="Scored:"))
+    <p class=""><b>Scored:</b> Cost: CPU s per simulated s.</p>
+    <p class="">Tolerance: 5 % &amp; 0.5 %.</p>
+    """
+    paragraphs = [text] if isinstance(text, str) else list(text)
+    if preformatted:
+        return template("pre.html").substitute(text=esc("\n".join(paragraphs))).rstrip("\n")
+    lead_html = f"<b>{esc(lead)}</b> " if lead else ""
+    return "\n".join(template("text.html").substitute(css_class="note" if note else "", text=esc(p),
+                                                      lead=lead_html if i == 0 else "").rstrip("\n")
+                     for i, p in enumerate(paragraphs))
 
 
 def _cell(v) -> str:

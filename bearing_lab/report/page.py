@@ -11,7 +11,7 @@ from ..errors import check_choice
 from ..utils._files import atomic_open
 from ..utils.figures import new_figure
 from .html import (css, esc, figure_html, kv_html, notice_html, rows_table, table_html, template,
-                   index_rows)
+                   index_rows, text_html)
 from .provenance import citation, environment
 
 __all__ = ["Report", "write_index"]
@@ -41,9 +41,10 @@ class Report:
 
     Figures are matplotlib :class:`~matplotlib.figure.Figure` objects (no backend is switched),
     embedded as PNG.  ``rows`` collects the validation rows added with :meth:`add_rows`.  Every
-    ``add_*`` method returns the report, so calls chain.  ``verdict=False`` makes a page without the
-    validation verdict (badge, rows passing, link to the case index): the studies' and the benchmark's
-    pages.
+    ``add_*`` method returns the report, so calls chain; one given ``title=None`` adds to the last
+    section instead of starting one (text, a figure and a table under one heading).
+    ``verdict=False`` makes a page without the validation verdict (badge, rows passing, link to the
+    case index): the studies' and the benchmark's pages.
 
     Parameters
     ----------
@@ -81,19 +82,33 @@ class Report:
         self.info: dict = {}
 
     # ---- adding content
-    def add_html(self, html_text: str, title: str):
-        self.sections.append({"title": title, "html": html_text})
+    def add_html(self, html_text: str, title: str | None):
+        """HTML as it is, in a section of its own (``title``) or, with ``title=None``, after the last
+        section's content (in a "Notes" section on an empty page)."""
+        if title is None and self.sections:
+            self.sections[-1]["html"] += "\n" + html_text
+        else:
+            self.sections.append({"title": "Notes" if title is None else title, "html": html_text})
         return self
 
-    def add_figure(self, fig, title: str, *, caption: str = "", dpi=80):
-        return self.add_html(figure_html(fig, title, caption, dpi=dpi), title)
+    def add_text(self, text, title: str | None, *, lead="", note=False, preformatted=False):
+        """Paragraphs of text (escaped; see :func:`~bearing_lab.report.html.text_html` for ``lead``,
+        ``note`` and ``preformatted``)."""
+        return self.add_html(text_html(text, lead=lead, note=note, preformatted=preformatted), title)
+
+    def add_figure(self, fig, title: str | None, *, caption: str = "", alt=None, dpi=80):
+        """A figure; ``alt`` describes it to screen readers (default: ``title``, else ``caption``, else the
+        section's title)."""
+        if alt is None:
+            alt = title if title is not None else (caption or (self.sections[-1]["title"] if self.sections else ""))
+        return self.add_html(figure_html(fig, alt, caption, dpi=dpi), title)
 
     def add_figures(self, figs, title: str, *, dpi=80, intro=""):
         """Several ``(figure, caption)`` pairs in one section."""
         body = "\n".join(figure_html(f, title, c, dpi=dpi) for f, c in figs)
         return self.add_html((f"<p>{esc(intro)}</p>" if intro else "") + body, title)
 
-    def add_table(self, rows: list, title: str, *, columns=None, intro=""):
+    def add_table(self, rows: list, title: str | None, *, columns=None, intro=""):
         return self.add_html(table_html(rows, columns=columns, intro=intro), title)
 
     def add_rows(self, rows: list, title: str = "Comparison table", *, show_reference=False, show_paper=False,

@@ -22,7 +22,6 @@ from .._version import __version__
 from ..errors import BearingLabError
 from ..io.export import to_netcdf
 from ..report import Report
-from ..report.html import esc, figure_html, table_html
 from ..sim.assembly import assemble
 from ..sim.integrate import METHODS, _run, _warm_up, anti_alias_taps
 from ..utils._files import savefig, write_text
@@ -88,6 +87,9 @@ Speed at equal accuracy (bearing_lab.studies.bench_speed): each of our methods a
 solve_ivp (LSODA, RK45, BDF, Radau on the same compiled right-hand side) at its cheapest
 setting within the tolerance, on a 0.1 s record with its own converged reference.
 """
+#: how a setting is scored (the page's second paragraph)
+SCORED = (f"Tolerance: {TOL_PEAK:.0%} in peak acceleration, {TOL_PERIOD:.1%} in excitation period. Cost: CPU "
+          "seconds (process time) per simulated second, one core, including the settling time.")
 
 
 def _timed(asm, method, rtol, step, max_step):
@@ -375,29 +377,25 @@ def _report(out, rows, notes, speed_md=""):
     """The benchmark's page through the report layer: per scene the reference's self-check, the
     fastest setting within tolerance, the work-precision figure and every row."""
     rep = Report("Speed against error", verdict=False)
-    rep.add_html(f"<p>{esc(MEASURED)}</p>"
-                 f"<p>Tolerance: {TOL_PEAK:.0%} in peak acceleration, {TOL_PERIOD:.1%} in excitation period. "
-                 "Cost: CPU seconds (process time) per simulated second, one core, including the settling "
-                 "time.</p>", "What is measured")
+    rep.add_text([MEASURED, SCORED], "What is measured")
     for sc in dict.fromkeys(r["scene"] for r in rows):
         rs = [r for r in rows if r["scene"] == sc]
         fig = _work_precision_figure(sc, rs)
         savefig(fig, out / f"work_precision_{sc.replace('/', '_').replace('=', '')}.png", dpi=100)
-        body = ["<p>reference self-check (rtol 1e-10 vs 1e-9): "
-                + esc(", ".join(f"{k} {v:.1e}" for k, v in notes[sc].items())) + "</p>"]
+        rep.add_text("reference self-check (rtol 1e-10 vs 1e-9): "
+                     + ", ".join(f"{k} {v:.1e}" for k, v in notes[sc].items()), sc)
         best = fastest_within_tolerance(rows, sc)
         if best:
-            body.append(f"<p><b>Fastest within tolerance:</b> {esc(best['fidelity'])}, {esc(best['contact'])}, "
-                        f"{esc(best['setting'])}: {best['cost']:.4f} s/s, peak error {best['err_peak']:.2e}</p>")
-        body.append(figure_html(fig, f"work-precision: {sc}", dpi=90))
-        body.append(table_html([{"fidelity": r["fidelity"], "contact": r["contact"], "setting": r["setting"],
-                                 "s/s": r["cost"], "peak err": r["err_peak"], "RMS err": r["err_rms"],
-                                 "period err": r["err_period"], "duration err": r["err_duration"]}
-                                for r in sorted(rs, key=lambda r: r["cost"])]))
-        rep.add_html("\n".join(body), sc)
+            rep.add_text(f"{best['fidelity']}, {best['contact']}, {best['setting']}: {best['cost']:.4f} s/s, "
+                         f"peak error {best['err_peak']:.2e}", None, lead="Fastest within tolerance:")
+        rep.add_figure(fig, None, alt=f"work-precision: {sc}", dpi=90)
+        rep.add_table([{"fidelity": r["fidelity"], "contact": r["contact"], "setting": r["setting"],
+                        "s/s": r["cost"], "peak err": r["err_peak"], "RMS err": r["err_rms"],
+                        "period err": r["err_period"], "duration err": r["err_duration"]}
+                       for r in sorted(rs, key=lambda r: r["cost"])], None)
     if speed_md:
-        rep.add_html(f"<pre>{esc(speed_md)}</pre>", "Speed at equal accuracy (CPU s per simulated s; cheapest "
-                     f"setting within {TOL_PEAK:.0%} peak and {TOL_PERIOD:.1%} period error)")
+        rep.add_text(speed_md, "Speed at equal accuracy (CPU s per simulated s; cheapest "
+                     f"setting within {TOL_PEAK:.0%} peak and {TOL_PERIOD:.1%} period error)", preformatted=True)
     rep.save(out / "index.html")
 
 

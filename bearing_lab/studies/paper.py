@@ -25,7 +25,6 @@ from ..analysis import excitation_duration
 from ..errors import BearingLabError
 from ..io.export import to_netcdf
 from ..report import Report
-from ..report.html import esc, figure_html, table_html
 from ..sim import load_scene, simulate
 from ..sim.assembly import assemble
 from ..units import G
@@ -324,6 +323,14 @@ def _findings(s, rs):
     return " ".join(parts)
 
 
+#: what the studies page's table columns mean (the page's first section)
+COLUMNS_MEANING = (
+    "Peak displacement is the largest deviation of the outer-ring Y displacement from its median over the "
+    f"passage window; peak acceleration the largest |a| in that window at {STUDY_FS/1e3:.0f} kHz; excitation "
+    "duration the width of the displacement pulse at 10 % of its height. Crossing time = defect extent along "
+    "the track / ball surface speed. The mechanism columns come from the defect's contact table at the static "
+    "approach of the most loaded ball.")
+
 #: the studies page's table: column heading -> (row key, decimals)
 _PAGE_COLUMNS = (("peak displacement (µm)", "peak_disp_um", 4), ("peak acceleration (g)", "peak_acc_g", 2),
                  ("acceleration peak-to-peak (g)", "p2p_acc_g", 2), ("excitation duration (ms)", "duration_ms", 3),
@@ -334,18 +341,13 @@ _PAGE_COLUMNS = (("peak displacement (µm)", "peak_disp_um", 4), ("peak accelera
 def _write_html(out, names, rows, figs):
     """The studies page through the report layer: per study its table, findings and pulse figure."""
     rep = Report("The paper's section-5 studies on the 2-D defect model", verdict=False)
-    rep.add_html(
-        "<p>Peak displacement is the largest deviation of the outer-ring Y displacement from its "
-        "median over the passage window; peak acceleration the largest |a| in that window at "
-        f"{STUDY_FS/1e3:.0f} kHz; excitation duration the width of the displacement pulse at 10 % of "
-        "its height. Crossing time = defect extent along the track / ball surface speed. The "
-        "mechanism columns come from the defect's contact table at the static approach of the most "
-        "loaded ball.</p>", "Measurement")
+    rep.add_text(COLUMNS_MEANING, "Measurement")
     for s in names:
         table = [{"case": r["label"], **{head: round(float(r[key]), nd) for head, key, nd in _PAGE_COLUMNS},
                   "contact model": r["contact_model"]} for r in rows if r["study"] == s]
         rs = [r for r in rows if r["study"] == s]
-        rep.add_html(table_html(table) + f"\n<p>{esc(_findings(s, rs))}</p>\n" + figure_html(figs[s], s, dpi=90),
-                     f"{s} ({STUDIES[s][2]}; paper: {STUDIES[s][3]})")
+        rep.add_table(table, f"{s} ({STUDIES[s][2]}; paper: {STUDIES[s][3]})")
+        rep.add_text(_findings(s, rs), None)
+        rep.add_figure(figs[s], None, alt=s, dpi=90)
     rep.add_figure(figs["mechanism"], "Mechanism", dpi=90)
     rep.save(out / "index.html")

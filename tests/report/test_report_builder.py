@@ -96,3 +96,35 @@ def test_report_cosmetics_booleans_long_reasons_and_trace_colours():
     anchor = re.search(r'href="#(reason-\d+)"', table).group(1)
     assert f'id="{anchor}"' in below and "a short one" in table
     assert not {SIGNAL_COLORS[k] for k in ("model", "path", "path+background")} & {"tab:red", "tab:green"}
+
+
+def test_text_a_figure_and_a_table_under_one_heading(tmp_path):
+    """``title=None`` continues the last section; text is escaped, its lead in bold, preformatted text kept."""
+    r = Report("Speed against error", verdict=False)
+    r.add_text(["a < b", "c & d"], "Scene 1", lead="Fastest:")
+    fig = Figure(figsize=(4, 2))
+    fig.subplots().plot(np.arange(10))
+    r.add_figure(fig, None, alt="work-precision")
+    r.add_table([{"a": 1.5}], None)
+    r.add_text("| x |\n|---|", "Markdown", preformatted=True)
+    assert [s["title"] for s in r.sections] == ["Scene 1", "Markdown"]
+    html = r.save(tmp_path / "index.html").read_text()
+    first = html.split('id="scene-1"')[1].split("</section>")[0]
+    assert "<p class=\"\"><b>Fastest:</b> a &lt; b</p>" in first and "c &amp; d" in first
+    assert 'alt="work-precision"' in first and "<table" in first
+    assert "<pre>| x |\n|---|</pre>" in html
+    assert Report("t").add_text("alone", None).sections[0]["title"] == "Notes"
+
+
+def test_the_workshop_pages_build_no_html_of_their_own():
+    """The studies' and the benchmark's pages say what they show through the report layer: no HTML
+    markup in their modules' strings."""
+    import ast
+    import re
+    from pathlib import Path
+    tag = re.compile(r"</?(p|b|i|pre|div|span|ul|ol|li|h[1-6]|table|tr|td|th|br|code|a|figure|img)\b[^>]*>")
+    pkg = Path(__file__).resolve().parents[2] / "bearing_lab" / "studies"
+    found = [f"{p.name}:{n.lineno}" for p in sorted(pkg.glob("*.py")) for n in ast.walk(ast.parse(p.read_text()))
+             if isinstance(n, ast.Constant) and isinstance(n.value, str) and tag.search(n.value)]
+    assert not found, found
+    assert tag.search("<p class=\"note\">x</p>") and not tag.search("``work_precision_<scene>.png``")
