@@ -18,14 +18,20 @@ from string import Template
 from .._docdict import fill_doc
 from ..utils.figures import figure_png
 
-__all__ = ["template", "css", "esc", "fmt", "figure_html", "text_html", "table_html", "rows_table",
-           "index_rows", "kv_html", "notice_html"]
+__all__ = ["template", "fill", "css", "esc", "fmt", "figure_html", "text_html", "list_html", "table_html",
+           "rows_table", "index_rows", "kv_html", "notice_html"]
 
 _TEMPLATES = Path(__file__).with_name("templates")
 
 
 def template(name: str) -> Template:
     return Template((_TEMPLATES / name).read_text(encoding="utf-8"))
+
+
+def fill(name: str, **values) -> str:
+    """The template ``name`` filled in with ``values`` (HTML as given: escape text with :func:`esc`),
+    without its file's last line break."""
+    return template(name).substitute(**values).rstrip("\n")
 
 
 def css() -> str:
@@ -119,6 +125,11 @@ def text_html(text, *, lead="", note=False, preformatted=False) -> str:
     return "\n".join(template("text.html").substitute(css_class="note" if note else "", text=esc(p),
                                                       lead=lead_html if i == 0 else "").rstrip("\n")
                      for i, p in enumerate(paragraphs))
+
+
+def list_html(texts) -> str:
+    """A bulleted list of texts (each escaped), through ``list.html`` and ``list_item.html``."""
+    return fill("list.html", items="".join(fill("list_item.html", text=esc(t)) for t in texts))
 
 
 def _cell(v) -> str:
@@ -223,7 +234,8 @@ def rows_table(rows: list, *, show_reference=False, show_paper=False, intro="") 
         status = r.get("status") or ("pass" if r.get("pass") else "fail")
         cls, label = _STATUS[status]
         mark = "" if r.get("independent", True) else " &#8224;"
-        cells = [f'<td class="l">{esc(r.get("label") or r["quantity"])}{mark}</td>', f"<td>{esc(r.get('units', ''))}</td>",
+        cells = [f'<td class="l">{esc(r.get("label") or r["quantity"])}{mark}</td>',
+                 f"<td>{esc(r.get('units', ''))}</td>",
                  f"<td>{fmt(r.get('simulation'))}</td>", f"<td>{fmt(r.get('experiment'))}</td>"]
         if show_reference:
             cells.append(f"<td>{fmt(r.get('reference_value'))}<br><span class='note'>"
@@ -244,7 +256,8 @@ def rows_table(rows: list, *, show_reference=False, show_paper=False, intro="") 
                     f'below the table)</a>')
         cells += [f"<td>{fmt(r.get('difference_pct'), 3)}</td>", f"<td>{esc(r.get('tolerance', ''))}</td>",
                   f'<td class="status">{label}</td>',
-                  f'<td class="l note">{esc(r.get("simulated_signal", ""))}<br>{esc(r.get("experiment_span", ""))}</td>',
+                  f'<td class="l note">{esc(r.get("simulated_signal", ""))}<br>'
+                  f'{esc(r.get("experiment_span", ""))}</td>',
                   f'<td class="reason">{text}</td>']
         lines.append(template("table_row.html").substitute(css_class=cls, cells="".join(cells)))
     return template("rows_table.html").substitute(

@@ -2,11 +2,13 @@
 
 Public API
 ----------
-write_case(case, result, out, *, wall) -> status   -- DIR/<case>/{index.html, comparison.nc, summary.json[, structural_path.json]}
+write_case(case, result, out, *, wall) -> status   -- DIR/<case>/{index.html, comparison.nc, summary.json}
+                                                      (and structural_path.json when a path was fitted)
 summary(case, result, wall) -> dict                -- the summary.json content
 verdict_html(rows, author) -> str                  -- a case page's opening: the verdict in words
 verdict_legend(entries) -> str                     -- the index page's opening: overall verdict, meanings, exit status
 MODEL_ASSUMPTIONS                                  -- the assumptions listed on every page
+VERDICT_LEVEL                                      -- the look of each verdict's notice
 """
 from __future__ import annotations
 
@@ -15,11 +17,16 @@ import json
 import numpy as np
 
 from ..report import Report, esc, fmt, table_html
+from ..report.html import fill, list_html
 from ..utils._files import atomic_open
+from ..utils._json import clean
 from .rows import EXIT_STATUS, ROW_KEYS, VERDICTS, case_verdict
 
 
-__all__ = ["write_case", "summary", "verdict_html", "verdict_legend", "MODEL_ASSUMPTIONS", "clean"]
+__all__ = ["write_case", "summary", "verdict_html", "verdict_legend", "MODEL_ASSUMPTIONS", "VERDICT_LEVEL"]
+
+#: the look of each verdict's notice (the report's "good", "warn" and "bad" blocks)
+VERDICT_LEVEL = {"pass": "good", "known limitations": "warn", "fail": "bad"}
 
 #: what every simulated number assumes (docs/validation.md explains each)
 MODEL_ASSUMPTIONS = [
@@ -36,9 +43,6 @@ MODEL_ASSUMPTIONS = [
 ]
 
 
-from ..utils._json import clean  # noqa: E402  (NaN/inf -> null: one rule for every JSON output)
-
-
 def summary(case, result, wall) -> dict:
     rows = [{k: r.get(k) for k in ROW_KEYS} for r in result.rows]
     failing = [r for r in result.rows if not r["pass"]]
@@ -53,41 +57,40 @@ def summary(case, result, wall) -> dict:
                   **result.extra})
 
 
+def _numbers(r) -> str:
+    return (f'simulation {fmt(r.get("simulation"))}, experiment {fmt(r.get("experiment"))} '
+            f'{esc(r.get("units", ""))}, tolerance {esc(r.get("tolerance", ""))}')
+
+
+def _label(r) -> str:
+    return esc(r.get("label") or r["quantity"])
+
+
 def verdict_html(rows, author) -> str:
     """The verdict in words, first on a case page: unexplained failures, the limitations the case's
-    author declared (with the author's reason), the passes, and what the case expects."""
+    author declared (with the author's reason), the passes, and what the case expects (the
+    ``verdict*.html`` templates of the report layer)."""
     v = case_verdict(rows)
     word = {"pass": "PASS", "known limitations": "KNOWN LIMITATIONS", "fail": "FAIL"}[v["verdict"]]
-    cls = {"pass": "good", "known limitations": "warn", "fail": "bad"}[v["verdict"]]
-    out = [f'<div class="notice {cls}"><b>{word}</b>: {esc(v["text"])}.<br>'
-           f'<span class="note">{esc(word)} means: {esc(VERDICTS[v["verdict"]])}.</span></div>']
+    out = [fill("verdict.html", level=VERDICT_LEVEL[v["verdict"]], word=esc(word), text=esc(v["text"]),
+                meaning=esc(VERDICTS[v["verdict"]]))]
     unexplained = [r for r in rows if not r["pass"] and not r.get("known_limitation")]
     declared = [r for r in rows if not r["pass"] and r.get("known_limitation")]
     passing = [r for r in rows if r["pass"]]
-
-    def _nums(r):
-        return (f'simulation {fmt(r.get("simulation"))}, experiment {fmt(r.get("experiment"))} '
-                f'{esc(r.get("units", ""))}, tolerance {esc(r.get("tolerance", ""))}')
     if unexplained:
-        out.append("<h3>Unexplained failures (a regression until fixed or explained)</h3><ul>"
-                   + "".join(f'<li><b>{esc(r.get("label") or r["quantity"])}</b>: {_nums(r)}'
-                             + (f'<br><span class="note">{esc(r["note"])}</span>' if r.get("note") else "")
-                             + "</li>" for r in unexplained) + "</ul>")
+        out.append(fill("verdict_unexplained.html", items="".join(
+            fill("term.html", term=_label(r), text=": " + _numbers(r),
+                 note=fill("term_note.html", note=esc(r["note"])) if r.get("note") else "") for r in unexplained)))
     if declared:
         who = sorted({r.get("declared_by") or author for r in declared})
-        out.append(f"<h3>Limitations declared by {esc(', '.join(who))}</h3>"
-                   "<p class=\"note\">The case file gives each of these rows a <code>known_limitation</code>: "
-                   "its author's reason why the model cannot reproduce the quantity. The row still fails; the "
-                   "reason is the author's statement, not a result of this run.</p><ul>"
-                   + "".join(f'<li><b>{esc(r.get("label") or r["quantity"])}</b> ({_nums(r)}): '
-                             f'{esc(r["known_limitation"])}</li>' for r in declared) + "</ul>")
+        out.append(fill("verdict_declared.html", who=esc(", ".join(who)), items="".join(
+            fill("term.html", term=_label(r), text=f" ({_numbers(r)}): {esc(r['known_limitation'])}", note="")
+            for r in declared)))
     if passing:
-        out.append("<h3>Passing</h3><p>" + esc(", ".join(r.get("label") or r["quantity"] for r in passing))
-                   + ".</p>")
-    n_lim = sum(bool(r.get("known_limitation")) for r in rows)
-    out.append(f'<p class="note">Expected result, as the case declares it: {n_lim} of {len(rows)} rows carry a '
-               f'declared limitation (allowed to fail with the stated reason); every other row is expected to '
-               f'pass. Declared by: {esc(author)}.</p>')
+        labels = ", ".join(r.get("label") or r["quantity"] for r in passing)
+        out.append(fill("verdict_passing.html", labels=esc(labels)))
+    out.append(fill("verdict_expected.html", n_declared=sum(bool(r.get("known_limitation")) for r in rows),
+                    n_rows=len(rows), author=esc(author)))
     return "\n".join(out)
 
 
@@ -97,16 +100,16 @@ def verdict_legend(entries: list) -> str:
     n_decl = sum(len(e.get("known") or []) for e in entries)
     errors = [e["case"] for e in entries if e.get("status") == "error"]
     if n_unexp or errors:
-        head = (f"<b>FAIL</b>: {n_unexp} row(s) fail without a declared reason"
-                + (f"; case(s) that could not run: {esc(', '.join(errors))}" if errors else "") + ".")
-        cls = "bad"
+        verdict = "fail"
+        text = (f"{n_unexp} row(s) fail without a declared reason"
+                + (f"; case(s) that could not run: {', '.join(errors)}" if errors else "") + ".")
     elif n_decl:
-        head, cls = f"<b>KNOWN LIMITATIONS</b>: no unexplained failure; {n_decl} row(s) fail as declared limitations.", "warn"
+        verdict, text = "known limitations", f"no unexplained failure; {n_decl} row(s) fail as declared limitations."
     else:
-        head, cls = "<b>PASS</b>: every row of every case that ran agrees.", "good"
-    items = "".join(f"<li><b>{esc(k)}</b>: {esc(v)}</li>" for k, v in VERDICTS.items())
-    return (f'<div class="notice {cls}">{head}</div><p class="note">Verdicts:</p><ul class="note">{items}</ul>'
-            f'<p class="note">Exit status of <code>bearing-lab validate</code>: {esc(EXIT_STATUS)}.</p>')
+        verdict, text = "pass", "every row of every case that ran agrees."
+    items = "".join(fill("term.html", term=esc(k), text=": " + esc(v), note="") for k, v in VERDICTS.items())
+    return fill("legend.html", level=VERDICT_LEVEL[verdict], word=esc(verdict.upper()), text=esc(text), items=items,
+                exit_status=esc(EXIT_STATUS))
 
 
 def _overview(report, rows, author):
@@ -157,7 +160,7 @@ def build_report(case, result, wall) -> Report:
     report.rows = list(result.rows)
     model = result.extra.get("model") or {}
     runs = model if model and all(isinstance(v, dict) for v in model.values()) else {"simulation": model}
-    report.add_html("<ul>" + "".join(f"<li>{esc(a)}</li>" for a in MODEL_ASSUMPTIONS) + "</ul>"
+    report.add_html(list_html(MODEL_ASSUMPTIONS)
                     + table_html([{"run": k, **v} for k, v in runs.items() if v],
                                  intro="The simulations as they ran:"), "Model assumptions")
     _compute_tables(report, result, wall)
@@ -165,13 +168,8 @@ def build_report(case, result, wall) -> Report:
                            **result.provenance})
     report.add_citation(note="Tolerances, quantities and the background model: docs/validation.md; the case "
                              "format: docs/case-format.md.")
-    files = ('<p>Data of this page: <a href="comparison.nc">comparison.nc</a> (waveforms on one time base, spectra, '
-             'SES and the table; <code>bearing_lab.compare.ComparisonResult.load</code>) and '
-             '<a href="summary.json">summary.json</a>')
-    if result.path is not None and result.path.resonances:
-        files += ('; the structural path: <a href="structural_path.json">structural_path.json</a> (reuse it with '
-                  '<code>[structural_path] file = ...</code>)')
-    report.add_html(files + ".</p>", "Files")
+    with_path = result.path is not None and result.path.resonances
+    report.add_html(fill("case_files.html", path=fill("case_files_path.html") if with_path else ""), "Files")
     return report
 
 
