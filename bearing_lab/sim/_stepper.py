@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 from numba import njit
 
-from . import _kernels as K  # K: the name sim/_variants.py rebinds in each per-kind copy of these kernels
+from . import _kernels  # the global sim/_variants.py rebinds in each per-kind copy of these kernels
 from . import _loopargs
 
 TWO_PI = 2.0 * math.pi
@@ -125,24 +125,24 @@ def _finish(method, y, k, h, ynew, err):
 def step_limit(t, y, h, m, nsteps_def):
     """Bound the step near defects: land on zone entry, then take >= nsteps_def steps inside."""
     p, dint, dflt = m.p, m.dint, m.dflt
-    ndef = int(p[K.P_NDEF])
+    ndef = int(p[_kernels.P_NDEF])
     if ndef == 0:
         return h
-    z = int(p[K.P_Z])
-    theta_s, omega_s = K.shaft_state(t, m.sp_t, m.sp_w, m.sp_th)
-    phic = p[K.P_PHI0] + p[K.P_FTF] * theta_s
-    phidot = p[K.P_FTF] * omega_s
-    spin = p[K.P_SPIN]
-    dyn = p[K.P_CAGE] > 0.5
+    z = int(p[_kernels.P_Z])
+    theta_s, omega_s = _kernels.shaft_state(t, m.sp_t, m.sp_w, m.sp_th)
+    phic = p[_kernels.P_PHI0] + p[_kernels.P_FTF] * theta_s
+    phidot = p[_kernels.P_FTF] * omega_s
+    spin = p[_kernels.P_SPIN]
+    dyn = p[_kernels.P_CAGE] > 0.5
     sp = TWO_PI / z
     hh = h
     for kk in range(ndef):
-        zlo = dflt[kk, K.F_ZLO]
-        zhi = dflt[kk, K.F_ZHI]
-        race = dint[kk, K.D_RACE]
+        zlo = dflt[kk, _kernels.F_ZLO]
+        zhi = dflt[kk, _kernels.F_ZHI]
+        race = dint[kk, _kernels.D_RACE]
         if not dyn and race <= 1 and zhi - zlo < sp:
             # equally spaced balls: the one in the zone / the next to enter, by one modulo
-            rel0 = phic - dflt[kk, K.F_PSI0] - (theta_s if race == 1 else 0.0)
+            rel0 = phic - dflt[kk, _kernels.F_PSI0] - (theta_s if race == 1 else 0.0)
             reld = phidot - (omega_s if race == 1 else 0.0)
             if abs(reld) < 1e-12:
                 continue
@@ -158,10 +158,10 @@ def step_limit(t, y, h, m, nsteps_def):
             continue
         for j in range(z):
             if dyn:
-                rel, reld = K.rel_angle(kk, j, y[8 + 2 * z + j], y[8 + 3 * z + j], theta_s, omega_s, spin,
+                rel, reld = _kernels.rel_angle(kk, j, y[8 + 2 * z + j], y[8 + 3 * z + j], theta_s, omega_s, spin,
                                         dint, dflt)
             else:
-                rel, reld = K.rel_angle(kk, j, phic + TWO_PI * j / z, phidot, theta_s, omega_s, spin, dint, dflt)
+                rel, reld = _kernels.rel_angle(kk, j, phic + TWO_PI * j / z, phidot, theta_s, omega_s, spin, dint, dflt)
             if rel > 5.0 or abs(reld) < 1e-12:
                 continue
             if zlo <= rel <= zhi:
@@ -223,7 +223,7 @@ def _dense(t, hstep, y, ynew, f0, f1, o, fine_pos, out_pos):
 # ``_loopargs``: ``m`` :class:`Model`, ``sol`` :class:`Solver`, ``w`` :class:`Work`, ``o`` :class:`Output`.
 
 
-@njit(cache=True, error_model="numpy", **K.NO_REFCOUNT)
+@njit(cache=True, error_model="numpy", **_kernels.NO_REFCOUNT)
 def integrate(t, t_stop, h, m, sol, w, o):
     """Integrate the state ``w.y`` from t to t_stop, writing the dense output of ``o``.
 
@@ -243,7 +243,7 @@ def integrate(t, t_stop, h, m, sol, w, o):
     c = C_DP if method == 0 else (C_BS if method == 1 else C_RK)
     fine_pos = 0
     out_pos = 0
-    K.rhs(t, y, m, k[0], w.fi, w.fo)
+    _kernels.rhs(t, y, m, k[0], w.fi, w.fo)
     while t < t_stop:
         hstep = h
         if hstep > sol.hmax:
@@ -258,7 +258,7 @@ def integrate(t, t_stop, h, m, sol, w, o):
             if fsal and st == ns:
                 for i in range(n):
                     ynew[i] = ytmp[i]
-            K.rhs(t + c[st] * hstep, ytmp, m, k[st], w.fi, w.fo)
+            _kernels.rhs(t + c[st] * hstep, ytmp, m, k[st], w.fi, w.fo)
         _finish(method, y, k, hstep, ynew, w.err)
         fac = 1.0
         if adaptive:
@@ -289,7 +289,7 @@ def integrate(t, t_stop, h, m, sol, w, o):
         # f at the new point: the FSAL stage, or one more evaluation
         f1 = k[ns]
         if not fsal:
-            K.rhs(t + hstep, ynew, m, ytmp, w.fi, w.fo)
+            _kernels.rhs(t + hstep, ynew, m, ytmp, w.fi, w.fo)
             stats[2] += 1
             f1 = ytmp
         fine_pos, out_pos = _dense(t, hstep, y, ynew, k[0], f1, o, fine_pos, out_pos)
@@ -306,14 +306,14 @@ def integrate(t, t_stop, h, m, sol, w, o):
     return t, h, 0
 
 
-@njit(cache=True, error_model="numpy", **K.NO_REFCOUNT)
+@njit(cache=True, error_model="numpy", **_kernels.NO_REFCOUNT)
 def loads_at(out_t, out_state, m, fi_all, fo_all, dy, fi, fo):
     """Ball loads (N) into ``fi_all``, ``fo_all`` (Z × samples) at the output samples from the
     interpolated states (``dy``, ``fi``, ``fo``: scratch, the loop's ``Work.ytmp``, ``.fi``, ``.fo``;
     only these three are passed: each array argument costs compile time to unbox)."""
     z = fi.shape[0]
     for i in range(out_t.shape[0]):
-        K.rhs(out_t[i], out_state[i], m, dy, fi, fo)
+        _kernels.rhs(out_t[i], out_state[i], m, dy, fi, fo)
         for j in range(z):
             fi_all[j, i] = fi[j]
             fo_all[j, i] = fo[j]
@@ -326,27 +326,27 @@ def _atan2(y, x):
     return math.atan(y / x) if x > 0.0 else math.atan2(y, x)
 
 
-@njit(cache=True, error_model="numpy", **K.NO_REFCOUNT)
+@njit(cache=True, error_model="numpy", **_kernels.NO_REFCOUNT)
 def contact_angles_at(out_t, out_state, m, out):
     """The 3-D bearing's contact angles (deg) at the output samples: ``out[0]`` outer race, ``out[1]``
     inner race, (Z, n) each, positive when the load line leans as under a +Z force on the outer
     ring; the geometry of :func:`.bearing3d.contact_angles`, in one compiled pass (in numpy it cost
     5-7 ms per simulated second at 20 kHz, now 2-3 ms)."""
     p = m.p
-    z = int(p[K.P_Z])
-    zb = int(p[K.P_ZOFF])
-    pd4 = 0.25 * p[K.P_PD]
-    a_i = p[K.P_AGI]
-    a_o = p[K.P_AGO]
-    multibody = p[K.P_FID] < 0.5
+    z = int(p[_kernels.P_Z])
+    zb = int(p[_kernels.P_ZOFF])
+    pd4 = 0.25 * p[_kernels.P_PD]
+    a_i = p[_kernels.P_AGI]
+    a_o = p[_kernels.P_AGO]
+    multibody = p[_kernels.P_FID] < 0.5
     deg = 180.0 / math.pi
     for i in range(out_t.shape[0]):
         y = out_state[i]
-        phic = p[K.P_PHI0] + p[K.P_FTF] * K.shaft_state(out_t[i], m.sp_t, m.sp_w, m.sp_th)[0]
+        phic = p[_kernels.P_PHI0] + p[_kernels.P_FTF] * _kernels.shaft_state(out_t[i], m.sp_t, m.sp_w, m.sp_th)[0]
         c0 = math.cos(phic)
         s0 = math.sin(phic)
         for j in range(z):
-            c, s = K._ball_dir(p, z, j, c0, s0)
+            c, s = _kernels._ball_dir(p, z, j, c0, s0)
             ui = y[0] * c + y[1] * s
             uo = y[4] * c + y[5] * s
             if multibody:
@@ -420,4 +420,4 @@ def drop_stale_machine_code(fns, sources) -> None:
 
 
 drop_stale_machine_code((integrate, loads_at, step_limit, contact_angles_at),
-                        (K.__file__, _loopargs.__file__, __file__))
+                        (_kernels.__file__, _loopargs.__file__, __file__))

@@ -30,9 +30,9 @@ import types
 
 from numba import njit
 
-from . import _kernels as K  # the same alias as _stepper.py's, the global a per-kind copy rebinds
+from . import _kernels  # the global of _stepper.py a per-kind copy rebinds
 from . import _loopargs
-from . import _stepper as S
+from . import _stepper
 
 #: the ball models of ``rhs`` and ``_rhs_3d``, with the number of values each returns
 BALL_MODELS = {"_balls_kinematic": 4, "_balls_quasi_static": 4, "_balls_dynamic": 5,
@@ -47,17 +47,17 @@ _MODULES: dict = {}
 
 def kind_of(p) -> str:
     """The kind of scene parameter vector ``p`` describes (the flags ``_kernels.rhs`` branches on)."""
-    qs = p[K.P_FID] > 0.5
-    if p[K.P_3D] > 0.5:
+    qs = p[_kernels.P_FID] > 0.5
+    if p[_kernels.P_3D] > 0.5:
         return "3d_quasi_static" if qs else "3d_kinematic"
     if qs:
         return "quasi_static"
-    return "dynamic" if p[K.P_CAGE] > 0.5 else "kinematic"
+    return "dynamic" if p[_kernels.P_CAGE] > 0.5 else "kinematic"
 
 
 def _stub(name):
     """A compiled stand-in for ``_kernels.<name>`` with its parameters, returning NaN."""
-    params = list(inspect.signature(getattr(K, name).py_func).parameters)
+    params = list(inspect.signature(getattr(_kernels, name).py_func).parameters)
     if name == "_rhs_3d":
         body = "    dy[0] = math.nan\n"
     else:
@@ -82,18 +82,18 @@ def _copy(dispatcher, qualname, *, cache, **glb):
 def _drop_stale(fns):
     """These copies also depend on ``_kernels.py``, ``_stepper.py``, ``_loopargs.py`` (their
     arguments' layout) and this file."""
-    S.drop_stale_machine_code(fns, (K.__file__, S.__file__, _loopargs.__file__, __file__))
+    _stepper.drop_stale_machine_code(fns, (_kernels.__file__, _stepper.__file__, _loopargs.__file__, __file__))
 
 
 def _stages_of(method):
     """The stage input and step finish of ``_stepper`` with the method fixed (a compile-time constant)."""
     @njit(inline="always")
     def stage_input(m, st, y, k, h, ytmp):
-        S._stage_input(method, st, y, k, h, ytmp)
+        _stepper._stage_input(method, st, y, k, h, ytmp)
 
     @njit(inline="always")
     def finish(m, y, k, h, ynew, err):
-        S._finish(method, y, k, h, ynew, err)
+        _stepper._finish(method, y, k, h, ynew, err)
     return {"_stage_input": stage_input, "_finish": finish}
 
 
@@ -108,21 +108,21 @@ def kernels(kind, method=None):
         live = KINDS[kind]
         stubs = {name: _stub(name) for name in BALL_MODELS if name != live}
         if kind.startswith("3d"):
-            rhs3d = _copy(K._rhs_3d, f"_rhs_3d__{kind}", cache=False, **stubs)
-            rhs = _copy(K.rhs, f"rhs__{kind}", cache=True, _rhs_3d=rhs3d, **stubs)
+            rhs3d = _copy(_kernels._rhs_3d, f"_rhs_3d__{kind}", cache=False, **stubs)
+            rhs = _copy(_kernels.rhs, f"rhs__{kind}", cache=True, _rhs_3d=rhs3d, **stubs)
         else:
-            rhs = _copy(K.rhs, f"rhs__{kind}", cache=True, _rhs_3d=_stub("_rhs_3d"), **stubs)
-        mod = types.ModuleType(K.__name__)
-        mod.__dict__.update(K.__dict__)
+            rhs = _copy(_kernels.rhs, f"rhs__{kind}", cache=True, _rhs_3d=_stub("_rhs_3d"), **stubs)
+        mod = types.ModuleType(_kernels.__name__)
+        mod.__dict__.update(_kernels.__dict__)
         mod.rhs = rhs
-        loads = _copy(S.loads_at, f"loads_at__{kind}", cache=True, K=mod)
+        loads = _copy(_stepper.loads_at, f"loads_at__{kind}", cache=True, _kernels=mod)
         _drop_stale([rhs, loads])
         _MODULES[kind] = (mod, loads)
     mod, loads = _MODULES[kind]
     if method is None:
-        integ = _copy(S.integrate, f"integrate__{kind}", cache=True, K=mod)
+        integ = _copy(_stepper.integrate, f"integrate__{kind}", cache=True, _kernels=mod)
     else:
-        integ = _copy(S.integrate, f"integrate__{kind}__{METHOD_NAMES[method]}", cache=True, K=mod,
+        integ = _copy(_stepper.integrate, f"integrate__{kind}__{METHOD_NAMES[method]}", cache=True, _kernels=mod,
                       **_stages_of(int(method)))
     _drop_stale([integ])
     _LOADED[key] = types.SimpleNamespace(kind=kind, method=method, rhs=mod.rhs, integrate=integ, loads_at=loads)

@@ -31,8 +31,8 @@ from .._docdict import fill_doc
 from .._version import __version__
 from ..errors import BearingLabError, SolverError
 from . import _kernels as kernels
-from . import _stepper as S
-from . import _variants as V
+from . import _stepper
+from . import _variants
 from ._loopargs import Output, Solver, new_work
 from .assembly import assemble
 from .auto import resolve
@@ -74,7 +74,7 @@ def _warm_up(asm=None, method=None):
     """Compile (or load from numba's cache) the loop of ``asm``'s kind for ``method``, or the
     loops of every kind for every method without ``asm`` (the benchmarks), once per process, by
     a 20 µs run; return the seconds it took (reported apart from run time)."""
-    keys = [(V.kind_of(asm.p), method)] if asm is not None else [(k, None) for k in V.KINDS]
+    keys = [(_variants.kind_of(asm.p), method)] if asm is not None else [(k, None) for k in _variants.KINDS]
     todo = [k for k in keys if k not in _COMPILED["kinds"]]
     if not todo:
         return 0.0
@@ -88,7 +88,7 @@ def _warm_up(asm=None, method=None):
         _run(run_on, METHODS["dp54"] if m is None else m, 1e-3, progress=False, t_end_override=2e-5,
              step=1e-6, fixed_method=m is not None)
         _COMPILED["kinds"].add((kind, m))
-    S.fir_decimate(np.zeros((4, 2)), np.ones(2), 0, 1, np.zeros((2, 2)))
+    _stepper.fir_decimate(np.zeros((4, 2)), np.ones(2), 0, 1, np.zeros((2, 2)))
     seconds = _time.perf_counter() - t0
     _COMPILED["seconds"] += seconds
     return seconds
@@ -165,7 +165,7 @@ class _Stream:
         self.disp[lo:hi] = o.out_state[:, [0, 1, 4, 5]]
         if self.three_d:
             self.disp_z[lo:hi] = o.out_state[:, self.zb + 1]
-            S.contact_angles_at(o.out_t, o.out_state, m, self.angles[:, :, lo:hi])
+            _stepper.contact_angles_at(o.out_t, o.out_state, m, self.angles[:, :, lo:hi])
         if self.cage_speed is not None:
             self.cage_speed[lo:hi] = o.out_state[:, self.cage_idx]
         if self.fi is not None:
@@ -189,9 +189,9 @@ class _Stream:
         if k_hi > k_acc:
             s0 = m_pad + k_acc * R - half - self.v_start
             if self.three_d:
-                S.fir_decimate3(a_fine, self.taps_rev, s0, R, self.acc[k_acc:k_hi], self.acc_z[k_acc:k_hi])
+                _stepper.fir_decimate3(a_fine, self.taps_rev, s0, R, self.acc[k_acc:k_hi], self.acc_z[k_acc:k_hi])
             else:
-                S.fir_decimate(a_fine, self.taps_rev, s0, R, self.acc[k_acc:k_hi])
+                _stepper.fir_decimate(a_fine, self.taps_rev, s0, R, self.acc[k_acc:k_hi])
             self.k_acc = k_acc = k_hi
         # drop the velocities no later output needs; v_buf[0] is always fine index v_start
         drop = min(max(m_pad + k_acc * R - half - self.v_start, 0), self.v_buf.shape[0])
@@ -230,7 +230,7 @@ def _run(asm, method, rtol, *, progress, t_end_override=None, step=None, max_ste
     out = _Stream(asm, t_end_override, loads)
     sol, h = _solver(asm, int(method), rtol, step, max_step, defect_steps)
     # the loop compiled for this kind of scene (and with fixed_method, for this method only)
-    kern = V.kernels(V.kind_of(asm.p), sol.method if fixed_method else None)
+    kern = _variants.kernels(_variants.kind_of(asm.p), sol.method if fixed_method else None)
     m = asm.model
     w = new_work(asm.y0, asm.n_balls)
     t, t_end = 0.0, out.t_end

@@ -32,7 +32,7 @@ import numpy as np
 
 from .. import sim
 from ..errors import SolverError
-from ..sim import integrate as I
+from ..sim import integrate
 from ..sim import load_scene
 from ..sim.assembly import assemble
 from ..sim.auto import resolve
@@ -174,7 +174,7 @@ def best_per_method(rows):
 def default_cost(label, base, ov, *, duration=1.0, repeats=3):
     """``simulate`` as users call it (auto), warm caches: CPU of the time loop and the whole call."""
     loop_cpu = []
-    orig = I._run
+    orig = integrate._run
 
     def timed_run(*a, **kw):  # the time loop alone, measured inside the user's call
         t0 = time.process_time()
@@ -184,7 +184,7 @@ def default_cost(label, base, ov, *, duration=1.0, repeats=3):
             loop_cpu.append(time.process_time() - t0)
     sim.simulate(base, duration=duration, progress=False, **ov)  # compile, build/cache the tables
     best = None
-    I._run = timed_run
+    integrate._run = timed_run
     try:
         for _ in range(repeats):
             loop_cpu.clear()
@@ -200,7 +200,7 @@ def default_cost(label, base, ov, *, duration=1.0, repeats=3):
             if best is None or row["loop_cpu_s_per_s"] < best["loop_cpu_s_per_s"]:
                 best = row
     finally:
-        I._run = orig
+        integrate._run = orig
     return best
 
 
