@@ -200,7 +200,7 @@ def static_equilibrium(scene: Scene, phi_c0: float, k_in: float, k_out: float, *
         return (xi - xo - e) / scale * w
     e0 = x0[:2] - x0[2:]
     # the balance to rounding (1e-15 of the load; 2-3 Newton steps from e0): the root Powell's
-    # hybrid method (scipy.optimize.root, used before) found, to one ulp of e
+    # hybrid method (scipy.optimize.root) finds, to one ulp of e
     try:
         e = _newton_2d(resid, e0, w, scale, f"scene {scene.name!r}", tol=1e-15, accept=1e-9)
     except SceneError as exc:
