@@ -192,22 +192,24 @@ def test_damaged_cache_entry_is_recomputed_and_reported(serial, cache, tmp_path,
     """NaN written into a cache file, a flipped byte, a lost checksum file or a wrong shape:
     the scene is computed again (never used), the sweep warns and says how many."""
     import shutil
-    from bearing_lab.sweep import CacheWarning, _checksum_path, _write_cache
+    from bearing_lab.io.export import checksum_path
+    from bearing_lab.sweep import CacheWarning
+    from bearing_lab.sweep.store import write_cache
     own = tmp_path / "cache"
     shutil.copytree(cache, own)
     victim = own / f"{serial.scene_hash.values[0, 1]}.nc"
     if damage == "nan":      # re-written consistently (valid checksum), but with a NaN inside
         ds = xr.load_dataset(victim)
         ds["outer_ring_acc_y"][5] = np.nan
-        _write_cache(ds, victim)
+        write_cache(ds, victim)
     elif damage == "shape":
-        _write_cache(xr.load_dataset(victim).isel(time=slice(0, 10)), victim)
+        write_cache(xr.load_dataset(victim).isel(time=slice(0, 10)), victim)
     elif damage == "bytes":
         b = bytearray(victim.read_bytes())
         b[len(b) // 2] ^= 0xFF
         victim.write_bytes(bytes(b))
     else:
-        _checksum_path(victim).unlink()
+        checksum_path(victim).unlink()
     with pytest.warns(CacheWarning, match="1 damaged cache entry"):
         res = bearing_lab.run_sweep(SCENE, PARAMS, scheduler="serial", cache_dir=own, progress=False,
                                 duration=DUR)

@@ -71,9 +71,8 @@ from ..errors import BearingLabError, SceneError
 from ..sim import load_scene, simulate
 from ..sim.budget import check_budget
 from ..sim.scene import SET_ALIASES as _ALIASES, convert_value as _convert, merge_overrides, parse_value as _parse_value
-from .store import (CacheWarning, checksum_path as _checksum_path,  # noqa: F401
-                           from_cache as _from_cache, METRIC_SIGNAL as _METRIC_SIGNAL,
-                           SWEEP_METRICS as _METRICS, Stack as _Stack, write_cache as _write_cache)
+from .store import (CacheWarning, from_cache as _from_cache, METRIC_SIGNAL as _METRIC_SIGNAL,
+                    SWEEP_METRICS as _METRICS, Stack as _Stack, write_cache as _write_cache)
 
 __all__ = ["run_sweep", "scene_hash", "code_fingerprint", "default_cache_dir", "dim_name", "key_units",
            "CacheWarning"]
@@ -326,19 +325,28 @@ def _open_cache_dir(cache_dir) -> Path | None:
     return cdir
 
 
-def _simulate_missing(missing, scene_tomls, digests, cache_dir, results, scheduler, n_workers, bar, failure) -> str:
+class _Jobs:
+    """The sweep's scenes as jobs: scene i's resolved TOML, its cache key and where its cache file goes."""
+
+    def __init__(self, scene_tomls, digests, cache_dir):
+        self.scene_tomls, self.digests, self.cache_dir = scene_tomls, digests, cache_dir
+
+    def cache_path(self, i):
+        return self.cache_dir / f"{self.digests[i]}.nc" if self.cache_dir is not None else None
+
+
+def _simulate_missing(missing, jobs, results, *, scheduler, n_workers, bar, failure) -> str:
     """Simulate the scenes whose indices are ``missing`` (serially or on Dask) into ``results``.
 
-    ``scene_tomls[i]`` and ``digests[i]`` are scene i's resolved TOML and cache key; ``cache_dir`` (or None)
-    receives each result; ``failure(i, exc)`` makes the error naming scene i's values.  Returns the
-    scheduler used, described."""
+    ``jobs``: each scene's TOML, cache key and cache file (:class:`_Jobs`); ``failure(i, exc)`` makes
+    the error naming scene i's values.  Returns the scheduler used, described."""
     if not missing:
         return "serial (in process)"
     if scheduler == "serial":
         for i in missing:
-            path = str(cache_dir / f"{digests[i]}.nc") if cache_dir is not None else None
+            path = jobs.cache_path(i)
             try:
-                ds = _simulate_scene(scene_tomls[i], digests[i], path)
+                ds = _simulate_scene(jobs.scene_tomls[i], jobs.digests[i], None if path is None else str(path))
             except Exception as exc:  # noqa: BLE001 - re-raised with the scene's values
                 raise failure(i, exc) from exc
             results.put(i, ds, cached=False)
@@ -352,9 +360,10 @@ def _simulate_missing(missing, scene_tomls, digests, cache_dir, results, schedul
         futures = {}
         for i in missing:
             # workers of a local cluster share our disk and write the cache themselves
-            path = str(cache_dir / f"{digests[i]}.nc") if (cache_dir is not None and not remote) else None
-            fut = client.submit(_simulate_scene, scene_tomls[i], digests[i], path,
-                                key=f"bearing_lab-scene-{digests[i][:16]}-{uuid.uuid4().hex[:8]}",
+            path = jobs.cache_path(i) if not remote else None
+            fut = client.submit(_simulate_scene, jobs.scene_tomls[i], jobs.digests[i],
+                                None if path is None else str(path),
+                                key=f"bearing_lab-scene-{jobs.digests[i][:16]}-{uuid.uuid4().hex[:8]}",
                                 pure=False)
             futures[fut] = i
         for fut in as_completed(list(futures)):
@@ -366,8 +375,8 @@ def _simulate_missing(missing, scene_tomls, digests, cache_dir, results, schedul
                     other.cancel()
                 raise failure(i, exc) from exc
             del fut
-            if remote and cache_dir is not None:
-                _write_cache(ds, cache_dir / f"{digests[i]}.nc")
+            if remote and jobs.cache_dir is not None:
+                _write_cache(ds, jobs.cache_path(i))
             results.put(i, ds, cached=False)
             if bar is not None:
                 bar.update(1)
@@ -483,7 +492,8 @@ def run_sweep(scene, params: dict, *, scheduler=None, n_workers: int | None = No
         return BearingLabError(f"sweep scene {label(i)}: {type(exc).__name__}: {exc}")
 
     try:
-        desc = _simulate_missing(todo, tomls, digests, cdir, acc, scheduler, n_workers, bar, failed)
+        desc = _simulate_missing(todo, _Jobs(tomls, digests, cdir), acc, scheduler=scheduler, n_workers=n_workers,
+                                 bar=bar, failure=failed)
     finally:
         if bar is not None:
             bar.close()
