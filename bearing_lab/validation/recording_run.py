@@ -10,7 +10,7 @@ Public API
 ----------
 run_recording_case(case, *, steps, mirror=None) -> CaseResult
 ratio_companion(case, prep, path, *, mirror=None), healthy_reference(case, prep, path, background, reference)
-assemble(case, prep, path, background, signals, rows, err, healthy, ctx) -> CaseResult
+assemble(case, prep, *, path, background, signals, rows, numerical_error, healthy, context) -> CaseResult
 """
 from __future__ import annotations
 
@@ -129,7 +129,7 @@ def _path_table(path) -> list:
     return rows
 
 
-def _sections(case, prep, path, background, aligned, shift_k, result, healthy):
+def _sections(prep, result, *, path, background, aligned, shift_k, healthy):
     rec = prep.recording
     secs = [("rows", "Comparison table", {"rows": result.rows})]
     intro = f"{path.source}. Status: {path.status}."
@@ -166,7 +166,9 @@ def _sections(case, prep, path, background, aligned, shift_k, result, healthy):
     return secs
 
 
-def assemble(case, prep, path, background, signals, rows, err, healthy, ctx):
+def assemble(case, prep, *, path, background, signals, rows, numerical_error, healthy, context):
+    """The case's result: the comparison on one time base, the rows, the page's sections, the provenance."""
+    ctx = context
     aligned, k = _aligned(prep, signals)
     m = prep.measured["record"]
     ff = m["extras"]["analysis"]["fault_frequencies"]
@@ -178,7 +180,7 @@ def assemble(case, prep, path, background, signals, rows, err, healthy, ctx):
     ds = prep.dataset
     extra = {"speed": {"rpm": prep.speed.rpm, "source": prep.speed.source}, "model": simulation.model_details(ds),
              "structural_path": path.to_dict(), "background": background.to_dict() if background else None,
-             "numerical_error": err, "ratio": {k_: v for k_, v in (ctx.get("ratio") or {}).items()},
+             "numerical_error": numerical_error, "ratio": {k_: v for k_, v in (ctx.get("ratio") or {}).items()},
              "healthy": {"decomposition": healthy["decomposition"], "speed": healthy["speed"]} if healthy else None,
              "compute": {"wall_time_s": float(ds.attrs["wall_time_s"]),
                          "compile_time_s": float(ds.attrs.get("compile_time_s", 0.0)),
@@ -192,7 +194,7 @@ def assemble(case, prep, path, background, signals, rows, err, healthy, ctx):
         prov["healthy reference"] = f"{healthy['recording']} (sha256 {healthy['sha256']})"
     if ctx.get("ratio"):
         prov["ratio companion"] = f"{ctx['ratio']['recording']} (sha256 {ctx['ratio']['sha256']})"
-    sections = _sections(case, prep, path, background, aligned, k, result, healthy)
+    sections = _sections(prep, result, path=path, background=background, aligned=aligned, shift_k=k, healthy=healthy)
     return CaseResult(rows, result, extra, prov, sections, path)
 
 
@@ -220,4 +222,5 @@ def run_recording_case(case, *, steps, mirror=None) -> CaseResult:
                                       duration=float(case.section("numerical_error").get("duration_s", 0.25)))
            if case.section("numerical_error").get("enabled", True) else {})
     steps.step("numerical error")
-    return assemble(case, prep, path, background, signals, rows, err, healthy, ctx)
+    return assemble(case, prep, path=path, background=background, signals=signals, rows=rows, numerical_error=err,
+                    healthy=healthy, context=ctx)

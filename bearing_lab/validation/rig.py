@@ -102,20 +102,21 @@ def _gain_on_signature(case, path, rec, measured, sim_x, period):
         return
     path.fit["signature_gain"] = trial.gain
     path.fit["signature_gain_sigma_db"] = sigma
-    _shape_residual(path, trial, x, bg, rec, fs, period, band)
+    _shape_residual(path, trial, rec, model=x, background=bg, period=period, band=band)
     path.fit.setdefault("notes", []).append(
-        f"impact-signature comparisons read the path with gain {trial.gain:.4g} ({20 * math.log10(trial.gain / path.gain):+.2f} dB "
-        f"from the fitted {path.gain:.4g}): the declared scene's signature ({band[0]:g}-{band[1]:g} Hz, path + "
-        f"background) then peaks where the recording's does; standard uncertainty {sigma:.3f} dB (4 interleaved "
-        "subsets of the impacts)")
+        f"impact-signature comparisons read the path with gain {trial.gain:.4g} "
+        f"({20 * math.log10(trial.gain / path.gain):+.2f} dB from the fitted {path.gain:.4g}): the declared "
+        f"scene's signature ({band[0]:g}-{band[1]:g} Hz, path + background) then peaks where the recording's "
+        f"does; standard uncertainty {sigma:.3f} dB (4 interleaved subsets of the impacts)")
 
 
-def _shape_residual(path, trial, x, bg, rec, fs, period, band):
+def _shape_residual(path, trial, rec, *, model, background, period, band):
     """The path's shape residual (``fit["signature_residual_db"]``, on the recording signature's time axis,
     and its RMS ``fit["signature_residual_rms_db"]``): how the declared scene's impact signature through the
     path differs in shape from the recording's.  Comparisons of *other* recordings through this path add it
     to their recording's log-envelope (see :mod:`bearing_lab.validation.signature`)."""
-    y = trial.apply(x, fs) + bg
+    fs = rec.fs
+    y = trial.apply(model, fs) + background
     sim = impact_signature(y, fs, impact_times(y, fs, period, band=band), band=band, period=period)
     meas = impact_signature(rec.x, fs, impact_times(rec.x, fs, period, band=band), band=band, period=period)
     r = shape_residual(sim, meas)
