@@ -8,9 +8,9 @@ Public API
     simulate, load_scene, Scene, list_scenes  -- scene -> xarray.Dataset (bearing_lab.sim)
     open_recording, list_engines              -- file -> xarray.Dataset, the readers (bearing_lab.io)
     to_netcdf, to_uff58b                      -- write a Dataset (bearing_lab.io)
-    analyze                                   -- signal -> speed, band, envelope spectrum, diagnosis (bearing_lab.analysis)
+    analyze                                   -- signal -> speed, envelope spectrum, diagnosis (bearing_lab.analysis)
     get_bearing, BearingGeometry, CATALOG     -- catalog geometry and kinematic fault frequencies (bearing_lab.bearings)
-    check_dataset                             -- the Dataset contract shared by recordings and simulations (bearing_lab.schema)
+    check_dataset                             -- the Dataset contract of recordings and simulations (bearing_lab.schema)
     run_sweep                                 -- many scenes on Dask (bearing_lab.sweep)
     identify                                  -- defect geometry from a recording (bearing_lab.validation.identify)
     BearingLabError, SceneError, RecordingError, AnalysisError, SolverError, ValidationCaseError

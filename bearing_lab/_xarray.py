@@ -9,12 +9,12 @@ has imported ``dask.array`` no dask array can exist; dask's own collection test 
 object for a ``__dask_graph__()`` that is not None, which needs no dask; and before the process
 has imported ``distributed`` (with no scheduler set in dask's config) no dask scheduler runs,
 so the three answers are known without the imports.  Importing this module teaches xarray
-those answers; the moment the process imports dask itself, xarray asks dask as before.  ``bearing_lab._accessor`` imports it, so
-every path that makes a Dataset (``simulate``, ``open_recording``, ``analysis``) has it.
+those answers; the moment the process imports dask itself, xarray asks dask.  ``bearing_lab._accessor``
+imports it, so every path that makes a Dataset (``simulate``, ``open_recording``, ``analysis``) has it.
 
 The hooks use xarray internals (``namedarray.pycompat._cached_duck_array_modules``,
-``namedarray.utils.is_dask_collection``, ``backends.locks.get_dask_scheduler``); on an xarray without them this module does nothing
-and xarray imports dask as it always did (slower, never wrong).  ``tests/test_imports.py``
+``namedarray.utils.is_dask_collection``, ``backends.locks.get_dask_scheduler``); on an xarray without
+them this module does nothing and xarray imports dask itself (slower, never wrong).  ``tests/test_imports.py``
 checks both that dask stays out and that chunked Datasets still write through dask.
 """
 from __future__ import annotations

@@ -117,7 +117,8 @@ class BearingGeometry:
 CATALOG: dict[str, BearingGeometry] = {
     "6308": BearingGeometry(
         "6308", 8, 15.081e-3, 65.0e-3, 0.0, bore=40e-3, outer_diameter=90e-3, width=23e-3,
-        source="Liu et al., Table 1 (6308-2RZ); conformities 0.52/0.53 assumed (Harris & Kotzalas typical deep-groove values)"),
+        source="Liu et al., Table 1 (6308-2RZ); conformities 0.52/0.53 assumed "
+               "(Harris & Kotzalas typical deep-groove values)"),
     "6205": BearingGeometry(
         "6205", 9, 0.3126 * INCH, 1.537 * INCH, 0.0, bore=25e-3, outer_diameter=52e-3, width=15e-3,
         source="CWRU drive end, 6205-2RS JEM SKF (CWRU bearing data center)"),

@@ -16,7 +16,7 @@ Public API
     bandpass(x, fs, *, band, axis=-1)                       -- ideal FFT band-pass
     squared_envelope(x, fs, *, band, prewhiten, axis)       -- |analytic(x)|**2 in U**2
     squared_envelope_spectrum(x, fs, *, window, band, prewhiten, fmax, axis) -- (f, SES in U**2)
-    fast_kurtogram(x, fs, *, nlevel, min_bandwidth, fmin)   -- Kurtogram(kurtosis, levels, frequency, band, level, kurtosis_max)
+    fast_kurtogram(x, fs, *, nlevel, min_bandwidth, fmin)   -- Kurtogram: kurtosis per level and band, the best band
     envelope_band(x, fs, *, frequency_range, min_bandwidth) -- (band, score): band with the strongest SES line family
     interpolated_peak(X, k, *, method)                      -- fractional bin of a DFT line (Quinn, Jacobsen, Hann)
     shaft_frequency(x, fs, *, window, rpm, ...)             -- (shaft Hz, number of harmonics used): strongest 1x family
@@ -33,7 +33,7 @@ Public API
     impulses(x, fs, *, band, threshold, min_separation, level) -- Impulses(time, peak, duration, entry, exit, resolved)
     rms, peak, peak_to_peak, crest_factor, kurtosis, impulse_factor, clearance_factor, shape_factor (x, *, axis)
     metrics(x, *, axis=-1, units="1")                       -- dict of the eight metrics + "units"
-    analyze(x, fs, *, bearing, rpm, rpm_source, shaft_hz, tacho, ...) -- dict: speed, graded verdict and evidence (docs/analysis.md)
+    analyze(x, fs, *, bearing, rpm, rpm_source, tacho, ...) -- dict: speed, verdict, evidence (docs/analysis.md)
     plot_analysis(x, fs, *, bearing, ..., path)             -- (figure, result): waveform, spectrum, SES with markers
     xr                                                      -- xarray wrappers of the above (apply_ufunc, dask-friendly)
 """

@@ -151,7 +151,8 @@ def measure(x, fs, *, bearing, rpm=None, shaft_hz=None, fault=None, duration_lev
     dict
         The keys of :data:`MEASURED` (NaN where the signal shows nothing) and ``extras``:
         ``analysis`` (the :func:`bearing_lab.analysis.analyze` result), ``band``,
-        ``impact_times``, ``duration_band`` (the band the impulse duration was measured in), ``notes`` (why a value is NaN), ``fault``, ``shaft_hz_used``,
+        ``impact_times``, ``duration_band`` (the band the impulse duration was measured in), ``notes``
+        (why a value is NaN), ``fault``, ``shaft_hz_used``,
         ``families`` (per BPFO/BPFI: ``detected``, the ``route`` that detected it, and
         ``evidence_margin_score``, the best route's evidence above its decoy threshold: how far the
         detection is from flipping).  BPFO and BPFI carry a value only where a route of the

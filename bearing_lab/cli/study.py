@@ -32,7 +32,8 @@ def _study(args) -> int:
 
 
 def register(sub) -> None:
-    p = sub.add_parser("study", help="run the paper's parametric studies (size, offset, skew, speed) and the slot's damping sensitivity")
+    p = sub.add_parser("study", help="run the paper's parametric studies (size, offset, skew, speed) and the "
+                                     "slot's damping sensitivity")
     p.add_argument("which", choices=["paper"], help="the study set")
     p.add_argument("-o", "--output", default="reports/studies", metavar="DIR")
     p.add_argument("--only", action="append", metavar="STUDY", help="size, offset, skew, speed or slot")

@@ -46,7 +46,8 @@ METHODS = {"dp54": 0, "bs32": 1, "rk4": 2}
 
 _COMPILED = {"kinds": set(), "seconds": 0.0}
 #: a scene of each kind of compiled loop (``_variants.KINDS``), for compiling them all at once
-_KIND_SCENES = {"kinematic": {}, "quasi_static": {"fidelity": "quasi-static"}, "dynamic": {"cage": {"model": "dynamic"}},
+_KIND_SCENES = {"kinematic": {}, "quasi_static": {"fidelity": "quasi-static"},
+                "dynamic": {"cage": {"model": "dynamic"}},
                 "3d_kinematic": {"load": {"axial_n": 20.0}},
                 "3d_quasi_static": {"load": {"axial_n": 20.0}, "fidelity": "quasi-static"}}
 

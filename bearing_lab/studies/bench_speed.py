@@ -228,8 +228,8 @@ def default_accuracy(label, base, ov, *, duration=0.1):
                step=ch.get("step_s") or None)
     m_ref = measures(ref["acc"][:, 1], sc.fs_out, sc)
     m = measures(res["acc"][:, 1], sc.fs_out, sc)
-    return dict(scene=label, err_peak=rel_err(m["peak"], m_ref["peak"]), err_period=rel_err(m["period"], m_ref["period"]),
-                method=ch["method"], rtol=ch["rtol"])
+    return dict(scene=label, err_peak=rel_err(m["peak"], m_ref["peak"]),
+                err_period=rel_err(m["period"], m_ref["period"]), method=ch["method"], rtol=ch["rtol"])
 
 
 def load_auto(base, ov, duration):
@@ -241,7 +241,8 @@ def tables(rows, infos, defaults, accs=()) -> str:
     best = best_per_method(rows)
     scenes = list(dict.fromkeys(r["scene"] for r in rows))
     methods = list(dict.fromkeys((r["solver"], r["method"]) for r in rows))
-    out = ["| scene | " +  " | ".join(f"{'ours' if sv == 'bearing_lab' else sv} {m}" for sv, m in methods) + " | scipy's best / ours' best (speed-up) |",
+    heads = " | ".join(f"{'ours' if sv == 'bearing_lab' else sv} {m}" for sv, m in methods)
+    out = ["| scene | " + heads + " | scipy's best / ours' best (speed-up) |",
            "|---|" + "---|" * (len(methods) + 1)]
     for s in scenes:
         cells = []

@@ -318,8 +318,8 @@ def _findings(s, rs):
         pk = [r["peak_acc_g"] for r in rs]
         parts.append(f"The peak acceleration spans {min(pk):.1f}-{max(pk):.1f} g over these choices "
                      f"({max(pk) / min(pk):.2f}x): the ball leaves the race over the slot and strikes the "
-                     "exit edge, and how that impact is damped moves the amplitude by that factor. No value is picked to "
-                     "match the paper; the default damps on the approach rate at the paper's c_max.")
+                     "exit edge, and how that impact is damped moves the amplitude by that factor. No value is "
+                     "picked to match the paper; the default damps on the approach rate at the paper's c_max.")
     return " ".join(parts)
 
 

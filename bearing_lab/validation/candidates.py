@@ -138,8 +138,9 @@ def _path_residual(prep, path, meas) -> tuple:
     if r is None or context(prep.case, prep, path)["path_fitted_here"]:
         return None, ""
     r = np.asarray(r, float)
-    if abs(float(path.fit.get("signature_residual_fs_hz", 0.0)) - prep.fs) > 1e-6 * prep.fs or r.shape != meas.envelope.shape:
-        return None, (f"the path's shape residual was measured at {path.fit.get('signature_residual_fs_hz', 0.0):g} Hz, "
+    measured_at = float(path.fit.get("signature_residual_fs_hz", 0.0))
+    if abs(measured_at - prep.fs) > 1e-6 * prep.fs or r.shape != meas.envelope.shape:
+        return None, (f"the path's shape residual was measured at {measured_at:g} Hz, "
                       f"this recording is at {prep.fs:g} Hz: not removed")
     return r, (f"the path's shape residual ({float(np.sqrt(np.mean(r * r))):.2f} dB RMS, measured on the recording the "
                "path was identified on, against its declared scene) is removed from every candidate's shape misfit")

@@ -205,7 +205,8 @@ def new_case_text(recording, *, name=None, bearing=None, speed=None, channel=Non
              f"duration_s = {_seconds(compared)}{' ' * max(1, 17 - len(_seconds(compared)))}# compared and simulated "
              f"duration, s: {'the whole record' if compared >= dur else 'the first %g s of the record' % compared}",
              "",
-             "# [reference]                  # a healthy recording of the same rig (optional): background, healthy rows",
+             "# [reference]                  # a healthy recording of the same rig (optional): "
+             "background, healthy rows",
              "# file = \"healthy.uff\"", "",
              "# [load]                       # the radial load you applied",
              "# radial_n = 300.0",

@@ -166,8 +166,8 @@ def run_paper_case(case, out_dir, *, steps):
         ("figures", "Waveforms and spectra (the paper's Figs 8-11)", figs + [figures.envelope_spectra(result)])]
     if studies:
         sections.append(("table", "Section 5 trends (2-D defect studies)", {"rows": studies["trends"], "intro": (
-            f"From bearing_lab.studies.paper.run_paper_studies ({studies['seconds']:.1f} s); its own page with the pulse "
-            "figures: studies/index.html. A trend counts as reproduced when it is monotonic over the study's three "
-            "cases.")}))
+            f"From bearing_lab.studies.paper.run_paper_studies ({studies['seconds']:.1f} s); its own page with the "
+            "pulse figures: studies/index.html. A trend counts as reproduced when it is monotonic over the "
+            "study's three cases.")}))
         extra["studies"] = {"trends": studies["trends"], "table": studies["table"]}
     return CaseResult(rows, result, extra, prov, sections, None)

@@ -15,7 +15,7 @@ make_row(quantity, simulation, experiment, tolerance, ...) -> dict
 row_status(row) -> "pass" | "known limitation" | "fail"
 case_verdict(rows) -> dict                          -- a case's verdict in words and its three counts
 VERDICTS                                            -- verdict -> what it means (CLI, pages, docs)
-EXIT_STATUS                                         -- what `bearing-lab validate` returns, in words (--help, pages, docs)
+EXIT_STATUS                                         -- what `bearing-lab validate` returns, in words (--help, pages)
 ROW_KEYS                                            -- the keys every row has (summary.json, netCDF)
 """
 from __future__ import annotations
@@ -197,7 +197,8 @@ def make_row(quantity: str, simulation, experiment, tolerance: Tolerance, *, lab
            "difference": diff, "difference_pct": pct, "tolerance_pct": tolerance.pct,
            "tolerance": tolerance.text(), "rule": tolerance.kind, "pass": bool(ok), "reason": tolerance.reason,
            "known_limitation": tolerance.known_limitation,
-           "declared_by": tolerance.declared_by if tolerance.known_limitation else "", "note": "; ".join(notes), "simulated_signal": signal,
+           "declared_by": tolerance.declared_by if tolerance.known_limitation else "", "note": "; ".join(notes),
+           "simulated_signal": signal,
            "experiment_span": span, "independent": bool(independent), "paper_simulation": _f(paper_simulation)}
     row["status"] = row_status(row)
     return row

@@ -42,8 +42,10 @@ Public API
 ----------
 Signature                                       -- time (s, relative to the impact), envelope (m s-2), n_impacts
 impact_signature(x, fs, times, *, band, window_s=(-0.002, 0.006)) -> Signature
-misfit(sim, meas, *, level_weight=1.0, level_tolerance_db=0.0, floor=0.05, max_lag_s=0.001, residual_db=None) -> dict
-shape_residual(sim, meas, *, floor=0.05, max_lag_s=0.001) -> ndarray   -- the model's log-envelope residual, meas's frame
+misfit(sim, meas, *, level_weight=1.0, level_tolerance_db=0.0, floor=0.05, max_lag_s=0.001,
+       residual_db=None) -> dict
+shape_residual(sim, meas, *, floor=0.05, max_lag_s=0.001) -> ndarray  -- the model's log-envelope residual
+                                                                        (meas's frame)
 """
 from __future__ import annotations
 
