@@ -44,7 +44,7 @@ SIGNAL_COLORS = {"experiment": "k", "recording": "k", "model": "tab:blue", "path
                  "path+background": "tab:purple"}
 
 
-def _f(v) -> float:
+def _float_or_nan(v) -> float:
     try:
         return float(v) if v is not None else float("nan")
     except (TypeError, ValueError):
@@ -228,7 +228,7 @@ def table_dataset(rows: list[dict]) -> xr.Dataset:
     for k in _TEXT_KEYS[1:]:
         data[k] = ("quantity", np.array([str(r.get(k, "")) for r in rows], dtype=object))
     for k in _FLOAT_KEYS:
-        data[k] = ("quantity", np.array([_f(r.get(k)) for r in rows], dtype=float))
+        data[k] = ("quantity", np.array([_float_or_nan(r.get(k)) for r in rows], dtype=float))
     for k in _BOOL_KEYS:
         data[k] = ("quantity", np.array([bool(r.get(k, True)) for r in rows], dtype=bool))
     return xr.Dataset(data, coords={"quantity": ("quantity", np.array(q, dtype=object))})

@@ -56,3 +56,15 @@ def test_bench_writes_report_rules_and_rows(tmp_path):
         assert (b["method"], b["rtol"]) == best[:2] and b["expected_peak_error"] <= 0.01
     assert "200 kHz" in ds.attrs["rate_table_md"]
     assert np.isfinite(ds["cost"].values).all()
+
+
+def test_one_tolerance_rule_for_both_benchmarks():
+    """Peak error within TOL_PEAK; the period error counts only where the reference has a period."""
+    from bearing_lab.studies.bench_common import TOL_PEAK, TOL_PERIOD, within_tolerance
+    good = {"err_peak": TOL_PEAK / 2, "err_period": TOL_PERIOD / 2}
+    assert within_tolerance(good, 0.01)
+    assert not within_tolerance({**good, "err_peak": 2 * TOL_PEAK}, 0.01)
+    assert not within_tolerance({**good, "err_peak": math.nan}, 0.01)
+    assert not within_tolerance({**good, "err_period": 2 * TOL_PERIOD}, 0.01)
+    assert not within_tolerance({**good, "err_period": math.nan}, 0.01)       # a period the run lost
+    assert within_tolerance({**good, "err_period": math.nan}, math.nan)       # none to lose

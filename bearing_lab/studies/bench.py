@@ -26,7 +26,7 @@ from ..sim.assembly import assemble
 from ..sim.integrate import METHODS, _run, _warm_up, anti_alias_taps
 from ..utils._files import savefig, write_text
 from ..utils.figures import new_figure
-from .bench_common import TOL_PEAK, TOL_PERIOD, bench_scene, measures, rel_err
+from .bench_common import TOL_PEAK, TOL_PERIOD, bench_scene, measures, rel_err, within_tolerance
 from .bench_speed import all_rows_table, equal_accuracy, tables
 
 #: the defect-contact model of the reference and of the solver rows (the default); the
@@ -170,7 +170,7 @@ def rate_choices(rows) -> dict:
             best = None
             for key in dict.fromkeys((r["method"], r["rtol"]) for r in rs):
                 sel = [r for r in rs if (r["method"], r["rtol"]) == key]
-                if len(sel) != len(scenes) or not all(_ok(r) for r in sel):
+                if len(sel) != len(scenes) or not all(_accurate(r) for r in sel):
                     continue
                 cost = float(np.mean([r["cost"] for r in sel]))
                 if best is None or cost < best[3]:
@@ -196,6 +196,11 @@ def _rate_rules(rows) -> str:
     return "\n".join(lines)
 
 
+def _accurate(row) -> bool:
+    """The row within tolerance of its scene's reference (its ``ref_period`` says whether that has a period)."""
+    return within_tolerance(row, row.get("ref_period", math.nan))
+
+
 def _worst(values) -> str:
     v = [x for x in values if math.isfinite(x)]
     return f"{max(v):.1e}" if v else "-"
@@ -214,7 +219,7 @@ def rate_table(rows) -> str:
             picked = any(c is not None and c[:2] == key and f == fs for (_, f), c in choice.items())
             lines.append(f"| {fs / 1e3:g} kHz | {key[0]} rtol={key[1]:g} | {w['err_peak']:.1e} | {w['scene']} | "
                          f"{_worst(r['err_period'] for r in sel)} | {np.mean([r['cost'] for r in sel]):.3f} | "
-                         f"{'yes' if all(_ok(r) for r in sel) else 'no'}{' (auto)' if picked else ''} |")
+                         f"{'yes' if all(_accurate(r) for r in sel) else 'no'}{' (auto)' if picked else ''} |")
     return "\n".join(lines)
 
 
@@ -290,17 +295,8 @@ def run_bench(out_dir="reports/performance", *, duration=0.3, scipy_duration=0.1
     return ds
 
 
-def _ok(r):
-    # a period that could not be measured passes only where the reference has none either
-    if math.isfinite(r.get("ref_period", math.nan)):
-        per_ok = math.isfinite(r["err_period"]) and r["err_period"] <= TOL_PERIOD
-    else:
-        per_ok = True
-    return math.isfinite(r["err_peak"]) and r["err_peak"] <= TOL_PEAK and per_ok
-
-
 def fastest_within_tolerance(rows, scene):
-    cands = [r for r in rows if r["scene"] == scene and r["solver"] == "bearing_lab" and _ok(r)]
+    cands = [r for r in rows if r["scene"] == scene and r["solver"] == "bearing_lab" and _accurate(r)]
     return min(cands, key=lambda r: r["cost"]) if cands else None
 
 
@@ -325,7 +321,7 @@ def _rules(rows) -> str:
             settings.setdefault((r["fidelity"], r["method"], r["rtol"], r["step"], r["max_step"]), []).append(r)
         best = None
         for key, rs in settings.items():
-            if len(rs) == len(scenes) and all(_ok(r) for r in rs):
+            if len(rs) == len(scenes) and all(_accurate(r) for r in rs):
                 cost = float(np.mean([r["cost"] for r in rs]))
                 worst = max(r["err_peak"] for r in rs)
                 if best is None or cost < best[1]:

@@ -24,7 +24,7 @@ from ..sim.integrate import _decimate_acc, anti_alias_taps
 # scipy's solve_ivp, the reference the benchmark compares against: loaded when it runs
 _integrate = lazy.load("scipy.integrate", suppress_warning=True)
 
-__all__ = ["TOL_PEAK", "TOL_PERIOD", "bench_scene", "measures", "scipy_acc", "rel_err"]
+__all__ = ["TOL_PEAK", "TOL_PERIOD", "bench_scene", "measures", "scipy_acc", "rel_err", "within_tolerance"]
 
 #: the benchmarks' tolerance: relative error in peak acceleration, and in excitation period
 TOL_PEAK = 0.01
@@ -100,6 +100,16 @@ def scipy_acc(asm, method, rtol, max_step=2.5e-5):
     v = sol.sol(fine_t)[[6, 7]].T
     acc = _decimate_acc(dict(fine_out=v, dt_f=dt_f, taps=taps, m_pad=m_pad, R=R, n_out=n_out))
     return acc[:, 1], cost
+
+
+def within_tolerance(row, ref_period) -> bool:
+    """Whether a benchmark row is accurate enough: its peak error (``err_peak``) within :data:`TOL_PEAK`
+    and, where the reference has an excitation period (``ref_period`` finite), its period error
+    (``err_period``) within :data:`TOL_PERIOD`; a period that could not be measured passes only where
+    the reference has none either."""
+    if not (math.isfinite(row["err_peak"]) and row["err_peak"] <= TOL_PEAK):
+        return False
+    return not math.isfinite(ref_period) or (math.isfinite(row["err_period"]) and row["err_period"] <= TOL_PERIOD)
 
 
 def rel_err(a, b):

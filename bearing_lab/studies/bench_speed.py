@@ -38,7 +38,7 @@ from ..sim.assembly import assemble
 from ..sim.auto import resolve
 from ..sim.integrate import METHODS, _run, _warm_up
 from ..units import G
-from .bench_common import TOL_PEAK, TOL_PERIOD, bench_scene, measures, rel_err, scipy_acc
+from .bench_common import bench_scene, measures, rel_err, scipy_acc, within_tolerance
 
 
 SPEED_SCENES = [
@@ -68,12 +68,6 @@ def _cpu(fn, *args, repeats=1, **kw):
     return out, best
 
 
-def _ok(row, ref_period):
-    if not math.isfinite(row["err_peak"]) or row["err_peak"] > TOL_PEAK:
-        return False
-    return not math.isfinite(ref_period) or (math.isfinite(row["err_period"]) and row["err_period"] <= TOL_PERIOD)
-
-
 def equal_accuracy(label, base, ov, *, duration=0.1, scipy=True, repeats=2, progress=None):
     """Rows (one per setting) of ours and scipy's methods against one converged reference."""
     sc = bench_scene(base, ov, duration)
@@ -96,7 +90,7 @@ def equal_accuracy(label, base, ov, *, duration=0.1, scipy=True, repeats=2, prog
         row = dict(scene=label, solver=solver, method=method, setting=setting, cost=cpu / t_sim,
                    err_peak=rel_err(m["peak"], m_ref["peak"]), err_period=rel_err(m["period"], m_ref["period"]),
                    **(extra or {}))
-        row["ok"] = _ok(row, m_ref["period"])
+        row["ok"] = within_tolerance(row, m_ref["period"])
         rows.append(row)
         if progress:
             progress(row)
@@ -144,7 +138,7 @@ def quasi_static(label, base, ov, *, duration=0.1, repeats=2):
                    err_peak=rel_err(m["peak"], ref_mb["peak"]), err_period=rel_err(m["period"], ref_mb["period"]),
                    num_err_peak=rel_err(m["peak"], ref_qs["peak"]), steps=int(res["stats"][0]),
                    rejected=int(res["stats"][1]))
-        row["ok"] = _ok(row, ref_mb["period"])
+        row["ok"] = within_tolerance(row, ref_mb["period"])
         rows.append(row)
     return rows
 

@@ -111,7 +111,7 @@ class Tolerance:
         return 1.0 / self.value <= sim / exp <= self.value
 
 
-def _f(v) -> float:
+def _float_or_nan(v) -> float:
     try:
         return float(v) if v is not None else float("nan")
     except (TypeError, ValueError):
@@ -177,7 +177,7 @@ def make_row(quantity: str, simulation, experiment, tolerance: Tolerance, *, lab
     >>> make_row("bpfo", None, 92.19, tol, label="BPFO", units="Hz")["note"]
     'missing value (simulation): counts as a failure'
     """
-    s, e = _f(simulation), _f(experiment)
+    s, e = _float_or_nan(simulation), _float_or_nan(experiment)
     ok = tolerance.check(s, e)
     notes = [note] if note else []
     both_absent = absence_agrees and not math.isfinite(s) and not math.isfinite(e)
@@ -193,12 +193,12 @@ def make_row(quantity: str, simulation, experiment, tolerance: Tolerance, *, lab
     diff = s - e
     pct = 100.0 * diff / abs(e) if (math.isfinite(diff) and e != 0) else float("nan")
     row = {"quantity": quantity, "label": label, "units": units, "simulation": s, "experiment": e,
-           "reference_value": _f(reference_value), "reference_label": reference_label,
+           "reference_value": _float_or_nan(reference_value), "reference_label": reference_label,
            "difference": diff, "difference_pct": pct, "tolerance_pct": tolerance.pct,
            "tolerance": tolerance.text(), "rule": tolerance.kind, "pass": bool(ok), "reason": tolerance.reason,
            "known_limitation": tolerance.known_limitation,
            "declared_by": tolerance.declared_by if tolerance.known_limitation else "", "note": "; ".join(notes),
-           "simulated_signal": signal,
-           "experiment_span": span, "independent": bool(independent), "paper_simulation": _f(paper_simulation)}
+           "simulated_signal": signal, "experiment_span": span, "independent": bool(independent),
+           "paper_simulation": _float_or_nan(paper_simulation)}
     row["status"] = row_status(row)
     return row

@@ -233,14 +233,15 @@ def _index_entry(oc) -> dict:
             "link": f"{oc.name}/index.html" if oc.status in ("pass", "fail") else None, "reason": oc.reason}
 
 
-def _run_one(c, out_dir, progress, mirror):
+def _outcome(case, out_dir, progress, mirror):
+    """The case run, or its failure to run as an \"error\" outcome (the other cases go on)."""
     try:
-        return run_case(c, out_dir, progress=progress, mirror=mirror)
+        return run_case(case, out_dir, progress=progress, mirror=mirror)
     except Exception as exc:  # one broken case must not lose the others' reports: listed as "error"
         msg = f"{exc}" if isinstance(exc, BearingLabError) else f"{type(exc).__name__}: {exc}"
         msg = msg.splitlines()[0] if msg else type(exc).__name__
-        print(f"bearing-lab validate: case {c.name!r} failed to run: {msg}", file=sys.stderr)
-        return CaseOutcome(c.name, c.title, "error", reason=msg)
+        print(f"bearing-lab validate: case {case.name!r} failed to run: {msg}", file=sys.stderr)
+        return CaseOutcome(case.name, case.title, "error", reason=msg)
 
 
 @fill_doc
@@ -298,7 +299,7 @@ def run_validation(specs=None, out_dir="reports", *, strict=False, progress=True
     for c in cases:
         if bar is not None:
             bar.set_postfix_str(c.name)
-        outcomes.append(_run_one(c, out_dir, progress, mirror))
+        outcomes.append(_outcome(c, out_dir, progress, mirror))
         if bar is not None:
             bar.update(1)
     if bar is not None:
