@@ -102,7 +102,7 @@ class Uff58Reader(RecordingReader):
         return self._read(data, b, channels, allow_truncated, fs, snap_rate)
 
     # -- scanning -------------------------------------------------------------------
-    def _scan(self, mm, b, allow_truncated):
+    def _scan(self, mm, b):
         """The file's sets (:func:`._uff_sets.scan_sets`), with the byte order the caller forced."""
         return scan_sets(mm, b, self._force_bo)
 
@@ -240,7 +240,7 @@ class Uff58Reader(RecordingReader):
     def _read(self, mm, b, channels, allow_truncated, fs_override, snap_rate):
         if len(mm) == 0:  # pragma: no cover - open_recording refuses empty files earlier
             b.fail("file is empty")
-        sets = self._scan(mm, b, allow_truncated)
+        sets = self._scan(mm, b)
         if not sets:
             b.fail("no datasets found between '-1' delimiters")
         units164, times = self._sort_sets(mm, sets, b)

@@ -47,8 +47,8 @@ from .auto import warn_off_track
 from .bearing3d import check_axial_keys, needs_3d
 from .defects import Defect  # the 2-D defect description
 from .defects import contact  # its registry CONTACT_MODELS, read at call time (models register at run time)
-from .limits import SceneWarning, check_limits  # noqa: F401  (SceneWarning: a scene's warning type)
-from .scene_keys import _NUM, DEFECT_KEYS, SCHEMA, STEEL_DENSITY  # noqa: F401  (the table of scene keys)
+from .limits import check_limits
+from .scene_keys import _NUM, DEFECT_KEYS, SCHEMA
 
 
 #: the shortest settling time of a scene with an axial load (the 3-D bearing), s

@@ -309,7 +309,7 @@ def test_big_58b_scanned_header_first(tmp_path):
     mm = _map(p)
     try:
         t0 = time.perf_counter()
-        sets = r._scan(mm, RecordingBuilder(p, r, checksum=False), False)
+        sets = r._scan(mm, RecordingBuilder(p, r, checksum=False))
         elapsed = time.perf_counter() - t0
     finally:
         mm.close()

@@ -133,7 +133,7 @@ def test_a_defect_the_3d_track_leaves_takes_the_healthy_rule_within_its_toleranc
     from bearing_lab.sim.auto import load_rules, resolve
     ov = {"defect.offset_mm": -2.3, "load.axial_n": 300.0}
     assert resolve(load_scene("paper-O1", **{"defect.offset_mm": -2.3}))["kind"] == "defect"
-    from bearing_lab.sim.scene import SceneWarning
+    from bearing_lab.sim.limits import SceneWarning
     with pytest.warns(SceneWarning, match="misses the ball track at the contact angle of the axial load"):
         load_scene("paper-O1", **ov)
     ref = simulate("paper-O1", duration=0.1, progress=False, **REF, **ov)
@@ -198,7 +198,7 @@ def test_a_grazed_defect_takes_the_tight_setting_and_its_peak_holds():
 
     from bearing_lab.sim import load_scene, simulate
     from bearing_lab.sim.auto import resolve
-    from bearing_lab.sim.scene import SceneWarning
+    from bearing_lab.sim.limits import SceneWarning
     grazed = {"load.axial_n": 300.0}
     with warnings.catch_warnings():
         warnings.simplefilter("error", SceneWarning)

@@ -15,7 +15,8 @@ import pytest
 from bearing_lab.errors import BearingLabError, SceneError, SolverError
 from bearing_lab.sim import load_scene, simulate
 from bearing_lab.sim.budget import check_budget, work_estimate
-from bearing_lab.sim.scene import SceneWarning, merge_overrides, parse_set
+from bearing_lab.sim.limits import SceneWarning
+from bearing_lab.sim.scene import merge_overrides, parse_set
 
 HOSTILE = [
     (["output.settle_s=1e9"], "budget.max_steps"),
