@@ -68,6 +68,11 @@ def open_at_rate(path, fs=None, *, name="fs"):
         No such file, or the reader refuses it.
     AnalysisError
         ``fs`` is not a positive number.
+
+    See Also
+    --------
+    signal_rate : the rate when none is given.
+    bearing_lab.io.open_recording : the readers and their options.
     """
     path = Path(path)
     if not path.is_file():
@@ -87,7 +92,19 @@ def open_at_rate(path, fs=None, *, name="fs"):
 
 def signal_rate(ds, channel) -> float:
     """The sampling rate of ``ds[channel]``, Hz: the Dataset's ``sampling_rate_hz``, else the
-    channel's own attribute or time axis (:func:`bearing_lab.analysis.xr.sampling_rate`)."""
+    channel's own attribute or time axis (:func:`bearing_lab.analysis.xr.sampling_rate`).
+
+    See Also
+    --------
+    open_at_rate : a rate the caller gives instead.
+
+    Examples
+    --------
+    >>> import numpy as np, xarray as xr
+    >>> ds = xr.Dataset({"acc": ("time", np.zeros(5))}, coords={"time": np.arange(5) / 2000.0})
+    >>> signal_rate(ds, "acc"), signal_rate(ds.assign_attrs(sampling_rate_hz=48000.0), "acc")
+    (2000.0, 48000.0)
+    """
     if "sampling_rate_hz" in ds.attrs:
         return float(ds.attrs["sampling_rate_hz"])
     return sampling_rate(ds[channel])
@@ -101,6 +118,17 @@ def shaft_rpm(ds, value=None, *, source="", name="rpm"):
     an :class:`~bearing_lab.errors.AnalysisError` when there is none.  A number: that speed
     ("given"), which must be positive.  ``source`` (the file) and ``name`` (how the caller calls
     ``value``, ``"--rpm"`` on the command line) start the messages.
+
+    See Also
+    --------
+    bearing_lab.analysis.analyze : takes the two as ``rpm`` and ``rpm_source``.
+
+    Examples
+    --------
+    >>> import xarray as xr
+    >>> ds = xr.Dataset(attrs={"shaft_speed_rpm": 1797.0})
+    >>> shaft_rpm(ds), shaft_rpm(ds, "none"), shaft_rpm(ds, 1750)
+    ((1797.0, 'file'), (None, 'given'), (1750.0, 'given'))
     """
     stored = ds.attrs.get("shaft_speed_rpm")
     if value is None:

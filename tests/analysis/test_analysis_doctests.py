@@ -5,7 +5,8 @@ import importlib
 import pytest
 
 MODULES = ["analysis._spectral", "analysis._speed", "analysis._faults", "analysis._impulse", "analysis._metrics",
-           "analysis.pipeline", "_accessor", "analysis._cyclo", "analysis._tacho", "errors", "utils.figures"]
+           "analysis.pipeline", "_accessor", "analysis._cyclo", "analysis._tacho", "analysis.inputs", "errors",
+           "utils.figures"]
 
 
 @pytest.mark.parametrize("name", MODULES)
