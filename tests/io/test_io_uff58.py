@@ -289,33 +289,36 @@ def test_wrong_byte_order_override(write, sine):
 
 
 def test_big_58b_scanned_header_first(tmp_path):
-    """A 1 GB 58b: the scan reads only headers (seeks past payloads), so it is instant.
+    """The scan reads headers and seeks past binary payloads, never through them.
 
-    The file is sparse (the payload is a hole), so this costs no disk and no memory.
+    Two files: a 1 GiB set whose payload is a hole (sparse: no disk, no memory), and a 1 MiB set
+    whose payload is text that looks like set delimiters and headers (``-1``, ``58b``) — a scanner
+    that read through a payload would stop inside it and report another extent or more sets.
     """
-    import time
     from bearing_lab.io._base import RecordingBuilder
     from bearing_lab.io.uff58 import Uff58Reader
-    n = 2 ** 27  # float64 -> 1 GiB per set
-    p = tmp_path / "big.uff"
-    head = uff58_block(np.zeros(1), binary=True, num_pts=n, nbytes=n * 8)
-    head = head[: head.rindex(b"\n", 0, len(head) - 8) + 1]  # header only, up to the payload
-    with open(p, "wb") as fh:
-        fh.write(head)
-        fh.seek(len(head) + n * 8)
-        fh.write(b"    -1\n")
-    r = Uff58Reader()
-    r._force_bo = None
-    mm = _map(p)
-    try:
-        t0 = time.perf_counter()
-        sets = r._scan(mm, RecordingBuilder(p, r, checksum=False))
-        elapsed = time.perf_counter() - t0
-    finally:
-        mm.close()
-    assert len(sets) == 1 and sets[0].header["num_pts"] == n
-    assert sets[0].data_end - sets[0].data_start == n * 8
-    assert elapsed < 0.5
+    junk = b"\n    -1\n    -1\n    58b     2     1    11     800     3   800\n"
+    for n, fill in ((2 ** 27, None), (2 ** 17, junk)):     # float64 values: 1 GiB, 1 MiB
+        p = tmp_path / f"big{n}.uff"
+        head = uff58_block(np.zeros(1), binary=True, num_pts=n, nbytes=n * 8)
+        head = head[: head.rindex(b"\n", 0, len(head) - 8) + 1]  # header only, up to the payload
+        with open(p, "wb") as fh:
+            fh.write(head)
+            if fill is None:
+                fh.seek(len(head) + n * 8)
+            else:
+                body = fill * (n * 8 // len(fill) + 1)
+                fh.write(body[: n * 8])
+            fh.write(b"    -1\n")
+        r = Uff58Reader()
+        r._force_bo = None
+        mm = _map(p)
+        try:
+            sets = r._scan(mm, RecordingBuilder(p, r, checksum=False))
+        finally:
+            mm.close()
+        assert len(sets) == 1 and sets[0].header["num_pts"] == n, p.name
+        assert sets[0].data_start == len(head) and sets[0].data_end - sets[0].data_start == n * 8, p.name
 
 
 def test_line_break_before_payload(write, sine):
