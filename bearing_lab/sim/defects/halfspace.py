@@ -164,10 +164,15 @@ class HalfSpace:
         self.shear = int(shear)
         # the grid offsets the array offsets reach: |di| < nx, |dj + m di| < ny + |m| (nx - 1)
         need = (nx, ny + abs(self.shear) * (nx - 1))
-        if kern is not None and kern.shape[0] >= need[0] and kern.shape[1] >= need[1]:
+        if kern is None:
+            k = love_influence(*need, dx, dy, e_star)
+        elif kern.shape[0] >= need[0] and kern.shape[1] >= need[1]:
             k = kern[:need[0], :need[1]]
         else:
-            k = love_influence(*need, dx, dy, e_star)
+            # a box of a larger grid whose kernel is given (:meth:`solve_batch`): offsets beyond
+            # it join a cell outside that grid, which never carries pressure: zero there
+            k = np.zeros(need)
+            k[:min(need[0], kern.shape[0]), :min(need[1], kern.shape[1])] = kern[:need[0], :need[1]]
         self._crops: dict[tuple[int, int, int], HalfSpace] = {}
         # the kernel spans offsets -(n-1)..(n-1): a period of 2n - 1 avoids wrap-around
         self.mx = sfft.next_fast_len(2 * nx - 1, real=True)
