@@ -42,7 +42,8 @@ semi-axes from the pressure's second moments within 0.7 % up to 8.4 µm (800 N);
 share of the intact force carried over a centred 1 x 1 mm defect converges to first
 order in the cell size (the pressure is singular at the pit's edge), which the
 two-grid extrapolation of :mod:`.contact` removes.  One approach node (both grids) costs
-about 13 ms of CPU for a rectangle along the track and 55 ms for a skewed one; figures in
+about 11 ms of CPU for a rectangle along the track and 40 ms for a skewed one (70 ms off the
+track's centre line, where no mirror symmetry halves the ball positions); figures in
 ``docs/contact-model.md``.
 
 What is neglected: the pit is a pressure-free region of the half-space surface; the
