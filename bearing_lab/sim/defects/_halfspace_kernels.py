@@ -73,12 +73,14 @@ def cg_direction(p, u, g, hd, t, allowed, restart, g_old, floor, k00, stalled, e
         gz = 0.0
         for i in range(nx):
             for j in range(ny):
+                if p[k, i, j] <= 0.0:
+                    z[k, i, j] = 0.0
+                    continue
                 jc = j + b
                 zz = (sc * gc[k, i + 1, jc] + sx * (gc[k, i, jc + m] + gc[k, i + 2, jc - m])
                       + sy * (gc[k, i + 1, jc - 1] + gc[k, i + 1, jc + 1])
                       + sd * (gc[k, i, jc - 1 + m] + gc[k, i + 2, jc - 1 - m] + gc[k, i, jc + 1 + m]
                               + gc[k, i + 2, jc + 1 - m]))
-                zz = zz if p[k, i, j] > 0.0 else 0.0
                 z[k, i, j] = zz
                 gz += gc[k, i + 1, jc] * zz
         beta = 0.0 if restart[k] or g_old[k] <= 0.0 else gz / g_old[k]
