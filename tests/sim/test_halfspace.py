@@ -235,3 +235,20 @@ def test_concurrent_processes_share_one_valid_entry(tmp_path, monkeypatch):
         T = contact_table(Defect(length=1.5e-3, width=0.7e-3), B6308, model="area", delta_max=DMAX)
     assert T.info["source"] == "disk"
     np.testing.assert_array_equal(T.G, g0)
+
+
+@pytest.mark.parametrize("module", ["halfspace.py", "halfspace_skewed.py", "_halfspace_kernels.py", "geometry.py",
+                                    "contact.py"])
+def test_cache_key_follows_the_table_code(module, monkeypatch):
+    """An edit of any module the tables are built by (the solver, its compiled kernels, the contact's
+    geometry, the table's assembly) gives new cache keys, so no table of the old code is served."""
+    from bearing_lab.sim.defects import _table_cache
+    args = dict(model="halfspace", clearance=0.0, delta_max=DMAX, n_psi=None, n_delta=41, against=None,
+                material=(208e9, 0.3))
+    d = Defect(length=1e-3, width=1e-3)
+    monkeypatch.setattr(_table_cache, "_SOURCE", [])
+    key = table_key(d, B6308, **args)
+    read = Path.read_bytes
+    monkeypatch.setattr(Path, "read_bytes", lambda p: read(p) + (b"#" if p.name == module else b""))
+    monkeypatch.setattr(_table_cache, "_SOURCE", [])
+    assert table_key(d, B6308, **args) != key

@@ -26,15 +26,19 @@ from numba import njit
 
 
 @njit(cache=True)
-def cg_direction(p, u, g, hd, t, allowed, restart, g_old, floor, k00, stalled, exact, stencil, gc, z):
+def cg_direction(p, u, g, hd, t, allowed, restart, g_old, floor, k00, stalled, exact, stencil, gc, z, shear):
     """The gap ``g = u + hd`` (``u`` the displacement), the new search direction ``t`` in place.
 
     Preconditioned (:func:`.halfspace.preconditioner_stencil`): ``z = M^-1 g`` with
     ``M^-1`` the symmetric 3 x 3 ``stencil`` (divided by ``k00``: Pa per m of gap), applied
     to ``g`` on the contact set and read there only, so that it acts as its restriction to
     the contact set; ``t = z + beta t``, ``beta = (g.z) / (g.z)_previous``.  A stencil with
-    only its centre (1) is the plain method.  Work space: ``gc`` (K, nx + 2, ny + 2) with a
-    zero border, ``z`` of ``g``'s shape.
+    only its centre (1) is the plain method.  Work space: ``gc`` (K, nx + 2, ny + 2 + 2 |shear|)
+    with a zero border, ``z`` of ``g``'s shape.
+
+    ``shear`` m: the arrays hold the cells in a sheared layout, index (i, j) being the grid's
+    cell (i, j + m i) (:class:`.halfspace.HalfSpace`); the stencil's weights stay those of the
+    cells' physical neighbours (offset (di, dj) sits at (di, dj - m di) in the arrays).
 
     A problem whose contact set is in equilibrium (or empty; ``sum g^2 <= floor``) is
     ``stalled``: its penetrating cells outside the contact enter with the pressure that
@@ -42,6 +46,8 @@ def cg_direction(p, u, g, hd, t, allowed, restart, g_old, floor, k00, stalled, e
     """
     K, nx, ny = p.shape
     sc, sx, sy, sd = stencil[1, 1] / k00, stencil[0, 1] / k00, stencil[1, 0] / k00, stencil[0, 0] / k00
+    m = shear
+    b = 1 + abs(m)
     for k in range(K):
         G = 0.0
         for i in range(nx):
@@ -49,7 +55,7 @@ def cg_direction(p, u, g, hd, t, allowed, restart, g_old, floor, k00, stalled, e
                 gk = u[k, i, j] + hd[k, i, j]
                 g[k, i, j] = gk
                 c = gk if p[k, i, j] > 0.0 else 0.0
-                gc[k, i + 1, j + 1] = c
+                gc[k, i + 1, j + b] = c
                 G += c * c
         stalled[k] = G <= floor[k]
         exact[k] = False
@@ -67,12 +73,16 @@ def cg_direction(p, u, g, hd, t, allowed, restart, g_old, floor, k00, stalled, e
         gz = 0.0
         for i in range(nx):
             for j in range(ny):
-                zz = (sc * gc[k, i + 1, j + 1] + sx * (gc[k, i, j + 1] + gc[k, i + 2, j + 1])
-                      + sy * (gc[k, i + 1, j] + gc[k, i + 1, j + 2])
-                      + sd * (gc[k, i, j] + gc[k, i + 2, j] + gc[k, i, j + 2] + gc[k, i + 2, j + 2]))
-                zz = zz if p[k, i, j] > 0.0 else 0.0
+                if p[k, i, j] <= 0.0:
+                    z[k, i, j] = 0.0
+                    continue
+                jc = j + b
+                zz = (sc * gc[k, i + 1, jc] + sx * (gc[k, i, jc + m] + gc[k, i + 2, jc - m])
+                      + sy * (gc[k, i + 1, jc - 1] + gc[k, i + 1, jc + 1])
+                      + sd * (gc[k, i, jc - 1 + m] + gc[k, i + 2, jc - 1 - m] + gc[k, i, jc + 1 + m]
+                              + gc[k, i + 2, jc + 1 - m]))
                 z[k, i, j] = zz
-                gz += gc[k, i + 1, j + 1] * zz
+                gz += gc[k, i + 1, jc] * zz
         beta = 0.0 if restart[k] or g_old[k] <= 0.0 else gz / g_old[k]
         for i in range(nx):
             for j in range(ny):
@@ -132,10 +142,11 @@ def cg_step(p, g, t, r, allowed, stalled, exact, restart, tol, done, tau_out, ex
 
 
 @njit(cache=True)
-def update_displacement(u, r, tau, extra, n_extra, kern, stalled, max_cells, refresh, fresh):
+def update_displacement(u, r, tau, extra, n_extra, kern, stalled, max_cells, refresh, fresh, shear):
     """``u(p)`` after a step, without a transform: ``u - tau u(t) + u(extra)``, the last by
     direct summation over the few cells in ``extra`` (``kern[|di|, |dj|]``: a cell's
-    displacement under unit pressure on another, m/Pa).  A problem that is ``stalled``,
+    displacement under unit pressure on another, m/Pa; in the sheared layout of
+    :func:`cg_direction` the array offset (di, dj) is the grid offset (di, dj + shear di)).  A problem that is ``stalled``,
     has more than ``max_cells`` such cells, or every problem if ``refresh``, is marked
     ``fresh`` and left (its displacement is to be transformed anew).  Returns True if any is."""
     K, nx, ny = u.shape
@@ -158,8 +169,9 @@ def update_displacement(u, r, tau, extra, n_extra, kern, stalled, max_cells, ref
                     continue
                 for i in range(nx):
                     di = abs(i - ci)
+                    sh = cj - shear * (i - ci)
                     for j in range(ny):
-                        u[k, i, j] += e * kern[di, abs(j - cj)]
+                        u[k, i, j] += e * kern[di, abs(j - sh)]
     return any_fresh
 
 
@@ -194,10 +206,10 @@ def warm_up():
     flags = np.zeros(1, dtype=np.bool_)
     cg_direction(p, g.copy(), g, g.copy(), g.copy(), b, flags.copy(), f.copy(), f.copy(), 1.0,
                  flags.copy(), flags.copy(), np.diag([0.0, 1.0, 0.0]), np.zeros((1, 4, 4)),
-                 g.copy())
+                 g.copy(), 0)
     n = np.zeros(1, dtype=np.int64)
     cg_step(p, g, g.copy(), g.copy(), b, flags.copy(), flags.copy(), flags.copy(), 1e-4, flags.copy(),
             f.copy(), g.copy(), n, 1.0)
     update_displacement(g, g.copy(), f.copy(), g.copy(), n, np.ones((2, 2)), flags.copy(), 32,
-                        False, flags.copy())
+                        False, flags.copy(), 0)
     torus_gap(f.copy(), f.copy(), 0.0, 1.0, 1.0, 1.1, 0.0, 1.0, 0.0, True, f.copy())

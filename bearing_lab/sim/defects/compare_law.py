@@ -5,10 +5,12 @@ tables (:mod:`.contact`) and the solver (:mod:`.halfspace`), which import neithe
 for it."""
 from __future__ import annotations
 
+import numpy as np
+
 from ...bearings import get_bearing
 from .contact import contact_table
 from .geometry import RaceGeometry
-from .halfspace import race_contact
+from .halfspace import HalfSpace, e_star_of, pressure_semi_axes
 from .model import Defect
 
 __all__ = ["compare_local_law"]
@@ -41,3 +43,37 @@ def compare_local_law(bearing=None, *, load: float = 300.0, k_hertz: float = 3.2
                 float(T.lookup(s / geom.track_radius, delta)) / delta ** 1.5)
         out["positions"].append(row)
     return out
+
+
+def race_contact(geom: RaceGeometry, defect: Defect | None, approach: float, *,
+                 s_ball: float = 0.0, half_across: float | None = None,
+                 half_along: float | None = None, dx: float = 0.0125e-3, dy: float = 0.004e-3,
+                 e_star: float | None = None, solver: HalfSpace | None = None):
+    """Half-space contact of the ball at track position ``s_ball`` (m from the defect
+    centre) and approach ``approach`` on a grid of given cell size (dx across, dy along).
+
+    A fine-grid check, independent of the tables' grids.  Returns a dict with force (N),
+    semi-axes a (across) and b (along) of the contact from the pressure's moments (m),
+    p (Pa), iterations and the solver (reusable for the same grid)."""
+    e_star = e_star_of() if e_star is None else e_star
+    if half_across is None or half_along is None:
+        b_r, a_r = geom.reach(approach)
+        half_across = a_r + dx if half_across is None else half_across
+        half_along = b_r + dy if half_along is None else half_along
+    nx, ny = int(round(2 * half_across / dx)), int(round(2 * half_along / dy))
+    z = (np.arange(nx) - nx / 2 + 0.5) * dx
+    s = (np.arange(ny) - ny / 2 + 0.5) * dy
+    Z, S = np.meshgrid(z, s, indexing="ij")
+    R = geom.track_radius
+    gap = geom.approach(S / R, Z)
+    if defect is not None:
+        ins = defect.contains(S + s_ball, Z)
+        gap = np.where(ins, geom.approach(S / R, Z, depth=defect.depth), gap)
+    gap = np.where(np.isfinite(gap), gap, 1.0)
+    hs = solver if solver is not None else HalfSpace(nx, ny, dx, dy, e_star)
+    p, it = hs.solve(gap, approach)
+    c = p > 0
+    if c.any() and (np.abs(Z[c]).max() > half_across - 2 * dx or np.abs(S[c]).max() > half_along - 2 * dy):
+        raise ValueError("the contact reaches the edge of the half-space grid; enlarge it")
+    a, b = pressure_semi_axes(p, Z, S, dx, dy) if c.any() else (0.0, 0.0)
+    return {"force": float(p.sum() * dx * dy), "a": a, "b": b, "p": p, "iterations": it, "solver": hs}

@@ -77,7 +77,6 @@ from typing import Callable
 import math
 import time
 
-import lazy_loader as lazy
 import numpy as np
 import xarray as xr
 
@@ -90,9 +89,6 @@ from .halfspace import ABOVE_NODE_STEP, HALFSPACE_NODES, TABLE_CELLS, aligned_si
 from .halfspace_skewed import ratio_curve_skewed
 from .lattice import track_lattice
 from .model import Defect
-
-# the half-space curves' interpolation: loaded when a table is built
-_interpolate = lazy.load("scipy.interpolate", suppress_warning=True)
 
 # CONTACT_MODELS, the registry of models (one entry each), closes this module.
 # the "halfspace" model's approach nodes (HALFSPACE_NODES, ABOVE_NODE_STEP) are set in :mod:`.halfspace`;
@@ -455,32 +451,61 @@ def _halfspace_G(defect, geom, s_tab, delta, drop, *, e_star, misses, settings=N
         forces.append(inf_f["intact_force_n"])
         axes.append(inf_f["semi_axes_m"])
     r = np.column_stack(ratios)
-    # G^(2/3) between the nodes by a monotone cubic (Fritsch-Carlson, scipy's PCHIP)
+    # G^(2/3) between the nodes by a monotone cubic (Fritsch-Carlson, :func:`pchip_rows`)
     # through (0, 0) and (drop, 0): exact for delta^1.5 scaling and for a rigid drop, and
     # the share curves' bends between nodes cost a quarter of what straight lines did
     g23 = (r ** (2 / 3)) * nodes_d[None, :]
     xd = np.concatenate([[0.0], nodes_d])
     # rows the ball's rigid drop does not touch share one set of nodes: one interpolant
     plain = drop <= 0
-    G = np.empty((n_psi, n_delta))
+    G = np.zeros((n_psi, n_delta))
     if np.any(plain):
         yd = np.column_stack([np.zeros(int(plain.sum())), g23[plain]])
-        G[plain] = np.maximum(_interpolate.PchipInterpolator(xd, yd, axis=1)(delta), 0.0) ** 1.5
-    for j in np.flatnonzero(~plain):
-        if drop[j] >= delta[-1]:
-            G[j] = 0.0
-            continue
-        keep = xd > drop[j]
-        xj = np.concatenate([[0.0, drop[j]], xd[keep]])
-        yj = np.concatenate([[0.0, 0.0], g23[j, keep[1:]]])
-        G[j] = (np.maximum(_interpolate.PchipInterpolator(xj, yj)(delta), 0.0) ** 1.5 if xj.size >= 3
-                else np.interp(delta, xj, yj) ** 1.5)
+        G[plain] = np.maximum(pchip_rows(np.broadcast_to(xd, yd.shape), yd, delta), 0.0) ** 1.5
+    # the other rows: knots 0, the drop and the nodes above it, grouped by how many nodes are above
+    above = (xd[None, :] > drop[:, None]).sum(axis=1)
+    for n in np.unique(above[~plain & (drop < delta[-1])]):
+        rows = np.flatnonzero(~plain & (drop < delta[-1]) & (above == n))
+        xj = np.column_stack([np.zeros(rows.size), drop[rows], np.broadcast_to(xd[xd.size - n:], (rows.size, n))])
+        yj = np.column_stack([np.zeros((rows.size, 2)), g23[rows, g23.shape[1] - n:]])
+        G[rows] = (np.maximum(pchip_rows(xj, yj, delta), 0.0) if n >= 1 else 0.0) ** 1.5
     far = np.all(r == 1.0, axis=1)
     G[far] = delta[None, :] ** 1.5
     info.update({"halfspace_ratio": r, "halfspace_intact_force_n": np.array(forces),
                  "halfspace_semi_axes_m": np.array(axes), "halfspace_richardson": richardson,
                  "halfspace_solves": solves})
     return G, info
+
+
+def pchip_rows(x: np.ndarray, y: np.ndarray, xq: np.ndarray) -> np.ndarray:
+    """Monotone piecewise-cubic interpolation (Fritsch & Carlson; the derivatives of scipy's
+    ``PchipInterpolator``) of each row of ``y`` (K, n) over the strictly increasing knots in the
+    same row of ``x`` (K, n), at the points ``xq`` (within every row's knots): (K, len(xq)).
+    All rows at once, where one interpolant per row cost more than the rest of a table's assembly."""
+    h = np.diff(x, axis=1)
+    m = np.diff(y, axis=1) / h
+    d = np.zeros_like(y)
+    if y.shape[1] == 2:
+        d[:] = m[:, :1]
+    else:
+        w1, w2 = 2 * h[:, 1:] + h[:, :-1], h[:, 1:] + 2 * h[:, :-1]
+        flat = (np.sign(m[:, 1:]) != np.sign(m[:, :-1])) | (m[:, 1:] == 0) | (m[:, :-1] == 0)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            d[:, 1:-1] = np.where(flat, 0.0, 1.0 / ((w1 / m[:, :-1] + w2 / m[:, 1:]) / (w1 + w2)))
+        for i, (h0, h1, m0, m1) in ((0, (h[:, 0], h[:, 1], m[:, 0], m[:, 1])),
+                                    (-1, (h[:, -1], h[:, -2], m[:, -1], m[:, -2]))):
+            e = ((2 * h0 + h1) * m0 - h0 * m1) / (h0 + h1)
+            e = np.where(np.sign(e) != np.sign(m0), 0.0,
+                         np.where((np.sign(m0) != np.sign(m1)) & (np.abs(e) > 3 * np.abs(m0)), 3 * m0, e))
+            d[:, i] = e
+    rows = np.arange(x.shape[0])[:, None]
+    k = np.clip((x[:, None, :] <= xq[None, :, None]).sum(axis=2) - 1, 0, x.shape[1] - 2)
+    t, hk, mk = xq[None, :] - x[rows, k], h[rows, k], m[rows, k]
+    d0, d1 = d[rows, k], d[rows, k + 1]
+    # scipy's coefficients and sum, operation for operation (so the tables are the same to the bit)
+    c = (d0 + d1 - 2 * mk) / hk
+    c2, c3 = (mk - d0) / hk - c, c / hk
+    return ((y[rows, k] + d0 * t) + c2 * (t * t)) + c3 * ((t * t) * t)
 
 
 # ---------------------------------------------------------------- the registry

@@ -145,29 +145,25 @@ class RaceGeometry:
     def reach(self, delta: float) -> tuple[float, float]:
         """(along, across) half-extents (m) of the region where h < delta, exact torus.
 
-        Found by bisection on the axes (h is monotone along each axis from the ball), until
-        the midpoint is one of the ends (the interval is then a float's width: more steps
-        change nothing).  Remembered per approach: a table asks for the same ones often.
+        In closed form: along the track (z = 0) with x = R sin(phi) the gap is
+        ``+-(sqrt(R^2 - x^2) - rho0) - sqrt(r_b^2 - x^2)`` and across it (phi = 0)
+        ``(r_b - r_g) + sqrt(r_g^2 - z^2) - sqrt(r_b^2 - z^2)``: on each axis h = delta fixes the
+        sum or difference of the two roots and so their difference of squares fixes the other,
+        which gives ``R - U = r_g - U' = delta (2 r_b - delta) / (2 c)`` without cancellation (U,
+        U' the outer roots, c their sum or difference).  Bounded by where the ball can reach.
+        Remembered per approach: a table asks for the same ones often.
         """
         key = float(delta)
         hit = self._reach_memo.get(key)
         if hit is not None:
             return hit
-
-        def solve(f, hi):
-            lo = 0.0
-            for _ in range(100):
-                mid = 0.5 * (lo + hi)
-                if mid <= lo or mid >= hi:
-                    break
-                if f(mid) < delta:
-                    lo = mid
-                else:
-                    hi = mid
-            return hi
-        along = solve(lambda s: float(self.approach(s / self.track_radius, 0.0)),
-                      0.5 * math.pi * self.track_radius)
-        across = solve(lambda z: float(self.approach(0.0, z)), self.z_limit)
+        d, rb, rg, R = max(key, 0.0), self.ball_radius, self.groove_radius, self.track_radius
+        c = d + self.rho0 if self.race == "outer" else self.rho0 - d
+        e = d * (2 * rb - d) / (2 * c)                      # R - U
+        x = math.sqrt(max(e * (2 * R - e), 0.0))
+        along = R * math.asin(min(x, rb) / R)
+        e = d * (2 * rb - d) / (2 * (d + rg - rb))          # r_g - U'
+        across = min(math.sqrt(max(e * (2 * rg - e), 0.0)), self.z_limit)
         if len(self._reach_memo) < 4096:
             self._reach_memo[key] = (along, across)
         return along, across

@@ -183,10 +183,15 @@ class IntactForce:
         self.coef = np.fft.fft2(force) / (m * m)
         self.k = np.fft.fftfreq(m, 1.0 / m)      # m odd: no Nyquist term
 
-    def __call__(self, fu: float, fv: float) -> float:
-        eu = np.exp(2j * np.pi * self.k * fu)
-        ev = np.exp(2j * np.pi * self.k * fv)
-        return float((eu @ self.coef @ ev).real)
+    def __call__(self, fu, fv):
+        """The force at the offsets (fu, fv): a float, or an array for arrays of offsets."""
+        if np.ndim(fu) == 0:
+            eu = np.exp(2j * np.pi * self.k * fu)
+            ev = np.exp(2j * np.pi * self.k * fv)
+            return float((eu @ self.coef @ ev).real)
+        eu = np.exp(2j * np.pi * self.k[None, :] * np.asarray(fu)[:, None])
+        ev = np.exp(2j * np.pi * self.k[None, :] * np.asarray(fv)[:, None])
+        return np.einsum("ka,ab,kb->k", eu, self.coef, ev).real
 
 
 def _intact_diagnostics(defect: Defect, g: SkewedGrid, p: np.ndarray):
@@ -226,27 +231,22 @@ def ratio_curve_skewed(defect: Defect, geom: RaceGeometry, delta: float, *, cell
     stats = {"solves": intact.solves, "iterations": intact.iterations}
 
     def solve_round(ks, starts):
-        todo, gaps, p0, f_int = [], [], [], []
         gi, gf, ins, (fu, fv) = windows(defect, geom, g, np.asarray(ks) * step)
         ins &= gi < delta
         gap = np.where(ins, gf, gi)
-        for i, (k, start) in enumerate(zip(ks, starts)):
-            if not np.any(ins[i]):
-                solved[k] = (1.0, p_ref)
-                continue
-            if np.all(gap[i] >= delta):
-                solved[k] = (0.0, np.zeros_like(p_ref))
-                continue
-            todo.append(k)
-            gaps.append(gap[i])
-            p0.append(start)
-            f_int.append(intact(fu[i], fv[i]))
-        if todo:
-            p, its = hs.solve_batch(np.array(gaps), delta, tol=tol, p0=np.array(p0))
-            stats["solves"] += len(gaps)
+        meets = ins.any(axis=(1, 2))
+        touches = (gap < delta).any(axis=(1, 2))
+        todo = np.flatnonzero(meets & touches)
+        for i in np.flatnonzero(~meets):
+            solved[ks[i]] = (1.0, p_ref)
+        for i in np.flatnonzero(meets & ~touches):
+            solved[ks[i]] = (0.0, np.zeros_like(p_ref))
+        if todo.size:
+            p, its = hs.solve_batch(gap[todo], delta, tol=tol, p0=np.array([starts[i] for i in todo]))
+            stats["solves"] += todo.size
             stats["iterations"] += int(its.sum())
-            for k, pk, fk in zip(todo, p, f_int):
-                solved[k] = (float(pk.sum()) / fk, pk)
+            for i, pk, fk in zip(todo, p, intact(fu[todo], fv[todo])):
+                solved[ks[i]] = (float(pk.sum()) / fk, pk)
 
     _refine(solve_round, solved, p_ref, k_lo, k_hi, coarse_step, refine_tol)
     s_nodes, ratio = _curve(solved, step, defect)
