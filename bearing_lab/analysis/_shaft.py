@@ -110,14 +110,17 @@ class RawLines:
         self.X_full = _fft.rfft(x - x.mean()) if spectrum is None else spectrum
         self.floors = floors  # a SpectrumFloors of X_full, or None
         self.X = self.X_full[: top + 2]
-        amp = np.abs(self.X)
+        own = floors is not None and floors.spectrum is self.X_full
+        amp = floors.amp[: top + 2] if own else np.abs(self.X)  # |X|: the floors' when of this spectrum
         self.amp = amp
         self.snr = np.clip(line_floor_db(amp, width=max(31, int(round(10.0 / self.df)))), 0.0, SNR_CAP_DB)
         f = np.arange(amp.size) * self.df
         masked = np.zeros(amp.size, bool)
         for fm in mains_hz or ():
-            for m in np.arange(fm, f[-1] + fm, fm):
-                masked |= np.abs(f - m) <= 1.5 * self.df
+            # |f - m| <= 1.5 df, tested on the few bins around each harmonic m (the same test)
+            m = np.arange(fm, f[-1] + fm, fm)[:, None]
+            near = np.clip(np.rint(m / self.df).astype(int) + np.arange(-3, 4), 0, amp.size - 1)
+            masked[near[np.abs(f[near] - m) <= 1.5 * self.df]] = True
         self.masked = masked
         local = np.zeros(amp.size, bool)
         local[1:-1] = (amp[1:-1] >= amp[:-2]) & (amp[1:-1] >= amp[2:])

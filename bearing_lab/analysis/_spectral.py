@@ -184,36 +184,53 @@ def cepstral_prewhitening(x, *, axis=-1):
                       n=n, axis=axis)
 
 
-def whitened_spectrum(X, *, axis=-1):
+def whitened_spectrum(X, *, axis=-1, mag=None):
     """``X / |X|`` (0 where ``|X|`` is below 1e-12 of its largest value): the DFT of the cepstrum-
-    pre-whitened signal, given the DFT ``X`` of the zero-mean signal (full or half spectrum)."""
-    mag = np.abs(X)
+    pre-whitened signal, given the DFT ``X`` of the zero-mean signal (full or half spectrum);
+    ``mag``: ``|X|`` when the caller has it."""
+    mag = np.abs(X) if mag is None else mag
     floor = 1e-12 * np.max(mag, axis=axis, keepdims=True)
     if np.all(floor == 0):
         raise AnalysisError("cepstral_prewhitening: x is constant; nothing to whiten")
-    return np.where(mag > floor, X / np.maximum(mag, floor), 0.0)
+    W = X / np.maximum(mag, floor)
+    W[~(mag > floor)] = 0.0
+    return W
 
 
-def prewhitened(x):
-    """(``rfft(x - mean)``, its whitened spectrum, the pre-whitened signal) of a 1-D record: what
-    :func:`cepstral_prewhitening` computes, with the two spectra kept for the record's other uses."""
-    X = _fft.rfft(x - x.mean())
-    W = whitened_spectrum(X)
-    return X, W, _fft.irfft(W, n=x.size)
+class Prewhitened:
+    """A 1-D record's DFT ``X`` (``rfft(x - mean)``), its magnitude ``mag``, its whitened DFT ``W``
+    and the pre-whitened signal ``signal`` (what :func:`cepstral_prewhitening` returns), the last
+    transformed back only when first read: the envelope spectra are demodulated from ``W``."""
+
+    def __init__(self, x):
+        self.n = x.size
+        self.X = _fft.rfft(x - x.mean())
+        self.mag = np.abs(self.X)
+        self.W = whitened_spectrum(self.X, mag=self.mag)
+        self._signal = None
+
+    @property
+    def signal(self):
+        if self._signal is None:
+            self._signal = _fft.irfft(self.W, n=self.n)
+        return self._signal
 
 
-def record_ses(x, fs, *, window, band=None, fmax=None, spectrum=None):
+def record_ses(x, fs, *, window, band=None, fmax=None, spectrum=None, n=None):
     """:func:`squared_envelope_spectrum` of a checked 1-D record, demodulated from ``spectrum``, the
     record's ``rfft`` (its zero-frequency bin is not used), when given and the envelope's transform
-    has the record's length (else from x)."""
-    if spectrum is None or _fft.next_fast_len(x.size, real=True) != x.size:
-        return squared_envelope_spectrum(x, fs, window=window, band=band, fmax=fmax)
+    has the record's length (else from x).  ``x`` may be a callable returning the record, with
+    ``n`` its length: it is then called only when the record's DFT cannot serve."""
+    n = x.size if n is None else int(n)
+    if spectrum is None or _fft.next_fast_len(n, real=True) != n:
+        return squared_envelope_spectrum(x() if callable(x) else x, fs, window=window, band=band, fmax=fmax)
     band = check_band(band, fs, func="squared_envelope")
     if window == "hann" and fmax is not None:
-        out = _hann_ses_low(spectrum, x.size, fs, band, float(fmax))
+        out = _hann_ses_low(spectrum, n, fs, band, float(fmax))
         if out is not None:
             return out
-    return _ses_of(_analytic_band(x, fs, band, x.size, X=spectrum), fs, window, fmax)
+    # the analytic signal of the band from the record's DFT (a zero-stride stand-in gives its length)
+    return _ses_of(_analytic_band(np.broadcast_to(0.0, (n,)), fs, band, n, X=spectrum), fs, window, fmax)
 
 
 def _hann_ses_low(X, n, fs, band, fmax):

@@ -123,9 +123,9 @@ class SpectrumFloors:
     where the slice's own median repeats its end values, are filtered from the slice's ends
     alone: the same numbers as ``line_floor_db(abs(spectrum[a:b]), width=width)``."""
 
-    def __init__(self, spectrum):
+    def __init__(self, spectrum, *, amp=None):
         self.spectrum = spectrum
-        self.amp = np.abs(spectrum)
+        self.amp = np.abs(spectrum) if amp is None else amp  # ``amp``: |spectrum|, when known
         self._median = {}
 
     def snr(self, a, b, *, width):

@@ -10,7 +10,7 @@ from scipy import fft
 
 from bearing_lab.analysis import cepstral_prewhitening, fast_kurtogram, squared_envelope_spectrum
 from bearing_lab.analysis._kurtogram import KurtogramTree
-from bearing_lab.analysis._spectral import prewhitened, record_ses
+from bearing_lab.analysis._spectral import Prewhitened, record_ses
 
 
 def _impacts(n, fs, seed=0):
@@ -51,11 +51,30 @@ def test_record_ses_reads_the_known_modulation_line():
 
 def test_prewhitened_gives_the_prewhitened_signal_and_its_spectra():
     x = _impacts(50000, 20000.0)
-    X, W, xw = prewhitened(x)
+    pw = Prewhitened(x)
+    X, W, xw = pw.X, pw.W, pw.signal
     np.testing.assert_allclose(xw, cepstral_prewhitening(x), rtol=0, atol=1e-12)
     np.testing.assert_allclose(X, fft.rfft(x - x.mean()), rtol=0, atol=1e-9)
+    np.testing.assert_array_equal(pw.mag, np.abs(X))
     np.testing.assert_allclose(np.abs(W[1:-1]), 1.0, rtol=1e-12)
     np.testing.assert_allclose(fft.rfft(xw)[1:], W[1:], rtol=0, atol=1e-9)
+
+
+@pytest.mark.parametrize("n,read", [(120000, False), (121991, True)])  # a fast length, one that pads
+def test_record_ses_reads_a_deferred_record_only_when_its_dft_cannot_serve(n, read):
+    fs = 20000.0
+    x = _impacts(n, fs)
+    asked = []
+
+    def record():
+        asked.append(1)
+        return x
+
+    f0, s0 = squared_envelope_spectrum(x, fs, window="hann", fmax=900.0)
+    f1, s1 = record_ses(record, fs, window="hann", fmax=900.0, spectrum=fft.rfft(x - x.mean()), n=n)
+    assert bool(asked) == read
+    np.testing.assert_array_equal(f1, f0)
+    np.testing.assert_allclose(s1, s0, rtol=0, atol=1e-12 * s0[1:].max())
 
 
 def test_kurtogram_tree_read_twice_equals_two_kurtograms():
