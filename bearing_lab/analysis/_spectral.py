@@ -242,24 +242,25 @@ def _hann_ses_low(X, n, fs, band, fmax):
     highest lag read), times ``L / n``, is ``SE[0..K]`` without aliasing; the periodic Hann window
     is the 3-tap kernel (-1/4, 1/2, -1/4) on that DFT.  A minute at 20 kHz demodulated in a band
     of 833 Hz and read up to 1 kHz: transforms of 120 000 points instead of 1.2 M."""
-    f = np.fft.rfftfreq(n, 1.0 / fs)
-    keep = np.ones(f.shape, bool) if band is None else (f >= band[0]) & (f <= band[1])
-    keep[0] = False
-    idx = np.flatnonzero(keep)
-    f = f[f <= fmax]
+    f = np.fft.rfftfreq(n, 1.0 / fs)  # increasing: the band's bins and those up to fmax are runs
+    lo, hi = (1, f.size) if band is None else (max(1, int(np.searchsorted(f, band[0], side="left"))),
+                                              int(np.searchsorted(f, band[1], side="right")))
+    f = f[: int(np.searchsorted(f, fmax, side="right"))]
     K = f.size  # lags 0 .. K read (K for the window's kernel at the top bin)
-    m = idx.size
+    m = max(0, hi - lo)
     if m == 0 or K < 2:
         return None
     L = _fft.next_fast_len(max(K + m + 1, 2 * K + 2), real=True)
     if L >= n:
         return None
     Zb = np.zeros(L, complex)
-    Zb[:m] = 2.0 * X[idx[0]: idx[-1] + 1]
-    if n % 2 == 0 and idx[-1] == n // 2:
+    np.multiply(X[lo:hi], 2.0, out=Zb[:m])
+    if n % 2 == 0 and hi - 1 == n // 2:
         Zb[m - 1] /= 2.0
-    c = _fft.ifft(Zb, workers=1)
-    SE = _fft.rfft(c.real ** 2 + c.imag ** 2)[: K + 1] * (L / n)
+    c = _fft.ifft(Zb, workers=1, overwrite_x=True)
+    se = np.multiply(c.real, c.real)
+    se += c.imag * c.imag
+    SE = _fft.rfft(se)[: K + 1] * (L / n)
     mean = SE[0].real / n
     SE[0] = 0.0  # the mean removed
     low = np.concatenate([[np.conj(SE[1])], SE[:-2]])  # SE[k - 1], SE[-1] = conj(SE[1])
