@@ -18,6 +18,8 @@ U**2 (squared envelope spectrum); pre-whitened signals are dimensionless.
 """
 from __future__ import annotations
 
+from functools import cached_property
+
 import numpy as np
 from scipy import fft as _fft
 from scipy import signal as _sig
@@ -198,29 +200,24 @@ def whitened_spectrum(X, *, axis=-1, mag=None):
 
 
 class Prewhitened:
-    """A 1-D record's DFT ``X`` (``rfft(x - mean)``), its magnitude ``mag``, its whitened DFT ``W``
-    and the pre-whitened signal ``signal`` (what :func:`cepstral_prewhitening` returns), the last
-    transformed back only when first read: the envelope spectra are demodulated from ``W``."""
+    """A 1-D record's DFT ``X = rfft(x - mean)``, ``mag = |X|``, the whitened DFT ``W`` and ``signal``,
+    :func:`cepstral_prewhitening`'s result, transformed back from ``W`` only when first read."""
 
     def __init__(self, x):
         self.n = x.size
         self.X = _fft.rfft(x - x.mean())
         self.mag = np.abs(self.X)
         self.W = whitened_spectrum(self.X, mag=self.mag)
-        self._signal = None
 
-    @property
+    @cached_property
     def signal(self):
-        if self._signal is None:
-            self._signal = _fft.irfft(self.W, n=self.n)
-        return self._signal
+        return _fft.irfft(self.W, n=self.n)
 
 
 def record_ses(x, fs, *, window, band=None, fmax=None, spectrum=None, n=None):
     """:func:`squared_envelope_spectrum` of a checked 1-D record, demodulated from ``spectrum``, the
-    record's ``rfft`` (its zero-frequency bin is not used), when given and the envelope's transform
-    has the record's length (else from x).  ``x`` may be a callable returning the record, with
-    ``n`` its length: it is then called only when the record's DFT cannot serve."""
+    record's ``rfft`` (its zero-frequency bin unused), when given and the envelope's transform has the
+    record's length, else from ``x``: the record or a callable returning it (then ``n`` its length)."""
     n = x.size if n is None else int(n)
     if spectrum is None or _fft.next_fast_len(n, real=True) != n:
         return squared_envelope_spectrum(x() if callable(x) else x, fs, window=window, band=band, fmax=fmax)
@@ -229,8 +226,8 @@ def record_ses(x, fs, *, window, band=None, fmax=None, spectrum=None, n=None):
         out = _hann_ses_low(spectrum, n, fs, band, float(fmax))
         if out is not None:
             return out
-    # the analytic signal of the band from the record's DFT (a zero-stride stand-in gives its length)
-    return _ses_of(_analytic_band(np.broadcast_to(0.0, (n,)), fs, band, n, X=spectrum), fs, window, fmax)
+    stand_in = np.broadcast_to(0.0, (n,))  # the band's analytic signal needs only the record's length
+    return _ses_of(_analytic_band(stand_in, fs, band, n, X=spectrum), fs, window, fmax)
 
 
 def _hann_ses_low(X, n, fs, band, fmax):
@@ -243,11 +240,10 @@ def _hann_ses_low(X, n, fs, band, fmax):
     is the 3-tap kernel (-1/4, 1/2, -1/4) on that DFT.  A minute at 20 kHz demodulated in a band
     of 833 Hz and read up to 1 kHz: transforms of 120 000 points instead of 1.2 M."""
     f = np.fft.rfftfreq(n, 1.0 / fs)  # increasing: the band's bins and those up to fmax are runs
-    lo, hi = (1, f.size) if band is None else (max(1, int(np.searchsorted(f, band[0], side="left"))),
-                                              int(np.searchsorted(f, band[1], side="right")))
+    lo, hi = (1, f.size) if band is None else (max(1, np.searchsorted(f, band[0])), np.searchsorted(f, band[1], "right"))
     f = f[: int(np.searchsorted(f, fmax, side="right"))]
     K = f.size  # lags 0 .. K read (K for the window's kernel at the top bin)
-    m = max(0, hi - lo)
+    m = int(max(0, hi - lo))
     if m == 0 or K < 2:
         return None
     L = _fft.next_fast_len(max(K + m + 1, 2 * K + 2), real=True)
