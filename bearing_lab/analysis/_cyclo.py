@@ -105,44 +105,66 @@ def enhanced_envelope_spectrum(x, fs, *, alpha_max, nw=None):
                             f"{x.size // 8}")
     hop = max(1, min(int(fs / (2 * alpha_max)), nw // 4))
     n_frames = (x.size - nw) // hop + 1
-    frames = np.lib.stride_tricks.sliding_window_view(x - x.mean(), nw)[::hop][:n_frames]
-    # frames as columns: the STFT's bins come out as contiguous rows (no transposed copy of them)
-    X = _fft.rfft(frames.T * np.hanning(nw + 1)[:-1, None], axis=0)
-    S = np.multiply(X.real, X.real)  # |X|^2: the bins' power, and the zero shift's products below
-    S += X.imag * X.imag
-    power = np.mean(S, axis=1)
     n_fft = _fft.next_fast_len(n_frames)
-    nb = X.shape[0]
-    # whitened bins 1 .. nb-2 (DC and Nyquist excluded) as rows, zero-padded to n_fft frames: each
-    # shift's products are then contiguous rows, transformed along the last axis
-    Xt = np.zeros((nb - 2, n_fft), complex)
-    scale = np.maximum(power, power.max() * 1e-12)[1:-1, None]
-    np.divide(X[1:-1], np.sqrt(scale), out=Xt[:, :n_frames])
-    del X
-    Xc = np.conj(Xt)  # once for every shift; one product buffer, transformed in place
-    buf = np.empty((max(nb - 3, 1), n_fft), complex)
+    X = _stft(x, nw, hop, n_frames, n_fft)
+    # each bin's mean power over the frames: the whitening (coherence) of the products below
+    power = np.array([np.dot(v, v) for v in X[:, :n_frames].view(np.float64)]) / n_frames
+    scale = np.maximum(power, power.max() * 1e-12)[1:-1]
     frame_rate = fs / hop
     alpha = np.arange(n_fft) * frame_rate / n_fft
     keep = int(np.searchsorted(alpha, alpha_max, side="right"))
     alpha = alpha[:keep]
     bin_hz = fs / nw
+    shift = np.rint(alpha / bin_hz).astype(int)
+    # shift p serves the run of cyclic frequencies [a, b) nearest to p bins (shift grows with alpha)
+    runs = [(p, int(sel[0]), int(sel[-1]) + 1) for p in range(min(int(shift.max()) + 1, nw // 2 - 1))
+            if (sel := np.flatnonzero(shift == p)).size]
+    sums = _shift_sums(X[1:-1], scale, runs)  # bins 1 .. nb-2: DC and Nyquist excluded
     g = _window_response(nw)
     grid_hz = fs / (nw * 64)
     ees = np.zeros(keep)
-    shift = np.rint(alpha / bin_hz).astype(int)
-    for p in range(int(shift.max()) + 1):
-        sel = np.flatnonzero(shift == p)  # a run of consecutive rows (shift grows with alpha)
-        if sel.size == 0 or p >= nb - 2:
-            continue
-        if p == 0:  # |X|^2 is real: half the transform
-            P = np.zeros((nb - 2, n_fft))
-            np.divide(S[1:-1], scale, out=P[:, :n_frames])  # |X|^2 whitened: |Xt|^2
-            Q = _fft.rfft(P, axis=1, workers=1)
-        else:
-            Q = _fft.fft(np.multiply(Xt[p:], Xc[: nb - 2 - p], out=buf[: nb - 2 - p]), axis=1, overwrite_x=True,
-                         workers=1)
-        rows = np.abs(Q[:, sel[0]: sel[-1] + 1])
-        delta = np.abs(alpha[sel] - p * bin_hz)
+    for p, a, b in runs:
+        delta = np.abs(alpha[a:b] - p * bin_hz)
         gain = g[np.rint(delta / grid_hz).astype(int) % g.size]
-        ees[sel] = rows.mean(axis=0) / n_frames / np.maximum(gain, 1e-3)
+        ees[a:b] = sums[p] / (scale.size - p) / n_frames / np.maximum(gain, 1e-3)
     return alpha, ees
+
+
+def _stft(x, nw, hop, n_frames, n_fft, block=8192):
+    """STFT of Hann-windowed frames of ``x - mean`` as columns: bins as rows ``(nw // 2 + 1, n_fft)``,
+    zero beyond ``n_frames``; computed a block of frames at a time (no record-sized temporaries)."""
+    frames = np.lib.stride_tricks.sliding_window_view(x - x.mean(), nw)[::hop][:n_frames]
+    w = np.hanning(nw + 1)[:-1, None]
+    X = np.zeros((nw // 2 + 1, n_fft), complex)
+    for c in range(0, n_frames, block):
+        X[:, c:min(c + block, n_frames)] = _fft.rfft(frames[c:c + block].T * w, axis=0)
+    return X
+
+
+def _shift_sums(X, scale, runs, block=4):
+    """For each ``(p, a, b)`` of ``runs``: the sum over bins k of the magnitude of the DFT over the
+    frames of the whitened products ``X[k + p] conj(X[k]) / sqrt(scale[k + p] scale[k])``, at DFT
+    bins ``a .. b-1``.  The whitening is a positive factor per product, so it scales the
+    magnitudes; a few bins at a time, so the products and their transforms stay in cache."""
+    nr, n_fft = X.shape
+    sums = {p: np.zeros(b - a) for p, a, b in runs}
+    conj = np.empty((block, n_fft), complex)
+    prod = np.empty((block, n_fft), complex)
+    for r in range(0, nr, block):
+        q = min(block, nr - r)
+        np.conjugate(X[r:r + q], out=conj[:q])
+        for p, a, b in runs:
+            m = min(q, nr - p - r)
+            if m <= 0:
+                continue
+            if p == 0:  # |X|^2 is real: half the transform
+                P = np.abs(X[r:r + m])
+                P *= P
+                Q = _fft.rfft(P, axis=1, workers=1)
+                wts = 1.0 / scale[r:r + m]
+            else:
+                Q = _fft.fft(np.multiply(X[r + p:r + p + m], conj[:m], out=prod[:m]), axis=1, overwrite_x=True,
+                             workers=1)
+                wts = 1.0 / np.sqrt(scale[r + p:r + p + m] * scale[r:r + m])
+            sums[p] += wts @ np.abs(Q[:, a:b])
+    return sums

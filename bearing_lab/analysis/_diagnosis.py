@@ -36,7 +36,7 @@ from __future__ import annotations
 from ..errors import AnalysisError
 from ._cyclo import enhanced_envelope_spectrum
 from ._families import LABELS, SK_MIN, CyclicSpectrum, route_verdict, search_families
-from ._spectral import fast_kurtogram, prewhitened, record_ses
+from ._spectral import Prewhitened, fast_kurtogram, record_ses
 from ._shaft import discrete_comb
 
 __all__ = ["run_routes", "combine", "coincidences", "ROUTES", "VERDICTS"]
@@ -55,17 +55,18 @@ def spectrum_top(fault_hz, shaft_hz, *, tolerance, n_harmonics):
     return n_harmonics * DECOY_SPAN * big * (1 + tolerance) + shaft_hz + 5.0
 
 
-def _ses(sig, fs, *, band, fmax, known, spectrum=None):
+def _ses(sig, fs, *, band, fmax, known, spectrum=None, n=None):
     """Squared envelope spectrum of ``sig`` up to ``fmax``: cropped from ``known`` = (f, spectrum,
     its fmax) when that reaches as far (the same numbers: the spectrum is cropped after the DFT);
-    else demodulated from ``spectrum``, the rfft of ``sig``, when given."""
+    else demodulated from ``spectrum``, the rfft of ``sig``, when given (``sig`` may then be a
+    callable returning the signal, of length ``n``: see ``record_ses``)."""
     if known is not None and fmax <= known[2]:
         keep = known[0] <= fmax
         return known[0][keep], known[1][keep]
-    return record_ses(sig, fs, window="hann", band=band, fmax=fmax, spectrum=spectrum)
+    return record_ses(sig, fs, window="hann", band=band, fmax=fmax, spectrum=spectrum, n=n)
 
 
-def run_routes(x, fs, geometry, shaft_hz, *, tolerance=0.02, n_harmonics=5, prewhiten=False, xw=None, ses=None):
+def run_routes(x, fs, geometry, shaft_hz, *, tolerance=0.02, n_harmonics=5, prewhiten=False, ses=None):
     """The three routes at one shaft speed.
 
     Parameters
@@ -77,22 +78,21 @@ def run_routes(x, fs, geometry, shaft_hz, *, tolerance=0.02, n_harmonics=5, prew
     tolerance, n_harmonics : as in :func:`~bearing_lab.analysis.analyze`
     prewhiten : bool
         Run the kurtogram route on the pre-whitened signal.
-    xw : ndarray, optional
-        The cepstrum-pre-whitened signal, if already computed.
     ses : dict, optional
-        Squared envelope spectra already computed (of ``xw``: key "cpw"; of ``x`` in a band:
+        What the speed search computed already: key "prewhitened", a ``Prewhitened`` of ``x``
+        (its DFT, whitened DFT and pre-whitened signal; computed here when missing); squared
+        envelope spectra (of the pre-whitened signal: key "cpw"; of ``x`` in a band:
         ("x", band)), as ``(f, spectrum, fmax)``; key "kurtogram": a ``KurtogramTree`` of ``x``
-        (its levels already computed are not computed again); keys "rfft" and "whitened": the DFT
-        of ``x - mean`` and of ``xw`` (given with ``xw``); "floors": a ``SpectrumFloors`` of the
-        former.
+        (its levels already computed are not computed again); "floors": a ``SpectrumFloors`` of
+        the DFT of ``x - mean``.
 
     Returns
     -------
     dict
         ``band`` (low, high) Hz or None, ``spectral_kurtosis``, ``impulsive``,
         ``fault_hz``, ``routes``: per route ``verdict`` (route_verdict result),
-        ``families``, ``f``, ``spectrum``, ``abstained`` (bool); ``xw`` and ``rfft``, the DFT of
-        ``x - mean`` (None when ``xw`` was given without it).
+        ``families``, ``f``, ``spectrum``, ``abstained`` (bool); ``prewhitened`` (the
+        ``Prewhitened`` of ``x``) and ``rfft``, the DFT of ``x - mean``.
     """
     ff = geometry.fault_frequencies(shaft_hz)
     line_top = n_harmonics * max(ff["bpfi"], 2 * ff["bsf"], ff["bpfo"]) * (1 + tolerance) + shaft_hz
@@ -100,11 +100,9 @@ def run_routes(x, fs, geometry, shaft_hz, *, tolerance=0.02, n_harmonics=5, prew
         raise AnalysisError(f"analyze: fs={fs:g} Hz is too low to see {n_harmonics} harmonics of the "
                             f"fault frequencies (up to {line_top:.0f} Hz) of bearing {geometry.name!r}")
     fmax = min(spectrum_top(ff, shaft_hz, tolerance=tolerance, n_harmonics=n_harmonics), 0.49 * fs)
-    if xw is None:
-        X, W, xw = prewhitened(x)
-        ses = {"rfft": X, "whitened": W}
     ses = ses or {}
-    xk = xw if prewhiten else x
+    pw = ses.get("prewhitened") or Prewhitened(x)
+    xk = pw.signal if prewhiten else x
     try:
         tree = ses.get("kurtogram") if not prewhiten else None
         kg = (tree.kurtogram(min_bandwidth=line_top) if tree is not None
@@ -114,8 +112,9 @@ def run_routes(x, fs, geometry, shaft_hz, *, tolerance=0.02, n_harmonics=5, prew
         band, sk = None, 0.0  # too short for a kurtogram: demodulate the whole band
     spectra = {
         "kurtogram_ses": _ses(xk, fs, band=band, fmax=fmax, known=None if prewhiten else ses.get(("x", band)),
-                              spectrum=ses.get("whitened" if prewhiten else "rfft")),
-        "cpw_ses": _ses(xw, fs, band=None, fmax=fmax, known=ses.get("cpw"), spectrum=ses.get("whitened")),
+                              spectrum=pw.W if prewhiten else pw.X),
+        # the pre-whitened signal itself only when its DFT cannot serve
+        "cpw_ses": _ses(lambda: pw.signal, fs, band=None, fmax=fmax, known=ses.get("cpw"), spectrum=pw.W, n=pw.n),
         # the EES costs grow with alpha_max squared: it reaches the fault lines (decoys below them)
         "ees": enhanced_envelope_spectrum(x, fs, alpha_max=min(line_top + 20.0, 0.24 * fs)),
     }
@@ -130,9 +129,9 @@ def run_routes(x, fs, geometry, shaft_hz, *, tolerance=0.02, n_harmonics=5, prew
         if routes[name]["abstained"]:
             routes[name]["abstain_reason"] = (f"the band's spectral kurtosis {sk:.2f} is below {SK_MIN:g}: "
                                               "no impulsiveness to demodulate")
-    note = _check_discrete(x, fs, routes, ff, ses.get("rfft"), ses.get("floors"))
+    note = _check_discrete(x, fs, routes, ff, pw.X, ses.get("floors"))
     return {"band": band, "spectral_kurtosis": sk, "impulsive": sk >= SK_MIN, "fault_hz": ff,
-            "routes": routes, "xw": xw, "rfft": ses.get("rfft"), "notes": [note] if note else []}
+            "routes": routes, "prewhitened": pw, "rfft": pw.X, "notes": [note] if note else []}
 
 
 def _check_discrete(x, fs, routes, fault_hz, spectrum=None, floors=None):

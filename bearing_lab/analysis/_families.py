@@ -54,6 +54,7 @@ family alone makes the route ``"uncertain"`` with the candidate ``ball``.
 from __future__ import annotations
 
 import numpy as np
+from scipy.ndimage import maximum_filter1d
 
 from ..errors import AnalysisError
 from ._fault_rule import FUNDAMENTAL_SNR_DB, HARMONIC_SNR_DB, MIN_HARMONICS, shaft_mask
@@ -159,6 +160,18 @@ class CyclicSpectrum:
         where = np.take_along_axis(idx, j[..., None], -1)[..., 0]
         return np.where(best > 0, where, -1), best
 
+    def window_max(self, half_bins):
+        """The largest counted peak SNR within +-half_bins of every bin (0 beyond the ends): what
+        :meth:`best` returns as SNR for a centre on that bin, for many centres at once."""
+        of, cache = self.__dict__.get("_window_max", (None, None))
+        if of is not self.peak_snr:  # a masked view starts from its base's attributes: its own peaks
+            cache = {}
+            self._window_max = (self.peak_snr, cache)
+        h = int(half_bins)
+        if h not in cache:
+            cache[h] = maximum_filter1d(self.peak_snr, size=2 * h + 1, mode="constant", cval=0.0)
+        return cache[h]
+
 
 def _half_bins(k):
     return np.maximum(2, np.ceil(np.asarray(k) / 2.0).astype(int) + 1)
@@ -195,19 +208,17 @@ def _batch(cs, expected, modulator, tolerance, n_harmonics):
     cand_bins = lo[:, None] + np.arange(width)[None, :]
     valid = cand_bins <= hi[:, None]
     cand = cand_bins * cs.df
-    _, snr = cs.best(cand[..., None] * k, hb)
+    # each carrier's harmonics: the largest peak within +-hb bins (cs.best's SNR, read from the
+    # running maxima; the windows of valid carriers lie inside the spectrum, checked above)
+    pos = np.clip(np.rint(cand[..., None] * k / cs.df).astype(int), 0, cs.f.size - 1)  # (invalid ones: 0 below)
+    snr = np.stack([cs.window_max(hb[q])[pos[..., q]] for q in range(K)], axis=-1)
     fund = cs.peak_snr[np.clip(cand_bins, 0, cs.f.size - 1)]
     score = np.minimum(snr, LINE_CAP_DB).sum(axis=-1) * (fund > 0) * valid
     i = np.argmax(score, axis=1)
-    # middle of the plateau holding the maximum
+    # middle of the plateau holding the maximum: it ends before the first lower score after i
     top = score[np.arange(M), i]
-    j = i.copy()
-    for _ in range(width):
-        nxt = np.minimum(j + 1, width - 1)
-        step = (score[np.arange(M), nxt] >= top) & (nxt > j)
-        if not step.any():
-            break
-        j = np.where(step, nxt, j)
+    drop = (np.arange(width) > i[:, None]) & (score < top[:, None])
+    j = np.where(drop.any(axis=1), np.argmax(drop, axis=1) - 1, width - 1)
     f1 = 0.5 * (cand[np.arange(M), i] + cand[np.arange(M), j])
     has = top > 0
     # the carrier is its fundamental line, interpolated (parabola through log amplitudes)

@@ -63,11 +63,23 @@ def hump_score(f, s, carrier_hz, *, shaft_hz, ftf_hz, n_harmonics=HUMP_HARMONICS
         win, ring = kk & (d <= h), kk & (d > h)
         if np.count_nonzero(win) < 3 or np.count_nonzero(ring) < 6:
             return float("nan")
-        base = float(np.median(ss[ring]))
+        base = _median(ss[ring])
         if base <= 0:
             return float("nan")
         total += 10.0 * np.log10(max(float(np.mean(ss[win])), 1e-300) / base)
     return float(total)
+
+
+def _median(v):
+    """``np.median`` of a 1-D array: the middle order statistics alone (numpy also places the
+    largest, to find NaNs; a NaN here gives NaN as numpy's does)."""
+    n, h = v.size, v.size // 2
+    if not np.isfinite(v).all():
+        return float(np.median(v))
+    if n % 2:
+        return float(np.partition(v, h)[h])
+    p = np.partition(v, (h - 1, h))
+    return float((p[h - 1] + p[h]) / 2)
 
 
 def route_humps(f, s, fault_hz, *, shaft_hz, factors, tolerance=0.02):

@@ -12,7 +12,6 @@ from collections import namedtuple
 
 import numpy as np
 from scipy import fft as _fft
-from scipy import signal as _sig
 
 from ..errors import AnalysisError
 from ._util import check_fs, check_signal
@@ -53,6 +52,16 @@ def level_bands(nlevel):
 
 
 
+def _tukey_ends(n, alpha):
+    """The ramps of ``scipy.signal.windows.tukey(n, alpha)`` (its formula) as ``(slice, values)``."""
+    width = int(np.floor(alpha * (n - 1) / 2.0))
+    n1 = np.arange(0, width + 1, dtype=np.float64)
+    n3 = np.arange(n - width - 1, n, dtype=np.float64)
+    w1 = 0.5 * (1 + np.cos(np.pi * (-1 + 2.0 * n1 / alpha / (n - 1))))
+    w3 = 0.5 * (1 + np.cos(np.pi * (-2.0 / alpha + 1 + 2.0 * n3 / alpha / (n - 1))))
+    return (slice(0, width + 1), w1), (slice(n - width - 1, n), w3)
+
+
 class KurtogramTree:
     """The record's tapered DFT and the 1/3-binary tree's levels, each level's spectral kurtosis
     computed once when first asked for: :meth:`kurtogram` for several ``min_bandwidth`` (the speed
@@ -77,7 +86,10 @@ class KurtogramTree:
         # taper's ramps) as an event at the record's edges; next to a strong tone it
         # gives narrow bands a spurious high kurtosis.  So: taper 5 % at each end
         # (Tukey, alpha 0.1) and measure the kurtosis on the middle 80 % only.
-        self.X = _fft.rfft((x - x.mean()) * _sig.windows.tukey(n, 0.1))
+        y = x - x.mean()
+        for sl, w in _tukey_ends(n, 0.1):  # tukey(n, 0.1) is 1 between its ramps
+            y[sl] *= w
+        self.X = _fft.rfft(y)
         self.layout = level_bands(nlevel)
         self._rows = {}
 

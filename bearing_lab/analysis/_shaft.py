@@ -61,7 +61,7 @@ from scipy.stats import binom
 from ..errors import AnalysisError
 from ._families import SK_MIN, search_families
 from ._fault_rule import FUNDAMENTAL_SNR_DB, MIN_HARMONICS
-from ._speed import LINE_SNR_DB, SNR_CAP_DB, interpolated_peak, line_floor_db
+from ._speed import LINE_SNR_DB, SNR_CAP_DB, grid_near_lines, interpolated_peak, line_floor_db
 
 __all__ = ["RawLines", "resolve_speed", "MIN_SHAFT_LINES", "PRIOR_TOLERANCE", "BLIND_RANGE_HZ"]
 
@@ -110,14 +110,15 @@ class RawLines:
         self.X_full = _fft.rfft(x - x.mean()) if spectrum is None else spectrum
         self.floors = floors  # a SpectrumFloors of X_full, or None
         self.X = self.X_full[: top + 2]
-        amp = np.abs(self.X)
+        amp = floors.amp[: top + 2] if floors is not None and floors.spectrum is self.X_full else np.abs(self.X)
         self.amp = amp
         self.snr = np.clip(line_floor_db(amp, width=max(31, int(round(10.0 / self.df)))), 0.0, SNR_CAP_DB)
         f = np.arange(amp.size) * self.df
         masked = np.zeros(amp.size, bool)
         for fm in mains_hz or ():
-            for m in np.arange(fm, f[-1] + fm, fm):
-                masked |= np.abs(f - m) <= 1.5 * self.df
+            m = np.arange(fm, f[-1] + fm, fm)[:, None]  # |f - m| <= 1.5 df tested on the bins near m
+            near = np.clip(np.rint(m / self.df).astype(int) + np.arange(-3, 4), 0, amp.size - 1)
+            masked[near[np.abs(f[near] - m) <= 1.5 * self.df]] = True
         self.masked = masked
         local = np.zeros(amp.size, bool)
         local[1:-1] = (amp[1:-1] >= amp[:-2]) & (amp[1:-1] >= amp[2:])
@@ -142,21 +143,24 @@ class RawLines:
         return int(max(1, min(N_SHAFT_HARMONICS, np.floor(min(self.top_hz, 0.45 * self.fs) / hi))))
 
     def scan(self, lo, hi):
-        """Family score (Hermes-weighted clear-line SNR) of candidates in [lo, hi]."""
+        """Family score (Hermes-weighted clear-line SNR) of candidates in [lo, hi] (exactly 0 for those
+        with no harmonic near a clear line: only the others are computed, when that saves work)."""
         nh = self.n_harmonics(hi)
         step = 0.5 * self.df / nh
         cand = np.arange(lo, hi + step, step)
         h = np.arange(1, nh + 1)
         wts = 0.9 ** (h - 1)
-        score = np.empty(cand.size)
-        for i in range(0, cand.size, 8192):  # blocks that stay in cache, operations in place
-            c = cand[i:i + 8192, None] * h
+        score = np.zeros(cand.size)
+        idx = grid_near_lines(self.clear3, self.df, lo, step, cand.size, h)
+        idx = np.arange(cand.size) if idx is None else idx  # a spectrum dense with lines: the whole grid
+        for i in range(0, idx.size, 8192):  # blocks that stay in cache, operations in place
+            c = cand[idx[i:i + 8192], None] * h
             c /= self.df
             pos = np.rint(c, out=c).astype(np.intp)
             np.clip(pos, 1, self.clear.size - 2, out=pos)
             vals = self.clear3[pos]
             vals *= wts
-            score[i:i + 8192] = vals.sum(axis=1)
+            score[idx[i:i + 8192]] = vals.sum(axis=1)
         return cand, score
 
     def candidates(self, lo, hi, count=6):

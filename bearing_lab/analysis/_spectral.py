@@ -18,6 +18,8 @@ U**2 (squared envelope spectrum); pre-whitened signals are dimensionless.
 """
 from __future__ import annotations
 
+from functools import cached_property
+
 import numpy as np
 from scipy import fft as _fft
 from scipy import signal as _sig
@@ -184,36 +186,48 @@ def cepstral_prewhitening(x, *, axis=-1):
                       n=n, axis=axis)
 
 
-def whitened_spectrum(X, *, axis=-1):
+def whitened_spectrum(X, *, axis=-1, mag=None):
     """``X / |X|`` (0 where ``|X|`` is below 1e-12 of its largest value): the DFT of the cepstrum-
-    pre-whitened signal, given the DFT ``X`` of the zero-mean signal (full or half spectrum)."""
-    mag = np.abs(X)
+    pre-whitened signal, given the DFT ``X`` of the zero-mean signal (full or half spectrum);
+    ``mag``: ``|X|`` when the caller has it."""
+    mag = np.abs(X) if mag is None else mag
     floor = 1e-12 * np.max(mag, axis=axis, keepdims=True)
     if np.all(floor == 0):
         raise AnalysisError("cepstral_prewhitening: x is constant; nothing to whiten")
-    return np.where(mag > floor, X / np.maximum(mag, floor), 0.0)
+    W = X / np.maximum(mag, floor)
+    W[~(mag > floor)] = 0.0
+    return W
 
 
-def prewhitened(x):
-    """(``rfft(x - mean)``, its whitened spectrum, the pre-whitened signal) of a 1-D record: what
-    :func:`cepstral_prewhitening` computes, with the two spectra kept for the record's other uses."""
-    X = _fft.rfft(x - x.mean())
-    W = whitened_spectrum(X)
-    return X, W, _fft.irfft(W, n=x.size)
+class Prewhitened:
+    """A 1-D record's DFT ``X = rfft(x - mean)``, ``mag = |X|``, the whitened DFT ``W`` and ``signal``,
+    :func:`cepstral_prewhitening`'s result, transformed back from ``W`` only when first read."""
+
+    def __init__(self, x):
+        self.n = x.size
+        self.X = _fft.rfft(x - x.mean())
+        self.mag = np.abs(self.X)
+        self.W = whitened_spectrum(self.X, mag=self.mag)
+
+    @cached_property
+    def signal(self):
+        return _fft.irfft(self.W, n=self.n)
 
 
-def record_ses(x, fs, *, window, band=None, fmax=None, spectrum=None):
+def record_ses(x, fs, *, window, band=None, fmax=None, spectrum=None, n=None):
     """:func:`squared_envelope_spectrum` of a checked 1-D record, demodulated from ``spectrum``, the
-    record's ``rfft`` (its zero-frequency bin is not used), when given and the envelope's transform
-    has the record's length (else from x)."""
-    if spectrum is None or _fft.next_fast_len(x.size, real=True) != x.size:
-        return squared_envelope_spectrum(x, fs, window=window, band=band, fmax=fmax)
+    record's ``rfft`` (its zero-frequency bin unused), when given and the envelope's transform has the
+    record's length, else from ``x``: the record or a callable returning it (then ``n`` its length)."""
+    n = x.size if n is None else int(n)
+    if spectrum is None or _fft.next_fast_len(n, real=True) != n:
+        return squared_envelope_spectrum(x() if callable(x) else x, fs, window=window, band=band, fmax=fmax)
     band = check_band(band, fs, func="squared_envelope")
     if window == "hann" and fmax is not None:
-        out = _hann_ses_low(spectrum, x.size, fs, band, float(fmax))
+        out = _hann_ses_low(spectrum, n, fs, band, float(fmax))
         if out is not None:
             return out
-    return _ses_of(_analytic_band(x, fs, band, x.size, X=spectrum), fs, window, fmax)
+    stand_in = np.broadcast_to(0.0, (n,))  # the band's analytic signal needs only the record's length
+    return _ses_of(_analytic_band(stand_in, fs, band, n, X=spectrum), fs, window, fmax)
 
 
 def _hann_ses_low(X, n, fs, band, fmax):
@@ -225,24 +239,24 @@ def _hann_ses_low(X, n, fs, band, fmax):
     highest lag read), times ``L / n``, is ``SE[0..K]`` without aliasing; the periodic Hann window
     is the 3-tap kernel (-1/4, 1/2, -1/4) on that DFT.  A minute at 20 kHz demodulated in a band
     of 833 Hz and read up to 1 kHz: transforms of 120 000 points instead of 1.2 M."""
-    f = np.fft.rfftfreq(n, 1.0 / fs)
-    keep = np.ones(f.shape, bool) if band is None else (f >= band[0]) & (f <= band[1])
-    keep[0] = False
-    idx = np.flatnonzero(keep)
-    f = f[f <= fmax]
+    f = np.fft.rfftfreq(n, 1.0 / fs)  # increasing: the band's bins and those up to fmax are runs
+    lo, hi = (1, f.size) if band is None else (max(1, np.searchsorted(f, band[0])), np.searchsorted(f, band[1], "right"))
+    f = f[: int(np.searchsorted(f, fmax, side="right"))]
     K = f.size  # lags 0 .. K read (K for the window's kernel at the top bin)
-    m = idx.size
+    m = int(max(0, hi - lo))
     if m == 0 or K < 2:
         return None
     L = _fft.next_fast_len(max(K + m + 1, 2 * K + 2), real=True)
     if L >= n:
         return None
     Zb = np.zeros(L, complex)
-    Zb[:m] = 2.0 * X[idx[0]: idx[-1] + 1]
-    if n % 2 == 0 and idx[-1] == n // 2:
+    np.multiply(X[lo:hi], 2.0, out=Zb[:m])
+    if n % 2 == 0 and hi - 1 == n // 2:
         Zb[m - 1] /= 2.0
-    c = _fft.ifft(Zb, workers=1)
-    SE = _fft.rfft(c.real ** 2 + c.imag ** 2)[: K + 1] * (L / n)
+    c = _fft.ifft(Zb, workers=1, overwrite_x=True)
+    se = np.multiply(c.real, c.real)
+    se += c.imag * c.imag
+    SE = _fft.rfft(se)[: K + 1] * (L / n)
     mean = SE[0].real / n
     SE[0] = 0.0  # the mean removed
     low = np.concatenate([[np.conj(SE[1])], SE[:-2]])  # SE[k - 1], SE[-1] = conj(SE[1])

@@ -115,6 +115,26 @@ def line_floor_db(amp, *, width):
     return 20 * np.log10(np.maximum(amp, 1e-300) / floor)
 
 
+def grid_near_lines(values, df, lo, step, count, h):
+    """Indices of the candidates ``c = lo + i step`` (i < count) one of whose harmonics ``h c``
+    rounds to a bin (of width ``df``) where ``values`` is nonzero, two candidates to spare each side
+    (a superset: the others read only zeros); None when that is not much fewer than all of them."""
+    nz = np.flatnonzero(values > 0)
+    if nz.size * len(h) > count:
+        return None
+    hh = np.asarray(h, float)[:, None]
+    a = np.floor(((nz - 0.5) * df / hh - lo) / step).astype(np.int64) - 2
+    b = np.ceil(((nz + 0.5) * df / hh - lo) / step).astype(np.int64) + 2
+    a[:, nz <= 1] = 0  # positions are clipped to bins 1 .. size-2
+    b[:, nz >= values.size - 2] = count - 1
+    np.clip(a, 0, count, out=a)
+    np.clip(b, -1, count - 1, out=b)
+    ok = a <= b
+    mark = np.bincount(a[ok], minlength=count + 1) - np.bincount(b[ok] + 1, minlength=count + 1)
+    idx = np.flatnonzero(np.cumsum(mark[:-1]) > 0)
+    return None if 2 * idx.size > count else idx
+
+
 class SpectrumFloors:
     """:func:`line_floor_db` of slices of one amplitude spectrum ``|spectrum|``, the running median
     of the whole spectrum computed once for the wide slices (the discrete-comb tests of several
@@ -123,9 +143,9 @@ class SpectrumFloors:
     where the slice's own median repeats its end values, are filtered from the slice's ends
     alone: the same numbers as ``line_floor_db(abs(spectrum[a:b]), width=width)``."""
 
-    def __init__(self, spectrum):
+    def __init__(self, spectrum, *, amp=None):
         self.spectrum = spectrum
-        self.amp = np.abs(spectrum)
+        self.amp = np.abs(spectrum) if amp is None else amp  # ``amp``: |spectrum|, when known
         self._median = {}
 
     def snr(self, a, b, *, width):

@@ -51,7 +51,7 @@ from ._impulse import excitation_period
 from ._kurtogram import KurtogramTree
 from ._metrics import METRIC_NAMES, metrics
 from ._shaft import BLIND_RANGE_HZ, resolve_speed
-from ._spectral import amplitude_spectrum, prewhitened, record_ses
+from ._spectral import Prewhitened, amplitude_spectrum, record_ses
 from ._speed import SpectrumFloors, shaft_frequency
 from ._tacho import ORDER_TRACK_VARIATION, order_track, tacho_pulses, tacho_speed
 from ._util import check_fs, check_signal
@@ -99,23 +99,25 @@ def _tacho_speed(x, fs, tacho, pulses_per_rev):
 
 def _speed(x, fs, geom, *, rpm, rpm_source, shaft_hz, tacho, pulses_per_rev, tolerance, n_harmonics,
            fallback=True, units="m s-2"):
-    """(signal to analyse, speed dict, pre-whitened signal or None, the envelope spectra computed:
-    ``{key: (f, spectrum, fmax)}``, key "cpw" or ("x", band), "rfft" and "whitened": the record's
-    DFT and its whitened one, "floors": a SpectrumFloors of the record's DFT, and "kurtogram": the
-    record's :class:`KurtogramTree` once a kurtogram was asked for, for :func:`run_routes` to reuse)."""
+    """(signal to analyse, speed dict, what was computed for :func:`run_routes` to reuse: the envelope
+    spectra ``{key: (f, spectrum, fmax)}``, key "cpw" or ("x", band), "prewhitened": the record's
+    :class:`Prewhitened` (its DFT "rfft", its whitened DFT "whitened"), "floors": a SpectrumFloors
+    of the record's DFT, and "kurtogram": the record's :class:`KurtogramTree` once a kurtogram was
+    asked for; empty when the speed was given or came from a tacho)."""
     if shaft_hz is not None:
         fr = float(shaft_hz)
         if not (math.isfinite(fr) and fr > 0):
             raise AnalysisError(f"analyze: shaft_hz={shaft_hz!r} must be a positive frequency in Hz")
-        return x, _fixed_speed(fr, "given", "exact", "shaft frequency given"), None, {}
+        return x, _fixed_speed(fr, "given", "exact", "shaft frequency given"), {}
     if tacho is not None:
         xa, sp = _tacho_speed(x, fs, tacho, pulses_per_rev)
-        return xa, sp, None, {}
+        return xa, sp, {}
     if rpm is not None and not (math.isfinite(rpm) and rpm > 0):
         raise AnalysisError(f"analyze: rpm={rpm!r} must be a positive speed in r/min")
     check_choice(rpm_source, ("given", "file"), "analyze: rpm_source", AnalysisError)
-    X, W, xw = prewhitened(x)  # the record's DFT and its whitened one, for every spectrum below
-    cache, ses = {}, {"rfft": X, "whitened": W, "floors": SpectrumFloors(X)}
+    pw = Prewhitened(x)  # the record's DFT and its whitened one, for every spectrum below
+    X, W = pw.X, pw.W
+    cache, ses = {}, {"prewhitened": pw, "rfft": X, "whitened": W, "floors": SpectrumFloors(X, amp=pw.mag)}
 
     def spectra(f0):
         """Pre-whitened SES (once, reaching the fastest blind candidate's decoys) and the SES of
@@ -124,7 +126,8 @@ def _speed(x, fs, geom, *, rpm, rpm_source, shaft_hz, tacho, pulses_per_rev, tol
         if "cpw" not in cache:
             fmax = min(0.49 * fs, spectrum_top(geom.fault_frequencies(BLIND_RANGE_HZ[1]), BLIND_RANGE_HZ[1],
                                                tolerance=tolerance, n_harmonics=n_harmonics))
-            ses["cpw"] = (*record_ses(xw, fs, window="hann", fmax=fmax, spectrum=W), fmax)
+            # (the pre-whitened signal itself only when its DFT cannot serve)
+            ses["cpw"] = (*record_ses(lambda: pw.signal, fs, window="hann", fmax=fmax, spectrum=W, n=x.size), fmax)
             cache["cpw"] = CyclicSpectrum(*ses["cpw"][:2])
         line_top = n_harmonics * max(ff["bpfi"], 2 * ff["bsf"], ff["bpfo"]) * (1 + tolerance) + f0
         nb = int(2 ** np.floor(np.log2(max(1.0, fs / 2 / line_top))))
@@ -146,7 +149,7 @@ def _speed(x, fs, geom, *, rpm, rpm_source, shaft_hz, tacho, pulses_per_rev, tol
         # nothing to go by: the strongest harmonic family, for the fault-frequency table only
         sp["shaft_hz"] = float(shaft_frequency(x, fs, window="boxcar")[0])
         sp["note"] += f"; fault frequencies shown at the strongest line family, {sp['shaft_hz']:.3f} Hz"
-    return x, sp, xw, ses
+    return x, sp, ses
 
 
 def _band_spectrum(x, fs, kg, geom, tolerance, n_harmonics, ses):
@@ -163,11 +166,12 @@ def _band_spectrum(x, fs, kg, geom, tolerance, n_harmonics, ses):
     return cs
 
 
-def _period(routes, decided, key, x, xw, fs, band):
-    """Excitation period of the diagnosed family in the deciding route's signal."""
+def _period(routes, decided, key, x, pw, fs, band):
+    """Excitation period of the diagnosed family in the deciding route's signal (``pw``: the
+    :class:`Prewhitened` of x)."""
     ev = routes[decided]["families"][key]
     f1 = ev["measured_hz"]
-    xx, bb = (x, band) if decided == "kurtogram_ses" else (xw, None)
+    xx, bb = (x, band) if decided == "kurtogram_ses" else (pw.signal, None)
     try:
         period, _ = excitation_period(xx, fs, frequency_range=(0.99 * f1, 1.01 * f1), band=bb)
     except AnalysisError as exc:  # too few clear harmonics for the refined estimate
@@ -201,7 +205,7 @@ def _run(x, fs, *, bearing, rpm=None, shaft_hz=None, tolerance=0.02, n_harmonics
         raise AnalysisError(f"analyze: x must be one channel (1-D), got shape {x.shape}")
     geom = _bearing(bearing)
     m = metrics(x)
-    xa, speed, xw, ses = _speed(x, fs, geom, rpm=rpm, rpm_source=rpm_source, shaft_hz=shaft_hz, tacho=tacho,
+    xa, speed, ses = _speed(x, fs, geom, rpm=rpm, rpm_source=rpm_source, shaft_hz=shaft_hz, tacho=tacho,
                            pulses_per_rev=pulses_per_rev, tolerance=tolerance, n_harmonics=n_harmonics,
                            units=units)
     fr = float(speed["shaft_hz"])
@@ -210,7 +214,7 @@ def _run(x, fs, *, bearing, rpm=None, shaft_hz=None, tolerance=0.02, n_harmonics
         rms = band_rms(xa, fs, None, spectrum=ses.get("rfft") if xa is x else None)
         return _below_floor_unresolved(out, rms, floor_in_units(units, fs / 2), units)
     res = run_routes(xa, fs, geom, fr, tolerance=tolerance, n_harmonics=n_harmonics, prewhiten=prewhiten,
-                     xw=xw if xa is x else None, ses=ses if xa is x else None)
+                     ses=ses if xa is x else None)
     routes = res["routes"]
     verdict, humps = apply_humps(combine(routes, speed), routes, res["fault_hz"], shaft_hz=fr,
                                  factors=geom.frequency_factors(), speed_status=speed["status"], tolerance=tolerance)
@@ -228,7 +232,7 @@ def _run(x, fs, *, bearing, rpm=None, shaft_hz=None, tolerance=0.02, n_harmonics
         elif by == ["ees"]:
             period = 1.0 / routes["ees"]["families"][key]["measured_hz"]
         else:
-            period = _period(routes, by[0], key, xa, res["xw"], fs, res["band"])
+            period = _period(routes, by[0], key, xa, res["prewhitened"], fs, res["band"])
     result = _result(fs, fr, verdict, period, m, speed)
     fams = routes[decided]["families"]
     for k in ("bpfo", "bpfi", "bsf", "ftf"):
@@ -363,7 +367,7 @@ def shaft_speed(x, fs, *, bearing, rpm=None, rpm_source="given", tolerance=0.02,
     x = check_signal(x, func="shaft_speed", min_samples=1024)
     if x.ndim != 1:
         raise AnalysisError(f"shaft_speed: x must be one channel (1-D), got shape {x.shape}")
-    _, sp, _, _ = _speed(x, fs, _bearing(bearing), rpm=rpm, rpm_source=rpm_source, shaft_hz=None, tacho=None,
+    _, sp, _ = _speed(x, fs, _bearing(bearing), rpm=rpm, rpm_source=rpm_source, shaft_hz=None, tacho=None,
                       pulses_per_rev=1, tolerance=tolerance, n_harmonics=n_harmonics, fallback=False, units=units)
     return sp
 

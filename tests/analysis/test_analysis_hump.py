@@ -62,3 +62,11 @@ def test_hump_score_measures_a_hump_over_its_ring():
     for k in range(1, 5):
         s[np.abs(f - 140.0 * k) <= 1.5 * 11.8 + 0.02 * 140.0 * k] = 2.0
     assert hump_score(f, s, 140.0, **kw) == pytest.approx(4 * 10 * np.log10(2), abs=1e-6)
+
+
+def test_ring_median_is_numpys_median():
+    from bearing_lab.analysis import _hump
+    rng = np.random.default_rng(2)
+    for v in [rng.exponential(size=n) for n in (1, 2, 3, 6, 7, 1000, 12345)] + [np.array([2.0, 2.0, 1.0, 5.0])]:
+        assert _hump._median(v) == float(np.median(v))
+    assert np.isnan(_hump._median(np.array([1.0, np.nan, 3.0])))
