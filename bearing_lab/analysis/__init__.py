@@ -33,6 +33,7 @@ Public API
     impulses(x, fs, *, band, threshold, min_separation, level) -- Impulses(time, peak, duration, entry, exit, resolved)
     rms, peak, peak_to_peak, crest_factor, kurtosis, impulse_factor, clearance_factor, shape_factor (x, *, axis)
     metrics(x, *, axis=-1, units="1")                       -- dict of the eight metrics + "units"
+    METRICS, metric_units(name, signal_units)               -- the metrics' table (name -> Metric) and units
     analyze(x, fs, *, bearing, rpm, rpm_source, tacho, ...) -- dict: speed, verdict, evidence (docs/analysis.md)
     plot_analysis(x, fs, *, bearing, ..., path)             -- (figure, result): waveform, spectrum, SES with markers
     xr                                                      -- xarray wrappers of the above (apply_ufunc, dask-friendly)
@@ -44,7 +45,7 @@ from ._faults import diagnose_ses, fault_line  # noqa: F401
 from ._diagnosis import coincidences  # noqa: F401
 from ._impulse import excitation_duration, excitation_period, impulses, Impulses  # noqa: F401
 from ._metrics import (clearance_factor, crest_factor, impulse_factor, kurtosis, metrics,  # noqa: F401
-                       peak, peak_to_peak, rms, shape_factor)
+                       metric_units, METRICS, peak, peak_to_peak, rms, shape_factor)
 from ._cyclo import enhanced_envelope_spectrum  # noqa: F401
 from ._tacho import order_track, tacho_pulses, tacho_speed  # noqa: F401
 from .pipeline import analyze, plot_analysis, shaft_speed  # noqa: F401
@@ -55,6 +56,7 @@ __all__ = ["amplitude_spectrum", "welch_psd", "cepstral_prewhitening", "bandpass
            "squared_envelope_spectrum", "fast_kurtogram", "Kurtogram", "envelope_band",
            "interpolated_peak", "shaft_frequency", "fault_line", "diagnose_ses", "coincidences", "excitation_period",
            "excitation_duration", "impulses", "Impulses", "rms", "peak", "peak_to_peak", "crest_factor",
-           "kurtosis", "impulse_factor", "clearance_factor", "shape_factor", "metrics", "analyze",
+           "kurtosis", "impulse_factor", "clearance_factor", "shape_factor", "metrics", "METRICS", "metric_units",
+           "analyze",
            "plot_analysis", "xr", "shaft_speed", "tacho_pulses", "tacho_speed", "order_track",
            "enhanced_envelope_spectrum"]

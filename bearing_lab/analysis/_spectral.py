@@ -240,7 +240,7 @@ def _hann_ses_low(X, n, fs, band, fmax):
     is the 3-tap kernel (-1/4, 1/2, -1/4) on that DFT.  A minute at 20 kHz demodulated in a band
     of 833 Hz and read up to 1 kHz: transforms of 120 000 points instead of 1.2 M."""
     f = np.fft.rfftfreq(n, 1.0 / fs)  # increasing: the band's bins and those up to fmax are runs
-    lo, hi = (1, f.size) if band is None else (max(1, np.searchsorted(f, band[0])), np.searchsorted(f, band[1], "right"))
+    lo, hi = (1, f.size) if band is None else (max(1, f.searchsorted(band[0])), f.searchsorted(band[1], "right"))
     f = f[: int(np.searchsorted(f, fmax, side="right"))]
     K = f.size  # lags 0 .. K read (K for the window's kernel at the top bin)
     m = int(max(0, hi - lo))

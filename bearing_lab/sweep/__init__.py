@@ -399,7 +399,7 @@ def _assemble(acc, keys, values, shape, digests, metrics):
     out = acc.dataset(sdims, coords)
     if metrics:
         units = out[_METRIC_SIGNAL].attrs.get("units", "") if _METRIC_SIGNAL in out else ""
-        from ..analysis._metrics import METRICS, metric_units  # read at call time (run-time metrics)
+        from ..analysis import METRICS, metric_units  # read at call time (run-time metrics)
         for name in _METRICS:
             out[name] = (sdims, acc.metrics[name].reshape(shape),
                          {"units": metric_units(name, units),

@@ -116,7 +116,7 @@ def from_cache(cdir, scenes, digests, acc):
 
 def _metrics(x: np.ndarray) -> dict:
     """The sweep's metrics (the analysis table's functions; NaN where undefined)."""
-    from ..analysis._metrics import METRICS  # read at call time (run-time metrics)
+    from ..analysis import METRICS  # read at call time (run-time metrics)
     out = {}
     for name in SWEEP_METRICS:
         try:

@@ -146,8 +146,8 @@ def update_displacement(u, r, tau, extra, n_extra, kern, stalled, max_cells, ref
     """``u(p)`` after a step, without a transform: ``u - tau u(t) + u(extra)``, the last by
     direct summation over the few cells in ``extra`` (``kern[|di|, |dj|]``: a cell's
     displacement under unit pressure on another, m/Pa; in the sheared layout of
-    :func:`cg_direction` the array offset (di, dj) is the grid offset (di, dj + shear di)).  A problem that is ``stalled``,
-    has more than ``max_cells`` such cells, or every problem if ``refresh``, is marked
+    :func:`cg_direction` the array offset (di, dj) is the grid offset (di, dj + shear di)).  A problem
+    that is ``stalled``, has more than ``max_cells`` such cells, or every problem if ``refresh``, is marked
     ``fresh`` and left (its displacement is to be transformed anew).  Returns True if any is."""
     K, nx, ny = u.shape
     any_fresh = False
