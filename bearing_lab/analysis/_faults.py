@@ -127,7 +127,8 @@ def fault_line(f, ses, expected_hz, *, shaft_hz=None, tolerance=0.02, n_harmonic
     usable[0] = False
     out = {"expected_hz": float(expected_hz), "measured_hz": None, "snr_db": 0.0, "harmonics": 0,
            "sidebands": 0, "evidence_score": 0.0, "detected": False,
-           "units": {"expected_hz": "Hz", "measured_hz": "Hz", "snr_db": "dB", "evidence_score": "1 (sum of line SNRs in dB)"}}
+           "units": {"expected_hz": "Hz", "measured_hz": "Hz", "snr_db": "dB",
+                     "evidence_score": "1 (sum of line SNRs in dB)"}}
     lo = int(np.floor(expected_hz * (1 - tolerance) / df))
     hi = int(np.ceil(expected_hz * (1 + tolerance) / df))
     if hi >= f.size - 1:

@@ -438,7 +438,8 @@ def _fault_comb(raw, cs, f0, lines_h=()):
     envelope spectrum; a slip-free impact train (a simulation) is also a comb of discrete
     lines reaching the resonances.  Shaft harmonics of unbalance or misalignment are
     neither.  The test: the comb k f0 (k = 1..COMB_HARMONICS, each within one bin) passes the
-    noise rule (a fundamental line, MIN_HARMONICS lines) in the pre-whitened envelope spectrum or in that of the kurtogram band when the band is
+    noise rule (a fundamental line, MIN_HARMONICS lines) in the pre-whitened envelope spectrum or in that of the
+    kurtogram band when the band is
     impulsive (spectral kurtosis at least ``SK_MIN``: a band of a few steady lines has an
     envelope beating at their spacing) and lies above the family's clear lines
     ``lines_h``, or is a discrete comb up to 0.45 fs

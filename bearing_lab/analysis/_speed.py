@@ -10,8 +10,9 @@ are nominal.  The estimate has two stages:
    found at ``h * f0``.  With a fixed number of harmonics a sub-harmonic
    ``f0/2`` only collects half of the family, so the true family wins; an
    octave check then prefers ``f0/2`` or ``f0/3`` when their own odd lines are
-   present (even harmonics next to mains can otherwise win).  Lines within 1.5 bins of mains harmonics (50 and 60 Hz multiples by
-   default) are masked, because ``2 f_r`` sits next to 60 Hz at 1797 r/min.
+   present (even harmonics next to mains can otherwise win).  Lines within 1.5 bins of mains
+   harmonics (50 and 60 Hz multiples by default) are masked, because ``2 f_r`` sits next to 60 Hz
+   at 1797 r/min.
 2. Interpolated-DFT refinement of every harmonic that stands clear of the floor
    (Quinn's second estimator on the rectangular-window DFT, or the exact
    two-point ratio of the Hann window), then a weighted least-squares fit of

@@ -187,7 +187,8 @@ def _evidence(res, verdict, speed, fs, n, tolerance, n_harmonics, decided):
     ff = res["fault_hz"]
     fams = routes[decided]["families"]
     ev = {"candidates": verdict["candidates"], "secondary": verdict["secondary"], "runner_up": LABELS[second],
-          "margin_score": margin, "leader_lines": line_stats(fams[lead]), "runner_up_lines": line_stats(fams[second]), "decided_by": verdict["decided_by"], "reason": verdict["reason"],
+          "margin_score": margin, "leader_lines": line_stats(fams[lead]), "runner_up_lines": line_stats(fams[second]),
+          "decided_by": verdict["decided_by"], "reason": verdict["reason"],
           "band": {"low_hz": None if res["band"] is None else float(res["band"][0]),
                    "high_hz": None if res["band"] is None else float(res["band"][1]),
                    "spectral_kurtosis": float(res["spectral_kurtosis"]), "impulsive": bool(res["impulsive"])},

@@ -17,10 +17,12 @@ import xarray as xr
 
 from .._version import __version__
 from ..report import Report
-from ..report.html import esc
+from ..errors import BearingLabError
+from ..io.export import to_netcdf
+from ..report.html import list_html
 from ..sweep import dim_name, key_units
-from ..units import G as G0
-from ..utils._files import atomic_open, atomic_path
+from ..units import G
+from ..utils._files import atomic_open
 from ..utils._json import clean
 from ..utils.figures import new_figure
 from .identify import PARAMS
@@ -75,9 +77,9 @@ def figures(result) -> list:
 def _best_figure(result, rec, best):
     fig = new_figure(figsize=(10, 3.4), layout="constrained")
     ax = fig.subplots()
-    ax.plot(rec.time * 1e3, rec.envelope / G0, color="k", lw=1.2, label=f"recording ({rec.n_impacts} impacts)")
+    ax.plot(rec.time * 1e3, rec.envelope / G, color="k", lw=1.2, label=f"recording ({rec.n_impacts} impacts)")
     lag = result.best.get("lag_s", 0.0)
-    ax.plot((best.time - lag) * 1e3, best.envelope / G0, color="tab:red", lw=1.0,
+    ax.plot((best.time - lag) * 1e3, best.envelope / G, color="tab:red", lw=1.0,
             label="best scene after the fixed path and background")
     ax.set_xlabel("time from the impact (ms)")
     ax.set_ylabel("mean envelope (g)")
@@ -110,15 +112,18 @@ def _profile_figure(result):
                       f"interval threshold); shaded: the interval."))
 
 
-def _sections(result) -> list:
-    items = "".join(f"<li>{esc(p['statement'])}</li>" for p in result.parameters.values())
-    notes = "".join(f"<p class=\"note\">{esc(n)}</p>" for n in result.notes)
-    text = (f"<p>{result.n_scenes} simulated scenes, {result.cpu_time_s:.0f} s CPU in this process "
-            f"({result.wall_time_s:.0f} s wall). Interval threshold {result.threshold_db:.2f} dB (the recording's "
-            f"split-half misfit {result.noise_db:.2f} dB"
-            + (f"; the score's roughness at the best scene {result.roughness_db:.2f} dB" if result.roughness_db is not None
-               else "") + f").</p><ul>{items}</ul>{notes}")
-    return [("Defect identification", text, None)] + [("Defect identification: figures", None, figures(result))]
+def _add_sections(rep, result):
+    """The identification's sections: what was run and the threshold, one statement per parameter, the
+    notes, the figures (through the report's templates)."""
+    rough = (f"; the score's roughness at the best scene {result.roughness_db:.2f} dB"
+             if result.roughness_db is not None else "")
+    rep.add_text(f"{result.n_scenes} simulated scenes, {result.cpu_time_s:.0f} s CPU in this process "
+                 f"({result.wall_time_s:.0f} s wall). Interval threshold {result.threshold_db:.2f} dB (the "
+                 f"recording's split-half misfit {result.noise_db:.2f} dB{rough}).", "Defect identification")
+    rep.add_html(list_html([p["statement"] for p in result.parameters.values()]), None)
+    if result.notes:
+        rep.add_text(list(result.notes), None, note=True)
+    rep.add_figures(figures(result), "Defect identification: figures")
 
 
 def add_to_case_report(result, case_dir):
@@ -126,11 +131,7 @@ def add_to_case_report(result, case_dir):
     rj = case_dir / "report.json"
     rep = Report.load(rj) if rj.is_file() else Report(f"{result.case}: defect identification")
     rep.sections = [s for s in rep.sections if not s["title"].startswith("Defect identification")]
-    for title, html, figs in _sections(result):
-        if figs is None:
-            rep.add_html(html, title)
-        else:
-            rep.add_figures(figs, title)
+    _add_sections(rep, result)
     rep.save(case_dir / ("index.html" if rj.is_file() else "identification.html"))
     if rj.is_file():
         rep.save(rj)
@@ -143,11 +144,9 @@ def write_identification(result, out, *, report=False, stem="identification") ->
     paths = {ext: d / f"{stem}.{ext}" for ext in ("json", "nc", "html")}
     with atomic_open(paths["json"], "w", encoding="utf-8") as fh:
         json.dump(clean(result.to_dict()), fh, indent=1, allow_nan=False)
-    with atomic_path(paths["nc"]) as tmp:
-        landscape(result).to_netcdf(tmp)
+    to_netcdf(landscape(result), paths["nc"], error=BearingLabError)
     rep = Report(f"{result.case}: defect identification" + (" (PARTIAL: interrupted)" if result.partial else ""))
-    for title, html, figs in _sections(result):
-        rep.add_html(html, title) if figs is None else rep.add_figures(figs, title)
+    _add_sections(rep, result)
     rep.add_provenance()
     rep.save(paths["html"])
     if report:

@@ -2,7 +2,8 @@
 
 Why exact rather than paraboloidal: the rigid drops of a 6308 ball into small defects
 are fractions of a micrometre (checked against a brute-force grid computation over the
-raceway, tests/sim/test_defect_geometry.py), and the outer groove is so conformal (r_o = 0.53 D_b) that small differences in
+raceway, tests/sim/test_defect_geometry.py), and the outer groove is so conformal (r_o = 0.53 D_b) that small
+differences in
 the across-track curvature matter.  The exact formulas cost no more than the
 approximations once vectorised.
 
@@ -269,7 +270,8 @@ def rigid_drop(defect: Defect, bearing, *, clearance: float = 0.0,
 
     The ball centre is at the defect centre's angular position and on the track centre
     line (z = 0), exact sphere in the exact torus groove (see the module docstring).  For
-    the 6308 outer race and a 1 x 1 mm, 0.5 mm deep defect this is 0.9413 µm.  A ball defect needs ``against`` ("outer" or "inner"): the defect
+    the 6308 outer race and a 1 x 1 mm, 0.5 mm deep defect this is 0.9413 µm.  A ball defect needs ``against``
+    ("outer" or "inner"): the defect
     centre at the contact point, its outline laid on the contact plane (first order).
     """
     if defect.race == "ball":

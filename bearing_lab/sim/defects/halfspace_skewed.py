@@ -130,7 +130,8 @@ def window(defect: Defect, geom: RaceGeometry, g: SkewedGrid, s_ball: float):
 
 def windows(defect: Defect, geom: RaceGeometry, g: SkewedGrid, s_balls: np.ndarray):
     """:func:`window` for K ball positions at once (one pass of the gap formula; the floor's
-    gap inside the outline only, the intact gap elsewhere): arrays (K, nu, nv), and the ball's sub-cell offsets (fu, fv) (each (K,), see :func:`_anchor`)."""
+    gap inside the outline only, the intact gap elsewhere): arrays (K, nu, nv), and the ball's sub-cell offsets
+    (fu, fv) (each (K,), see :func:`_anchor`)."""
     c, sn = math.cos(defect.skew), math.sin(defect.skew)
     s_balls = np.asarray(s_balls, dtype=float)
     xu = ((s_balls * c - defect.offset * sn) + defect.length / 2) / g.du - g.nu / 2
@@ -159,7 +160,8 @@ class IntactForce:
     is periodic in both, and even (the offsets (fu, fv) and (-fu, -fv) see the same contact
     turned by 180 degrees: forces within 4e-8).  It is solved on an m x m lattice of offsets
     (one of each even pair, (m^2 + 1) / 2 solves in one batch, started from the intact
-    pressure ``p0`` at another offset) and read between them by trigonometric interpolation, instead of one intact solve per ball position (which
+    pressure ``p0`` at another offset) and read between them by trigonometric interpolation, instead of one intact
+    solve per ball position (which
     doubled a table's solves).  On the tables' grids the force spreads by 0.03 % (fine) to
     0.17 % (coarse) over the offsets (up to 0.3 % on paper-O2's coarse grids); the lattice
     (:data:`INTACT_LATTICE`: 3 x 3 on the fine grid, whose solves cost three times the coarse

@@ -42,8 +42,8 @@ from .outlines import OUTLINES, finite as _finite
 RACES = ("outer", "inner", "ball")
 #: the outline names a scene accepts (``defect.shape``): the registry in :mod:`.outlines`
 SHAPES = tuple(OUTLINES)
-#: Default defect depth (m): 0.5 mm.  The reference paper (Liu et al.) does not state one; any depth much larger than the ball's drop (micrometres) gives the
-#: same response.
+#: Default defect depth (m): 0.5 mm.  The reference paper (Liu et al.) does not state one; any depth much larger
+#: than the ball's drop (micrometres) gives the same response.
 DEFAULT_DEPTH = 0.5e-3
 
 _KEYS = ("race", "shape", "length_mm", "width_mm", "depth_mm", "offset_mm", "skew_deg",

@@ -207,7 +207,8 @@ class Polygon(Outline):
             raise SceneError(f"{where}.vertices: a polygon defect needs at least 3 vertices")
         v = np.asarray(defect.vertices, dtype=float)
         if v.ndim != 2 or v.shape[1] != 2 or v.shape[0] < 3:
-            raise SceneError(f"{where}.vertices must be a list of at least 3 [along, across] pairs, got shape {v.shape}")
+            raise SceneError(f"{where}.vertices must be a list of at least 3 [along, across] pairs, "
+                             f"got shape {v.shape}")
         if not np.all(np.isfinite(v)):
             raise SceneError(f"{where}.vertices must be finite")
         if abs(polygon_area(v)) <= 0:
