@@ -107,6 +107,11 @@ REGISTRY: tuple[Entry, ...] = (
     Entry("cwru_preload.py", ("125", "188", "250", "--rtol", "1e-8"), variant="converged",
           quick=("250", "--rtol", "1e-6"), cost="35 s", quick_cost="~15 s", quoted_in=(B, D + "validation.md")),
     Entry("bearing3d_cost.py", (), cost="24 s", quoted_in=(B, D + "model.md")),
+    # a grazed pit's peak under rounding-level perturbations per solver setting: auto's grazed-defect rule
+    Entry("grazed_peak.py", (), quick=("--quick",), cost="52 s", quick_cost="5 s",
+          quoted_in=(B, D + "model.md", "bearing_lab/sim/auto.py")),
+    Entry("grazed_peak.py", ("--o2",), variant="o2", quick=("--o2", "--perturbations", "1"), cost="22 s",
+          quick_cost="6 s", quoted_in=(B,)),
     Entry("diagnosis_eval.py", ("--repeat", "7"), quick=("--quick", "--repeat", "1"), mirror_arg=True,
           cost="19 s", quick_cost="13 s", quoted_in=("benchmarks/README_diagnosis.md", D + "analysis.md")),
     Entry("io_throughput.py", ("--repeat", "7"), quick=("--repeat", "1", "--big-mb", "4"), mirror_arg=True,
