@@ -30,7 +30,7 @@ REFINE_XTOL = 1.0 / 16.0
 REFINE_FIRST_STEP = 0.125
 REFINE_FTOL_DB = 0.01
 #: a profile value's simplex starts with steps of this fraction of the coarse step along each other parameter
-PROFILE_FIRST_STEP = 0.125
+PROFILE_FIRST_STEP = 0.25
 
 
 def snap(grid, key, x) -> float:
