@@ -18,7 +18,16 @@ bracket these with the spread of a shared machine; update them from this output.
 standin``, ``case new``, the TOML additions, ``validate``, then ``identify rig.toml -o reports --report``),
 twice: with an empty table cache of its own, then again with the tables cached (the second run with its
 journal removed, so that it simulates every scene).  CPU time (user + system, ``RUSAGE_CHILDREN``) of the
-``identify`` command alone, its scene count and answer (a few minutes on the shared 2-core machine).
+``identify`` command alone, its scene count and answer, and whether the estimate it printed before its
+scenes ran brackets their CPU time (the command's CPU less its setup).  Then the small grid of 12 scenes
+without refinement (``--length-mm 2.5 3 3.6 --offset-mm 0 0.3 --skew-deg 0 30 --no-refine``) on the same
+case, with a table cache of its own left empty: CPU time of the whole process (a few minutes in all on
+the shared 2-core machine).
+
+``--phases``: where the cold walkthrough's CPU time goes, in this process: the same identification (its
+table cache a copy of the one ``validate`` left, as in ``--walkthrough``), each scene and each contact table
+counted in the step that asked for it (coarse grid, simplex, roughness probe, profiles, polish, recheck),
+with the CPU time of the tables built (as each table's build recorded it) and of the step.
 """
 from __future__ import annotations
 
@@ -26,6 +35,7 @@ import argparse
 import json
 import os
 import resource
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -61,45 +71,146 @@ def _cli(args, cwd, env):
     return (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime), out
 
 
+def _walkthrough_case(tmp, env) -> None:
+    """The README walkthrough's stand-in, case and validation in ``tmp`` (tables in ``env``'s cache)."""
+    for args in (STANDIN, CASE_NEW):
+        _cli(args, tmp, env)
+    with open(Path(tmp) / "rig.toml", "a", encoding="utf-8") as fh:
+        fh.write(ADDED)
+    _cli(["validate", "rig.toml", "-o", "reports"], tmp, env)
+
+
 def walkthrough(quick=False) -> None:
-    """The README walkthrough's identification, cold then warm (see the module docstring); ``quick``: one
-    scene at the hidden geometry, no refinement."""
+    """The README walkthrough's identification, cold then warm, and the 12-scene grid cold (see the module
+    docstring); ``quick``: one scene at the hidden geometry, no refinement, and no 12-scene grid."""
     with tempfile.TemporaryDirectory(prefix="identify_walkthrough_") as tmp:
         env = {**os.environ, "BEARING_LAB_CACHE": str(Path(tmp) / "cache")}
-        for args in (STANDIN, CASE_NEW):
-            _cli(args, tmp, env)
-        with open(Path(tmp) / "rig.toml", "a", encoding="utf-8") as fh:
-            fh.write(ADDED)
-        _cli(["validate", "rig.toml", "-o", "reports"], tmp, env)
+        _walkthrough_case(tmp, env)
         print("\n| run (README walkthrough) | scenes | CPU s | length mm | offset H mm | skew θ° | all hidden values "
-              "inside their intervals |\n|---|---|---|---|---|---|---|")
+              "inside their intervals | estimate of the scenes' CPU s (brackets it) |\n|---|---|---|---|---|---|---|---|")
         for label in ("empty table cache", "tables cached"):
             (Path(tmp) / "reports" / "rig" / "identification-journal.jsonl").unlink(missing_ok=True)
             small = ["--length-mm", "3", "--offset-mm", "0.3", "--skew-deg", "30", "--no-refine"] if quick else []
             cpu, out = _cli(["identify", "rig.toml", "-o", "reports", "--report", "--json", "--no-progress", *small],
                             tmp, env)
-            r = json.loads(out)
-            inside = all(r["parameters"][k]["interval"][0] <= v <= r["parameters"][k]["interval"][1]
-                         for k, v in HIDDEN.items())
-            best = [r["best"][k] for k in HIDDEN]
-            print(f"| {label} | {r['n_scenes']} | {cpu:.1f} | {best[0]:g} | {best[1]:g} | {best[2]:g} | "
-                  f"{'yes' if inside else 'NO'} |", flush=True)
+            r = _row(label, cpu, json.loads(out))
         for k in HIDDEN:
             print(f"- {r['parameters'][k]['statement']}")
         print(f"- threshold {r['threshold_db']:.2f} dB, roughness {r['roughness_db'] or 0:.2f} dB, "
-              f"best score {r['best']['score_db']:.2f} dB; estimate {r['estimate']['cpu_s'][0]:.0f}-"
-              f"{r['estimate']['cpu_s'][1]:.0f} s (likely {r['estimate']['likely_cpu_s']:.0f} s) for the warm run")
+              f"best score {r['best']['score_db']:.2f} dB")
+        notes = [n for n in r["notes"] if "interval ends excluded" in n]
+        print("".join(f"- {n}\n" for n in notes), end="")
+        if quick:
+            return
+        print("\n| run (12-scene grid, no refinement) | scenes | CPU s (whole process) | length mm | offset H mm | "
+              "skew θ° | all hidden values inside their intervals | estimate of the scenes' CPU s (brackets it) |"
+              "\n|---|---|---|---|---|---|---|---|")
+        env12 = {**os.environ, "BEARING_LAB_CACHE": str(Path(tmp) / "cache-grid12")}
+        cpu, out = _cli(["identify", "rig.toml", "-o", "reports-grid12", "--json", "--no-progress", *GRID12], tmp,
+                        env12)
+        _row("empty table cache", cpu, json.loads(out))
+
+
+#: the small grid: 3 lengths, 2 offsets, 2 skews, no refinement (12 scenes)
+GRID12 = ["--length-mm", "2.5", "3", "3.6", "--offset-mm", "0", "0.3", "--skew-deg", "0", "30", "--no-refine"]
+
+
+def _row(label, cpu, r) -> dict:
+    """Print one table row of an identification's JSON ``r`` that cost ``cpu`` s; returns ``r``."""
+    inside = all(r["parameters"][k]["interval"][0] <= v <= r["parameters"][k]["interval"][1] for k, v in HIDDEN.items())
+    best = [r["best"][k] for k in HIDDEN]
+    lo, hi = r["estimate"]["cpu_s"]
+    scenes = r["cpu_time_s"] - r["setup_cpu_s"]
+    print(f"| {label} | {r['n_scenes']} | {cpu:.1f} | {best[0]:g} | {best[1]:g} | {best[2]:g} | "
+          f"{'yes' if inside else 'NO'} | {lo:.0f}-{hi:.0f} (likely {r['estimate']['likely_cpu_s']:.0f}) for "
+          f"{scenes:.1f} ({'yes' if lo <= scenes <= hi else 'NO'}) |", flush=True)
+    return r
+
+
+def phases(quick=False) -> None:
+    """Where the cold walkthrough's CPU goes, per step of the search (see the module docstring); ``quick``:
+    the 12-scene grid without refinement instead."""
+    with tempfile.TemporaryDirectory(prefix="identify_phases_") as tmp:
+        env = {**os.environ, "BEARING_LAB_CACHE": str(Path(tmp) / "cache-validate")}
+        _walkthrough_case(tmp, env)
+        shutil.copytree(Path(tmp) / "cache-validate", Path(tmp) / "cache")
+        os.environ["BEARING_LAB_CACHE"] = str(Path(tmp) / "cache")
+        t0 = time.process_time()
+        import importlib
+        from bearing_lab.sim import defects
+        idm = importlib.import_module("bearing_lab.validation.identify")
+        step = ["setup"]
+        rows: dict = {}
+
+        def row():
+            return rows.setdefault(step[0], {"scenes": 0, "tables": 0, "table_cpu": 0.0, "cpu": 0.0})
+        real_table = defects.contact_table
+
+        def table(*a, **k):
+            t = real_table(*a, **k)
+            if t.info.get("source") == "built":
+                row()["tables"] += 1
+                row()["table_cpu"] += float(t.info.get("build_cpu_s", 0.0))
+            return t
+        defects.contact_table = table
+        real_sweep = idm._sweep_scored
+
+        def sweep(setting, base, params, combos, scored, *a, **k):
+            c, n = time.process_time(), len(scored)
+            real_sweep(setting, base, params, combos, scored, *a, **k)
+            row()["scenes"] += len(scored) - n
+            row()["cpu"] += time.process_time() - c
+        idm._sweep_scored = sweep
+
+        def tagged(name, label, first=False):
+            real = getattr(idm, name)
+
+            def run(*a, **k):
+                old, step[0] = step[0], label
+                try:
+                    return real(*a, **k)
+                finally:
+                    step[0] = label if first else old
+            setattr(idm, name, run)
+        for name, label in (("minimise", "simplex"), ("walk_profiles", "profiles"), ("polish", "polish"),
+                            ("recheck", "recheck")):
+            tagged(name, label)
+        tagged("probes", "roughness probe", first=True)
+        real_setting = idm._setting
+
+        def setting(*a, **k):
+            out = real_setting(*a, **k)
+            step[0] = "coarse grid"
+            return out
+        idm._setting = setting
+        small = {"defect.length_mm": [2.5, 3.0, 3.6], "defect.offset_mm": [0.0, 0.3], "defect.skew_deg": [0.0, 30.0]}
+        r = idm.identify(str(Path(tmp) / "rig.toml"), progress=False, **(dict(grid=small, refine=False) if quick else {}))
+        total = time.process_time() - t0
+    print(f"\nidentify() in this process, cold: {total:.1f} s CPU (imports included; setup {r.setup_cpu_s:.1f} s), "
+          f"{r.n_scenes} scenes ({r.estimate['mirrored']} of them mirrored, not simulated)\n")
+    print("| step | scenes simulated | contact tables built | their CPU s | step CPU s |\n|---|---|---|---|---|")
+    for label, v in rows.items():
+        if label != "setup":
+            print(f"| {label} | {v['scenes']} | {v['tables']} | {v['table_cpu']:.1f} | {v['cpu']:.1f} |")
+    tot = [sum(v[k] for lab, v in rows.items() if lab != "setup") for k in ("scenes", "tables", "table_cpu", "cpu")]
+    print(f"| all | {tot[0]} | {tot[1]} | {tot[2]:.1f} | {tot[3]:.1f} |")
+    print("\n" + "\n".join(f"- {p['statement']}" for p in r.parameters.values()))
 
 
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--repeat", type=int, default=2)
     ap.add_argument("--walkthrough", action="store_true", help="the README walkthrough's identification instead")
-    ap.add_argument("--quick", action="store_true", help="with --walkthrough: one scene, no refinement (a check "
-                                                        "that the walkthrough runs, not its cost)")
+    ap.add_argument("--quick", action="store_true", help="with --walkthrough: one scene, no refinement; with "
+                                                        "--phases: the 12-scene grid, no refinement (checks that "
+                                                        "they run, not their cost)")
+    ap.add_argument("--phases", action="store_true", help="the cold walkthrough's CPU per step of the search")
     args = ap.parse_args()
     if args.walkthrough:
         walkthrough(quick=args.quick)
+        return
+    if args.phases:
+        phases(quick=args.quick)
         return
     os.environ["BEARING_LAB_CACHE"] = tempfile.mkdtemp(prefix="identify_cost_")
     from bearing_lab.sim import load_scene, simulate

@@ -125,6 +125,8 @@ REGISTRY: tuple[Entry, ...] = (
     Entry("identify_cost.py", ("--walkthrough",), variant="walkthrough", quick=("--walkthrough", "--quick"),
           cost="~3 min", quick_cost="~15 s",
           quoted_in=("README.md", D + "identification.md")),
+    Entry("identify_cost.py", ("--phases",), variant="phases", quick=("--phases", "--quick"),
+          cost="~2 min", quick_cost="~30 s", quoted_in=(D + "identification.md",)),
     Entry("identify_selfconsistency.py", (), quick=("--quick",), cost="~1 min", quick_cost="13 s",
           quoted_in=(D + "identification.md",)),
     Entry("sweep_scaling.py", (), quick=("--scenes", "4", "--duration", "0.1", "--rounds", "1"),

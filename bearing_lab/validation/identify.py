@@ -9,7 +9,9 @@ long; every scene's impact signature is scored against the recording's (:mod:`.c
 steps): from the best coarse scene a simplex search follows the misfit's valleys; the score's
 roughness is probed there; each parameter's *profile* is then walked from the best value through the
 coarse values and half steps, minimising over the other parameters at each until a value lies more
-than ``threshold_db`` above the best; and a polish searches again from the profile points that
+than ``threshold_db`` above the best (a value whose first scenes all lie far above it, by
+:data:`.identify_run.PROFILE_CLEAR` thresholds, is excluded there, and the notes say which interval ends
+were so excluded); and a polish searches again from the profile points that
 explain the recording as well but lie apart from the best.
 The interval of a parameter spans the accepted values up to the nearest excluded walked value on
 each side.  A parameter no walked value excludes is *flat*: not identifiable from this recording.
@@ -32,8 +34,8 @@ from ..errors import ValidationCaseError
 from ..sweep import dim_name, run_sweep, scene_hash
 from . import simulation
 from .candidates import candidate_signature, setting_for
-from .identify_run import (REFINE_MAX_SCENES, Journal, Progress, comparison_fingerprint, estimate, estimate_text,
-                           mirrors)
+from .identify_run import (PROFILE_CLEAR, PROFILE_CLEAR_SCENES, REFINE_MAX_SCENES, Journal, Progress,
+                           comparison_fingerprint, estimate, estimate_text, mirrors)
 from .identify_search import (REFINE_FIRST_STEP, REFINE_XTOL, ROUGHNESS_STEP, coarse_steps, minimise, polish, probes,
                               recheck, walk_profiles)
 from .load import load_case
@@ -259,7 +261,7 @@ def identify(case, *, grid=None, refine=True, scheduler="serial", n_workers=None
         ``defect.skew_deg``, ``defect.depth_mm``.
     refine : bool
         After the coarse grid: a simplex search from its best scene, the roughness probe there (each
-        parameter moved by 0.3 % of its grid step; the threshold is at least twice the score change),
+        parameter moved one way by 0.3 % of its grid step; the threshold is at least twice the score change),
         profiles walked by minimisation, and the polish.  False: the grid's scores (profiles are upper bounds).
     scheduler, n_workers, cache_dir : as :func:`bearing_lab.sweep.run_sweep` (default serial, in process, no
         sweep cache: 3.6 MB per scene of 1 s at 20 kHz; contact tables are cached regardless).
@@ -300,12 +302,13 @@ def identify(case, *, grid=None, refine=True, scheduler="serial", n_workers=None
     points: list = []
     keep: dict = {}
     walked = roughness = None
+    cleared: dict = {}
     try:
         _run_grid(st, base, grid, scheduler=client, cache_dir=cache_dir, bar=bar, out=points, keep=keep, journal=jr)
         bar.tables(0, ())
         if refine:
             run = dict(scheduler="serial", cache_dir=cache_dir, bar=bar, out=points, keep=keep, journal=jr)
-            roughness, thr, walked = _refinement(st, base, grid, points, run, thr, threshold_db is None)
+            roughness, thr, walked, cleared = _refinement(st, base, grid, points, run, thr, threshold_db is None)
         best = min(points, key=lambda p: p["score_db"])
         if keep.get("score_db") != best["score_db"]:     # the best scene was read back: its signature again
             keep = {}
@@ -323,13 +326,14 @@ def identify(case, *, grid=None, refine=True, scheduler="serial", n_workers=None
             client.close()
     res = _stamped(_result(case, st, points, grid, thr, declared, t_cpu, t_wall, keep["signature"], roughness,
                            walked), len(old), est, setup_cpu)
-    res.notes += _method_notes(st, base, grid, res.best, est, refine)
+    res.notes += _method_notes(st, base, grid, res, est, refine, cleared)
     return res
 
 
-def _method_notes(st, base, grid, best, est, refine) -> list:
-    """What the search's economies mean for this result: the candidates' length, the mirrored scenes, and
-    the refinement's lattice (the resolution of the best values)."""
+def _method_notes(st, base, grid, res, est, refine, cleared=None) -> list:
+    """What the search's economies mean for this result: the candidates' length, the mirrored scenes, the
+    refinement's lattice (the resolution of the best values) and the profile values excluded by a margin
+    after their first scenes (weaker evidence than a whole minimisation)."""
     rec = st.prep.n / st.prep.fs
     out = []
     if base.duration < rec - 1e-9:
@@ -339,11 +343,21 @@ def _method_notes(st, base, grid, best, est, refine) -> list:
         out.append(f"{est['mirrored']} coarse scenes at H = 0 and θ < 0 were not simulated: they are scored as their "
                    "mirror images (H = 0, -θ), which give the same signal")
     if refine:
-        steps = {k: v * REFINE_XTOL for k, v in coarse_steps(grid, best).items()}
+        steps = {k: v * REFINE_XTOL for k, v in coarse_steps(grid, res.best).items()}
         out.append(f"refinement scenes lie on a lattice of 1/{round(1 / REFINE_XTOL)} of the coarse grid's steps "
                    "(near the best: "
                    + ", ".join(f"{PARAMS[k][0]} {v:.3g} {PARAMS[k][1]}" for k, v in steps.items())
                    + "): the best values are resolved to it")
+    vals = {}
+    for k, x in sorted(cleared or ()):      # the interval ends so excluded (a later scene may accept a value)
+        p = res.parameters[k]
+        if x in p["interval"] and dict(p["profile"]).get(x, -np.inf) > res.best["score_db"] + res.threshold_db:
+            vals.setdefault(k, []).append(f"{x:g}")
+    if vals:
+        out.append(f"interval ends excluded after their first {PROFILE_CLEAR_SCENES} scenes, all more than "
+                   f"{PROFILE_CLEAR:g} times the threshold above the best, without the rest of their minimisation: "
+                   + "; ".join(f"{PARAMS[k][0]} {', '.join(v)} {PARAMS[k][1]}" for k, v in vals.items())
+                   + " (a basin narrower than those scenes' steps could still lie there)")
     return out
 
 
@@ -439,11 +453,12 @@ def _refinement(st, base, grid, points, run, thr, widen):
         if widen:                   # the best and any other scene each move by up to it
             thr = max(thr, 2 * roughness)
     early: dict = {}
+    cleared: dict = {}
     walked = walk_profiles(grid, best, score, lambda: min(p["score_db"] for p in points), thr, points,
-                            early=early)
+                           early=early, cleared=cleared)
     polish(grid, walked, points, score, thr)
     recheck(grid, walked, early, score, points, thr)
-    return roughness, thr, walked
+    return roughness, thr, walked, cleared
 
 
 def _client(scheduler, n_workers):

@@ -35,21 +35,25 @@ TABLE_CPU_S = {"aligned": (0.08, 1.0), "skewed": (0.3, 3.0)}
 #: CPU s per second of record of one scene with its table cached, its signature and score included
 #: (0.08-0.10 s for the time loop at rtol 1e-6, 20 kHz; the sweep, the Dataset and the scoring add to it)
 SCENE_CPU_S_PER_S = (0.08, 0.8)
-#: fewest scenes the refinement adds in the runs measured (68-80 on the stand-ins, docs/identification.md);
+#: fewer scenes than the refinement added in any run measured (53-57 on the stand-ins, docs/identification.md);
 #: its most is its budget
-REFINE_FEWEST = 40
+REFINE_FEWEST = 30
 #: the likely figures inside those brackets: the middle of the measured tables (0.17 s aligned, 0.47-1.14 s
 #: skewed), a scene with its scoring (0.065 s for the README walkthrough's 0.65 s scenes), and the
 #: refinement's scenes in the runs measured
 TABLE_CPU_LIKELY_S = {"aligned": 0.17, "skewed": 0.9}
 SCENE_CPU_LIKELY_S_PER_S = 0.12
-REFINE_LIKELY = 75
+REFINE_LIKELY = 55
 #: the search's budgets (identify.py runs the search; the estimate bounds it from these):
 #: the refinement's simplex stops at REFINE_MAX_SCENES scenes; a profile value is the best score over
 #: the other parameters found in at most PROFILE_MAX_SCENES scenes; the polish makes at most
 #: POLISH_STARTS starts, each a simplex search of at most POLISH_MAX_SCENES scenes
 REFINE_MAX_SCENES = 30
 PROFILE_MAX_SCENES = 10
+#: a profile value whose first PROFILE_CLEAR_SCENES scenes (its start and the first simplex around it) all
+#: score more than PROFILE_CLEAR thresholds above the best is excluded there, without the rest of its budget
+PROFILE_CLEAR_SCENES = 3
+PROFILE_CLEAR = 2.0
 POLISH_STARTS = 2
 POLISH_MAX_SCENES = 15
 
@@ -60,7 +64,7 @@ def refine_budget(grid) -> int:
     searched = [v for v in grid.values() if len(v) > 1]
     n = len(searched)
     walked = sum(2 * len(v) - 2 for v in searched)          # coarse values and half steps, the best apart
-    return (REFINE_MAX_SCENES + n + 2 * n + walked * (PROFILE_MAX_SCENES + n)
+    return (REFINE_MAX_SCENES + n + n + walked * (PROFILE_MAX_SCENES + n)
             + POLISH_STARTS * (POLISH_MAX_SCENES + n))
 
 

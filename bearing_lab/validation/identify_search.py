@@ -12,7 +12,8 @@ from __future__ import annotations
 import lazy_loader as lazy
 import numpy as np
 
-from .identify_run import POLISH_MAX_SCENES, POLISH_STARTS, PROFILE_MAX_SCENES
+from .identify_run import (POLISH_MAX_SCENES, POLISH_STARTS, PROFILE_CLEAR, PROFILE_CLEAR_SCENES,
+                           PROFILE_MAX_SCENES)
 
 # the simplex (Nelder-Mead): loaded when a refinement runs
 _optimize = lazy.load("scipy.optimize", suppress_warning=True)
@@ -26,8 +27,10 @@ __all__ = ["REFINE_XTOL", "REFINE_FIRST_STEP", "REFINE_FTOL_DB", "ROUGHNESS_STEP
 #: REFINE_FTOL_DB
 REFINE_XTOL = 1.0 / 16.0
 #: the refinement's simplex starts with steps of this fraction of the coarse step along each parameter
-REFINE_FIRST_STEP = 0.25
+REFINE_FIRST_STEP = 0.125
 REFINE_FTOL_DB = 0.01
+#: a profile value's simplex starts with steps of this fraction of the coarse step along each other parameter
+PROFILE_FIRST_STEP = 0.25
 
 
 def snap(grid, key, x) -> float:
@@ -92,12 +95,19 @@ class _Accepted(Exception):
     """A profile value's minimisation found a scene within the threshold: the value is accepted."""
 
 
-def profile_value(grid, k, x, best_point, score, points, budget, accept_at):
+class _Cleared(Exception):
+    """A profile value's least score after its first PROFILE_CLEAR_SCENES scenes lies more than PROFILE_CLEAR
+    thresholds above the best: the value is excluded without the rest of its budget."""
+
+
+def profile_value(grid, k, x, best_point, score, points, budget, accept_at, clear_at=None):
     """The profile at ``k`` = ``x``: the least score over the other parameters, found by :func:`minimise`
-    (a quarter coarse step first, from the better of the best scene's other values and the best scene
+    (PROFILE_FIRST_STEP of a coarse step first, from the better of the best scene's other values and the best scene
     already simulated at ``x``) in at most ``budget`` scenes; it stops as soon as a scene scores at most
-    ``accept_at()`` (the value is then accepted: a lower minimum would not change that).  Returns
-    (least score found, scenes used, stopped early)."""
+    ``accept_at()`` (the value is then accepted: a lower minimum would not change that), or, given
+    ``clear_at``, when its first PROFILE_CLEAR_SCENES scenes all score above ``clear_at()`` (the value is
+    then excluded by a wide margin).  Returns (least score found, scenes used, how it stopped: "accepted",
+    "cleared" or None)."""
     found = []
 
     def f(point):
@@ -105,31 +115,38 @@ def profile_value(grid, k, x, best_point, score, points, budget, accept_at):
         found.append(val)
         if val <= accept_at():
             raise _Accepted
+        if clear_at is not None and len(found) == PROFILE_CLEAR_SCENES and min(found) > clear_at():
+            raise _Cleared
         return val
     here = [p for p in points if abs(p[k] - x) <= 1e-12]
     start = {**{q: best_point[q] for q in grid}, k: x}
     try:
         if here and min(p["score_db"] for p in here) <= accept_at():
-            return min(p["score_db"] for p in here), 0, True
+            return min(p["score_db"] for p in here), 0, "accepted"
         if here and min(p["score_db"] for p in here) < f(start):
             start = {q: min(here, key=lambda p: p["score_db"])[q] for q in grid}
-        minimise(grid, start, f, [q for q in grid if q != k], budget - len(found), first_step=0.25)
+        minimise(grid, start, f, [q for q in grid if q != k], budget - len(found), first_step=PROFILE_FIRST_STEP)
     except _Accepted:
-        return min(found), len(found), True
-    return min(found), len(found), False
+        return min(found), len(found), "accepted"
+    except _Cleared:
+        return min(found), len(found), "cleared"
+    return min(found), len(found), None
 
 
 def walk_profiles(grid, best_point, score, best_score, thr, points, max_scenes=PROFILE_MAX_SCENES,
-                   early=None) -> dict:
+                   early=None, cleared=None) -> dict:
     """Profiles by optimisation: for each searched parameter, step from the best scene through its coarse
     grid values and the midpoints between them, each way; at each value minimise the score over the *other*
     parameters (:func:`profile_value`) and stop at the first value whose minimum lies more than ``thr``
     above the best (``best_score()``, which may fall while walking).  A value's minimisation stops at the
-    first scene within ``thr`` of the best: that accepts it.  ``early`` (a dict, optional) receives
-    {(key, value): scenes used} of the values so accepted, which :func:`recheck` revisits if the best falls.
-    Returns {key: {value: profile score}}, the best scene's value included."""
+    first scene within ``thr`` of the best: that accepts it; and after its first PROFILE_CLEAR_SCENES scenes
+    if all lie more than PROFILE_CLEAR × ``thr`` above the best: that excludes it with a margin.  ``early``
+    (a dict, optional) receives {(key, value): scenes used} of the values so accepted, which :func:`recheck`
+    revisits if the best falls; ``cleared`` (a dict, optional) {(key, value): scenes used} of the values so
+    excluded.  Returns {key: {value: profile score}}, the best scene's value included."""
     prof = {}
     early = {} if early is None else early
+    cleared = {} if cleared is None else cleared
     for k, vals in grid.items():
         if len(vals) < 2:
             continue
@@ -139,11 +156,14 @@ def walk_profiles(grid, best_point, score, best_score, thr, points, max_scenes=P
         for side in (-1, 1):
             ahead = [x for x in v if (x - best_point[k]) * side > 1e-12]
             for x in sorted(ahead, key=lambda x: abs(x - best_point[k])):
-                val, used, stopped = profile_value(grid, k, x, best_point, score, points, max_scenes,
-                                                    lambda: best_score() + thr)
+                val, used, how = profile_value(grid, k, x, best_point, score, points, max_scenes,
+                                               lambda: best_score() + thr,
+                                               lambda: best_score() + PROFILE_CLEAR * thr)
                 prof[k][x] = val
-                if stopped:
+                if how == "accepted":
                     early[(k, x)] = used
+                elif how == "cleared":
+                    cleared[(k, x)] = used
                 if prof[k][x] > best_score() + thr:
                     break
     return prof
@@ -158,7 +178,7 @@ def recheck(grid, walked, early, score, points, thr, max_scenes=PROFILE_MAX_SCEN
             continue
         here = min((p for p in points if abs(p[k] - x) <= 1e-12), key=lambda p: p["score_db"])
         val, _, _ = profile_value(grid, k, x, here, score, points, max_scenes - used,
-                                   lambda: best["score_db"] + thr)
+                                  lambda: best["score_db"] + thr)
         walked[k][x] = min(walked[k][x], val)
 
 
@@ -191,18 +211,21 @@ ROUGHNESS_STEP = 0.003
 
 
 def probes(grid, best) -> list:
-    """Scenes ROUGHNESS_STEP (0.3 %) of a coarse step from the best one, each parameter alone, both ways:
-    geometries no recording can tell apart.  How much their scores differ from the best's is the
-    score's roughness at this scale (the contact tables' discretisation of the outline, the
-    impact signature's sampling): differences below it carry no information."""
+    """Scenes ROUGHNESS_STEP (0.3 %) of a coarse step from the best one, each parameter alone, one way (up,
+    or down at the top of the searched range): geometries no recording can tell apart.  How much their
+    scores differ from the best's is the score's roughness at this scale (the contact tables'
+    discretisation of the outline, the impact signature's sampling): differences below it carry no
+    information.  One scene per parameter, not one each way: each is an outline of its own, whose contact
+    table is built for it alone (about 1 s for a skewed outline off the track centre)."""
     out = []
     for k, vals in grid.items():
         v = sorted(vals)
         if len(v) < 2:
             continue
         step = ROUGHNESS_STEP * (v[-1] - v[0]) / (len(v) - 1)
-        for sign in (-1, 1):
+        for sign in (1, -1):
             x = round(best[k] + sign * step, 5)
             if v[0] <= x <= v[-1]:          # inside the searched range (an offset beyond B/2 is another defect)
                 out.append({**{q: [best[q]] for q in grid}, k: [x]})
+                break
     return out
