@@ -160,8 +160,8 @@ def read_rate_study(path) -> list:
 
 def rate_choices(rows) -> dict:
     """Per (kind, output rate): the cheapest setting (mean cost over the scenes) within
-    :data:`~.bench_common.RULE_MARGIN` of the tolerance on EVERY scene the study ran at that rate, as ``(method, rtol, worst peak error, mean cost,
-    scenes)``; None where no candidate held."""
+    :data:`~.bench_common.RULE_MARGIN` of the tolerance on EVERY scene the study ran at that rate, as
+    ``(method, rtol, worst peak error, mean cost, scenes)``; None where no candidate held."""
     out = {}
     for kind in sorted({r["kind"] for r in rows}):
         for fs in sorted({r["rate_hz"] for r in rows if r["kind"] == kind}):

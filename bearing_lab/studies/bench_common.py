@@ -24,7 +24,8 @@ from ..sim.integrate import _decimate_acc, anti_alias_taps
 # scipy's solve_ivp, the reference the benchmark compares against: loaded when it runs
 _integrate = lazy.load("scipy.integrate", suppress_warning=True)
 
-__all__ = ["TOL_PEAK", "TOL_PERIOD", "RULE_MARGIN", "bench_scene", "measures", "scipy_acc", "rel_err", "within_tolerance"]
+__all__ = ["TOL_PEAK", "TOL_PERIOD", "RULE_MARGIN", "bench_scene", "measures", "scipy_acc", "rel_err",
+           "within_tolerance"]
 
 #: the benchmarks' tolerance: relative error in peak acceleration, and in excitation period
 TOL_PEAK = 0.01
