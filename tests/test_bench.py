@@ -68,3 +68,25 @@ def test_one_tolerance_rule_for_both_benchmarks():
     assert not within_tolerance({**good, "err_period": 2 * TOL_PERIOD}, 0.01)
     assert not within_tolerance({**good, "err_period": math.nan}, 0.01)       # a period the run lost
     assert within_tolerance({**good, "err_period": math.nan}, math.nan)       # none to lose
+
+
+def test_rules_are_chosen_within_a_margin_of_the_tolerance():
+    """A setting becomes a rule only within RULE_MARGIN of the tolerance: an error of 0.6 % peak
+    (or 0.06 % period) is within the 1 % (0.1 %) promised but not within half of it; the rule
+    chosen from rows is the cheapest that keeps the margin, not the cheapest within tolerance."""
+    from bearing_lab.studies.bench import rate_choices
+    from bearing_lab.studies.bench_common import RULE_MARGIN, TOL_PEAK, TOL_PERIOD, within_tolerance
+    assert 0 < RULE_MARGIN < 1
+    thin = {"err_peak": 0.6 * TOL_PEAK, "err_period": 0.0}
+    assert within_tolerance(thin, 0.01) and not within_tolerance(thin, 0.01, RULE_MARGIN)
+    thin_period = {"err_peak": 0.0, "err_period": 0.6 * TOL_PERIOD}
+    assert within_tolerance(thin_period, 0.01) and not within_tolerance(thin_period, 0.01, RULE_MARGIN)
+    with pytest.raises(ValueError, match="fraction"):
+        within_tolerance(thin, 0.01, 0.0)
+
+    def row(scene, method, rtol, cost, err):
+        return dict(kind="defect", scene=scene, rate_hz=1e5, method=method, rtol=rtol, cost=cost,
+                    err_peak=err, err_period=1e-8, ref_period=0.01)
+    rows = [row(s, "bs32", 1e-4, 1.0, e) for s, e in (("a", 0.002), ("b", 0.6 * TOL_PEAK))]
+    rows += [row(s, "bs32", 1e-5, 1.1, 0.1 * TOL_PEAK) for s in ("a", "b")]
+    assert rate_choices(rows)[("defect", 1e5)][:2] == ("bs32", 1e-5)

@@ -24,11 +24,19 @@ from ..sim.integrate import _decimate_acc, anti_alias_taps
 # scipy's solve_ivp, the reference the benchmark compares against: loaded when it runs
 _integrate = lazy.load("scipy.integrate", suppress_warning=True)
 
-__all__ = ["TOL_PEAK", "TOL_PERIOD", "bench_scene", "measures", "scipy_acc", "rel_err", "within_tolerance"]
+__all__ = ["TOL_PEAK", "TOL_PERIOD", "RULE_MARGIN", "bench_scene", "measures", "scipy_acc", "rel_err",
+           "within_tolerance"]
 
 #: the benchmarks' tolerance: relative error in peak acceleration, and in excitation period
 TOL_PEAK = 0.01
 TOL_PERIOD = 0.001
+#: the fraction of those tolerances a setting's worst error on the bench scenes must stay within to
+#: become an auto rule.  The promise stays the full tolerance; the rest is room for what the study
+#: cannot see: a run perturbed at rounding level (contact table x (1 +- 1e-12), another start) moved
+#: the peak error of bs32 rtol 1e-4 on paper-O2 at 30 deg, 100 kHz, from 0.68 % to 0.78-0.97 %
+#: (benchmarks/grazed_peak.py --o2), and two runs of the rate study on one day moved a worst error
+#: from 0.91 % to 1.1 %: shifts up to 0.3 % of the peak, which half the tolerance leaves room for
+RULE_MARGIN = 0.5
 
 
 def bench_scene(base, ov, duration, fidelity="multibody", model=None, cage="kinematic"):
@@ -102,14 +110,18 @@ def scipy_acc(asm, method, rtol, max_step=2.5e-5):
     return acc[:, 1], cost
 
 
-def within_tolerance(row, ref_period) -> bool:
-    """Whether a benchmark row is accurate enough: its peak error (``err_peak``) within :data:`TOL_PEAK`
-    and, where the reference has an excitation period (``ref_period`` finite), its period error
-    (``err_period``) within :data:`TOL_PERIOD`; a period that could not be measured passes only where
-    the reference has none either."""
-    if not (math.isfinite(row["err_peak"]) and row["err_peak"] <= TOL_PEAK):
+def within_tolerance(row, ref_period, fraction=1.0) -> bool:
+    """Whether a benchmark row is accurate enough: its peak error (``err_peak``) within ``fraction``
+    of :data:`TOL_PEAK` and, where the reference has an excitation period (``ref_period`` finite), its
+    period error (``err_period``) within ``fraction`` of :data:`TOL_PERIOD`; a period that could not
+    be measured passes only where the reference has none either.  ``fraction`` is 1 for the
+    tolerance itself, :data:`RULE_MARGIN` for a setting that is to become an auto rule."""
+    if not 0 < fraction <= 1:
+        raise ValueError(f"fraction of the tolerance must be in (0, 1], got {fraction!r}")
+    if not (math.isfinite(row["err_peak"]) and row["err_peak"] <= fraction * TOL_PEAK):
         return False
-    return not math.isfinite(ref_period) or (math.isfinite(row["err_period"]) and row["err_period"] <= TOL_PERIOD)
+    return not math.isfinite(ref_period) or (math.isfinite(row["err_period"])
+                                             and row["err_period"] <= fraction * TOL_PERIOD)
 
 
 def rel_err(a, b):
