@@ -21,6 +21,7 @@ background_for(case, rec, measured, reference=None, *, model=None, band=None) ->
 """
 from __future__ import annotations
 
+import hashlib
 import math
 from pathlib import Path
 
@@ -41,6 +42,7 @@ __all__ = ["identify_path", "path_for", "background_for", "PATH_DEFAULT_BOUNDS"]
 #: damping ratio of bolted housings is 1-30 %; the gain is free over six decades
 PATH_DEFAULT_BOUNDS = {"frequency_hz": (500.0, None), "damping_ratio": (0.005, 0.5), "gain": (1e-3, 1e3)}
 
+#: the fitted paths, {(case source, mirror): (digest of the simulation fitted on, path)}
 _CACHE: dict = {}
 
 
@@ -143,18 +145,28 @@ def _fit_or_fail(case, rec, measured, sim_x) -> StructuralPath:
 
 
 def identify_path(case, *, mirror=None, prep=None) -> StructuralPath:
-    """The path a case fits on its own recording against its declared scene; one fit per case.
+    """The path a case fits on its own recording against its declared scene; one fit per case and scene.
 
     The same fit serves the case's own comparison and every case that names it (``from_case``), so a
     path "identified by case X" is the one X's own report shows, whichever case runs first.  It is
     fitted on the simulation the case itself compares (so a recording the model made is explained by
-    a gain of 1 and no background).  ``prep``: the case's prepared recording, when the caller has it.
+    a gain of 1 and no background).  ``prep``: the case's prepared recording, when the caller has it;
+    a remembered fit is used only if it was made on the same simulation (another scene for the case,
+    e.g. a changed load, is fitted anew; a case that names X uses X's latest fit).
     """
     key = (case.source, mirror)
-    if key not in _CACHE:
-        prep = prep if prep is not None else prepare(case, mirror=mirror)
-        _CACHE[key] = _fit_or_fail(case, prep.recording, prep.measured["record"], prep.simulated["model"])
-    return _CACHE[key]
+    hit = _CACHE.get(key)
+    if hit is not None and (prep is None or hit[0] == _digest(prep.simulated["model"])):
+        return hit[1]
+    prep = prep if prep is not None else prepare(case, mirror=mirror)
+    x = prep.simulated["model"]
+    _CACHE[key] = (_digest(x), _fit_or_fail(case, prep.recording, prep.measured["record"], x))
+    return _CACHE[key][1]
+
+
+def _digest(x) -> str:
+    """The simulated signal's identity (its samples' bytes)."""
+    return hashlib.sha256(np.ascontiguousarray(x).tobytes()).hexdigest()
 
 
 def path_for(case, prep, *, mirror=None) -> StructuralPath:

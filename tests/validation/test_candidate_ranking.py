@@ -159,3 +159,23 @@ def test_the_shape_residual_is_never_taken_from_the_compared_recording(rig):
     path = identify_path(case)
     st = setting_for(prep, path, background_for(case, prep.recording, prep.measured["record"]))
     assert path.fit["signature_residual_db"] and st.residual_db is None
+
+
+def test_a_remembered_path_serves_only_the_simulation_it_was_fitted_on(rig):
+    """Run again with another scene in one process (a changed load; here the compared simulation made
+    twice as loud), the case's path is fitted anew, not read back from the first fit (which would make
+    the second run's amplitudes wrong by the ratio of the two simulations); a case that names it reads
+    the latest fit."""
+    import dataclasses
+    _, calib = rig
+    case = load_case(calib)
+    prep = prepare(case)
+    first = identify_path(case, prep=prep)
+    assert identify_path(case, prep=prep) is first and identify_path(case) is first
+    louder = dataclasses.replace(prep, simulated={"model": 2.0 * prep.simulated["model"]})
+    try:
+        second = identify_path(case, prep=louder)
+        assert second is not first and identify_path(case) is second
+        assert second.gain == pytest.approx(first.gain / 2.0, rel=0.01), (first.fit["notes"], second.fit["notes"])
+    finally:
+        assert identify_path(case, prep=prep).gain == pytest.approx(first.gain, rel=1e-9)  # the other tests' path
