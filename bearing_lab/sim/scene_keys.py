@@ -19,7 +19,7 @@ SCHEMA: dict[str, dict[str, tuple]] = {
         "bearing": ("6308", str, None, "catalog bearing (6308, 6205, 6203) or see [bearing_geometry]"),
         "fidelity": ("auto", str, ("multibody", "quasi-static", "auto"),
                      "multibody: each ball a body with radial inertia; quasi-static: massless balls; "
-                     "auto: the cheapest within 1 % peak acceleration (sim/auto.py)"),
+                     "auto: the cheapest measured within half of the 1 % peak acceleration it promises (sim/auto.py)"),
     },
     "bearing_geometry": {
         "n_balls": (None, int, "pos", "override Z"),
