@@ -20,11 +20,6 @@ pytestmark = pytest.mark.xdist_group("identify_selfconsistency")
 RPM, LOAD_N, OFFSET_MM, SKEW_DEG = 1793.0, 600.0, 0.3, 30.0
 RESONANCE_HZ, DAMPING = 4300.0, 0.05            # the stand-in's housing resonance (make_standin_recording)
 
-KNOWN = pytest.mark.xfail(strict=True, reason="the structural path's fit is biased on the signature's shape "
-                                              "(4282 Hz, 5.29 % for 4300 Hz, 5 %): the truth scores 0.41 dB "
-                                              "against a 0.35 dB threshold")
-
-
 @pytest.fixture(scope="module")
 def truth_case(tmp_path_factory):
     d = tmp_path_factory.mktemp("selfcons")
@@ -60,7 +55,6 @@ bpfo = {{}}
     return case
 
 
-@KNOWN
 def test_the_true_geometry_explains_a_recording_the_model_made(truth_case):
     truth = identify(truth_case, grid={"defect.length_mm": [3.0], "defect.offset_mm": [OFFSET_MM],
                                        "defect.skew_deg": [SKEW_DEG]}, refine=False, progress=False)
@@ -68,7 +62,6 @@ def test_the_true_geometry_explains_a_recording_the_model_made(truth_case):
     assert truth.best["score_db"] <= truth.threshold_db, (truth.best, truth.threshold_db, truth.noise_db)
 
 
-@KNOWN
 def test_signatures_are_compared_through_the_stand_ins_own_resonance(truth_case):
     """The impact signature is compared through the resonance the stand-in was made with: within 0.2 % in
     frequency and 0.001 in damping ratio (a 4300 Hz, 5 % ring's decay then differs by under 3 %)."""
