@@ -3,13 +3,11 @@
 the TRUE geometry, must be explained by the true geometry, within the identification's threshold.  Otherwise
 the intervals can exclude the truth.
 
-Both checks fail today and are marked so (strict: a fix turns them into failures until the marks go).  The
-path fit's own views (impact peaks, pooled envelope, impact spectrum) give this stand-in's resonance as
-4282 Hz, 5.29 % (4294 Hz, 5.23 % without speed jitter, tones and noise), and the true scene's signature then
-misfits the recording's by 0.41 dB against a 0.35 dB threshold (split-half misfit 0.12 dB); through the
-stand-in's own resonance (4300 Hz, 5 %, gain 1) the truth scores 0.16 dB.  Candidates simulated at the
-recording's full length (0.42 dB), the path fitted on the candidates' own simulation at rtol 1e-6 (0.41 dB)
-and no background (0.42 dB) leave it where it is."""
+The path fit once gave this stand-in's resonance as 4282 Hz, 5.29 % (the envelope maximum of each impact
+flipped between the defect's entry and exit rings, and the simulation's impacts were located on the bare
+simulation, not on its ringing through the path), and the truth then misfit by 0.41 dB against a 0.35 dB
+threshold; these checks keep the truth within the threshold and the fitted resonance within the
+tolerance below."""
 import pytest
 
 from bearing_lab.validation import make_standin_recording
