@@ -3,13 +3,11 @@
 the TRUE geometry, must be explained by the true geometry, within the identification's threshold.  Otherwise
 the intervals can exclude the truth.
 
-Both checks fail today and are marked so (strict: a fix turns them into failures until the marks go).  The
-path fit's own views (impact peaks, pooled envelope, impact spectrum) give this stand-in's resonance as
-4282 Hz, 5.29 % (4294 Hz, 5.23 % without speed jitter, tones and noise), and the true scene's signature then
-misfits the recording's by 0.41 dB against a 0.35 dB threshold (split-half misfit 0.12 dB); through the
-stand-in's own resonance (4300 Hz, 5 %, gain 1) the truth scores 0.16 dB.  Candidates simulated at the
-recording's full length (0.42 dB), the path fitted on the candidates' own simulation at rtol 1e-6 (0.41 dB)
-and no background (0.42 dB) leave it where it is."""
+The path fit once gave this stand-in's resonance as 4282 Hz, 5.29 % (the envelope maximum of each impact
+flipped between the defect's entry and exit rings, and the simulation's impacts were located on the bare
+simulation, not on its ringing through the path), and the truth then misfit by 0.41 dB against a 0.35 dB
+threshold; these checks keep the truth within the threshold and the fitted resonance within the
+tolerance below."""
 import pytest
 
 from bearing_lab.validation import make_standin_recording
@@ -19,11 +17,6 @@ pytestmark = pytest.mark.xdist_group("identify_selfconsistency")
 
 RPM, LOAD_N, OFFSET_MM, SKEW_DEG = 1793.0, 600.0, 0.3, 30.0
 RESONANCE_HZ, DAMPING = 4300.0, 0.05            # the stand-in's housing resonance (make_standin_recording)
-
-KNOWN = pytest.mark.xfail(strict=True, reason="the structural path's fit is biased on the signature's shape "
-                                              "(4282 Hz, 5.29 % for 4300 Hz, 5 %): the truth scores 0.41 dB "
-                                              "against a 0.35 dB threshold")
-
 
 @pytest.fixture(scope="module")
 def truth_case(tmp_path_factory):
@@ -60,7 +53,6 @@ bpfo = {{}}
     return case
 
 
-@KNOWN
 def test_the_true_geometry_explains_a_recording_the_model_made(truth_case):
     truth = identify(truth_case, grid={"defect.length_mm": [3.0], "defect.offset_mm": [OFFSET_MM],
                                        "defect.skew_deg": [SKEW_DEG]}, refine=False, progress=False)
@@ -68,7 +60,6 @@ def test_the_true_geometry_explains_a_recording_the_model_made(truth_case):
     assert truth.best["score_db"] <= truth.threshold_db, (truth.best, truth.threshold_db, truth.noise_db)
 
 
-@KNOWN
 def test_signatures_are_compared_through_the_stand_ins_own_resonance(truth_case):
     """The impact signature is compared through the resonance the stand-in was made with: within 0.2 % in
     frequency and 0.001 in damping ratio (a 4300 Hz, 5 % ring's decay then differs by under 3 %)."""
