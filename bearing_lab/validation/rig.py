@@ -22,6 +22,7 @@ background_for(case, rec, measured, reference=None, *, model=None, band=None) ->
 from __future__ import annotations
 
 import hashlib
+import json
 import math
 from pathlib import Path
 
@@ -42,7 +43,7 @@ __all__ = ["identify_path", "path_for", "background_for", "PATH_DEFAULT_BOUNDS"]
 #: damping ratio of bolted housings is 1-30 %; the gain is free over six decades
 PATH_DEFAULT_BOUNDS = {"frequency_hz": (500.0, None), "damping_ratio": (0.005, 0.5), "gain": (1e-3, 1e3)}
 
-#: the fitted paths, {(case source, mirror): (digest of the simulation fitted on, path)}
+#: the fitted paths, {(case source, case content, mirror): (digest of the simulation fitted on, path)}
 _CACHE: dict = {}
 
 
@@ -151,10 +152,11 @@ def identify_path(case, *, mirror=None, prep=None) -> StructuralPath:
     path "identified by case X" is the one X's own report shows, whichever case runs first.  It is
     fitted on the simulation the case itself compares (so a recording the model made is explained by
     a gain of 1 and no background).  ``prep``: the case's prepared recording, when the caller has it;
-    a remembered fit is used only if it was made on the same simulation (another scene for the case,
-    e.g. a changed load, is fitted anew; a case that names X uses X's latest fit).
+    a remembered fit is used only for the same case content and, when ``prep`` is given, the same
+    simulation (another scene for the case, e.g. a changed load, is fitted anew; without ``prep``, as for
+    a case that names X, X's latest fit is used).
     """
-    key = (case.source, mirror)
+    key = (case.source, json.dumps(case.data, sort_keys=True, default=str), mirror)
     hit = _CACHE.get(key)
     if hit is not None and (prep is None or hit[0] == _digest(prep.simulated["model"])):
         return hit[1]
