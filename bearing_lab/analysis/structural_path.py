@@ -248,8 +248,8 @@ class _PathProblem:
         self.e = np.asarray(recording, float) - np.mean(recording)
         self.s = np.asarray(simulation, float) - np.mean(simulation)
         self.pre, self.post = pre, post
-        self.te = centred_times(self.e, fs, impact_times(self.e, fs, period, band=band), period)
-        self.ts = centred_times(self.s, fs, impact_times(self.s, fs, period, band=band), period)
+        self.band = band
+        self.te, self.ts = self._locate(self.e), self._locate(self.s)
         if self.te.size < MIN_IMPACTS or self.ts.size < MIN_IMPACTS:
             raise AnalysisError(f"structural path: the fit needs at least {MIN_IMPACTS} impacts in each signal; "
                                 f"found {self.te.size} in the recording and {self.ts.size} in the simulation")
@@ -271,9 +271,14 @@ class _PathProblem:
         kept = [b for b, lv in zip(bins, level) if lv >= 0.01 * level.max()]
         self.bins = [b for b, _ in kept]
         self.peak_e = self.impact_peak(self.e, self.te)
-        self.band, self.ranges = band, [r for _, r in kept]
+        self.ranges = [r for _, r in kept]
         self.w2 = float(np.sum(np.hanning(int(round(pre * fs)) + int(round(post * fs))) ** 2))
-        self.relocate(self.s)
+        self.noise_e = background_power(self.e, fs, self.te, period, self.ranges, self.w2)
+        self._hold_background(self.s)
+
+    def _locate(self, y):
+        """The impacts of ``y``, each at the centroid of its envelope power."""
+        return centred_times(y, self.fs, impact_times(y, self.fs, self.period, band=self.band), self.period)
 
     def relocate(self, y) -> bool:
         """Pool the simulation's impacts where ``y`` (the simulation through a path) has them, and hold
@@ -285,11 +290,18 @@ class _PathProblem:
         paper-O2 600 N stand-in (4300 Hz, 5 %; speed jitter, tones, noise) the fit gave 4314 Hz with the
         windows on the bare simulation, 4305 Hz with them moved onto the fitted path's ringing.
         """
-        ts = centred_times(y, self.fs, impact_times(y, self.fs, self.period, band=self.band), self.period)
+        ts = self._locate(y)
         if ts.size < MIN_IMPACTS:
             return False
-        changed = ts.size != getattr(self, "ts", np.array([])).size or not np.array_equal(ts, self.ts)
+        changed = not np.array_equal(ts, self.ts)
         self.ts = ts
+        self._hold_background(y)
+        return changed
+
+    def _hold_background(self, y):
+        """The recording's background that ``y`` (impacts at ``self.ts``) does not hold, in the envelope and
+        the spectrum views."""
+        ts = self.ts
         # the part of the recording's floor the model does not hold, fixed before each fit: the
         # model's own floor at the gain that matches the impact peaks (a floor that followed the
         # fitted gain would let the gain trade impact level for floor, and bias it)
@@ -298,10 +310,8 @@ class _PathProblem:
         self.floor_add2 = max(self.floor ** 2 - (g0 * floor_level(y, self.fs, ts, self.period)) ** 2, 0.0)
         # the same for the spectrum view: the background's power in each bin (measured between the
         # impacts, scaled to an impact window) that the model's own background does not hold
-        noise_e = background_power(self.e, self.fs, self.te, self.period, self.ranges, self.w2)
         noise_s = background_power(y, self.fs, ts, self.period, self.ranges, self.w2)
-        self.spec_add = np.maximum(noise_e - g0 ** 2 * noise_s, 0.0)
-        return changed
+        self.spec_add = np.maximum(self.noise_e - g0 ** 2 * noise_s, 0.0)
 
     def impact_peak(self, y, times):
         return float(np.percentile(impact_peaks(y, self.fs, times, self.period), 90))
