@@ -204,11 +204,12 @@ def _profile(points, key, threshold, walked=None, span=None):
     """A parameter's profile, interval and statement.
 
     Without ``walked``: the profile is the best score among ``points`` at each searched value (the coarse
-    grid's). With ``walked`` ({value: score minimised over the other parameters}, :func:`.identify_search.walk_profiles`):
-    only those values can be *excluded* (more than ``threshold`` above the best); any simulated scene within
-    the threshold *accepts* its value (a geometry that explains the recording that well is an answer,
-    whatever the others score).  The interval runs from the nearest excluded value below the accepted ones
-    to the nearest above (the profile is known at those values only), or to the end of ``span``.
+    grid's). With ``walked`` ({value: score minimised over the other parameters},
+    :func:`.identify_search.walk_profiles`): only those values can be *excluded* (more than ``threshold``
+    above the best); any simulated scene within the threshold *accepts* its value (a geometry that
+    explains the recording that well is an answer, whatever the others score).  The interval runs from
+    the nearest excluded value below the accepted ones to the nearest above (the profile is known at
+    those values only), or to the end of ``span``.
     """
     best = min(points, key=lambda p: p["score_db"])
     top = best["score_db"] + threshold
@@ -519,7 +520,8 @@ def _explains(best_db, thr, noise_db, partial) -> tuple:
     a model that misfits, not the defect."""
     if best_db <= thr:
         return True, ""
-    ratio = f", {best_db / noise_db:.1f} times the recording's split-half misfit ({noise_db:.2f} dB)" if noise_db > 0 else ""
+    ratio = (f", {best_db / noise_db:.1f} times the recording's split-half misfit ({noise_db:.2f} dB)"
+             if noise_db > 0 else "")
     return False, ((("so far, " if partial else "") + "the model does not explain this recording: the best scene "
                     f"misfits it by {best_db:.2f} dB, above the threshold of {thr:.2f} dB{ratio}; the intervals "
                     "are those of the nearest geometry of a model that misfits, not the defect's, and a parameter "
