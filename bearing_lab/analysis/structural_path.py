@@ -47,7 +47,8 @@ lowered to 0.45 fs, and the fit says so).  A fit that ends at a bound, does not
 converge, or ends no better than the unfitted simulation is *degraded*, and says
 why.  Such a fit is then compared with the path without a resonance (the gain alone,
 fitted on the same residuals): when the gain alone explains the impacts as well, the
-recording shows no housing resonance, and the path is that gain (a note says so).
+recording shows no housing resonance, and the path is that gain (a note says so).  Each
+evaluation filters the simulation's transform (taken once) and reads windows indexed once.
 
 Public API
 ----------
