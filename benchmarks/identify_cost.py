@@ -22,7 +22,12 @@ journal removed, so that it simulates every scene).  CPU time (user + system, ``
 scenes ran brackets their CPU time (the command's CPU less its setup).  Then the small grid of 12 scenes
 without refinement (``--length-mm 2.5 3 3.6 --offset-mm 0 0.3 --skew-deg 0 30 --no-refine``) on the same
 case, with a table cache of its own left empty: CPU time of the whole process (a few minutes in all on
-the shared 2-core machine).
+the shared 2-core machine).  ``--grid12``: that grid alone (the case made as above first, ~1 min).
+
+``--path-fit``: the structural path's fit alone (``fit_structural_path``), on the inputs ``identify_path`` gives it:
+the README walkthrough's case (made as above) and cwru-130 (its recording from ``BEARING_LAB_MIRROR``).  CPU time
+(``time.process_time``) of each of ``--repeat`` fits on the same inputs, and what they found (the fit is
+deterministic: every repeat the same).
 
 ``--phases``: where the cold walkthrough's CPU time goes, in this process: the same identification (its
 table cache a copy of the one ``validate`` left, as in ``--walkthrough``), each scene and each contact table
@@ -80,12 +85,16 @@ def _walkthrough_case(tmp, env) -> None:
     _cli(["validate", "rig.toml", "-o", "reports"], tmp, env)
 
 
-def walkthrough(quick=False) -> None:
+def walkthrough(quick=False, grid_only=False) -> None:
     """The README walkthrough's identification, cold then warm, and the 12-scene grid cold (see the module
-    docstring); ``quick``: one scene at the hidden geometry, no refinement, and no 12-scene grid."""
+    docstring); ``quick``: one scene at the hidden geometry, no refinement, and no 12-scene grid; ``grid_only``:
+    the 12-scene grid alone."""
     with tempfile.TemporaryDirectory(prefix="identify_walkthrough_") as tmp:
         env = {**os.environ, "BEARING_LAB_CACHE": str(Path(tmp) / "cache")}
         _walkthrough_case(tmp, env)
+        if grid_only:
+            _grid12(tmp)
+            return
         print("\n| run (README walkthrough) | scenes | CPU s | length mm | offset H mm | skew θ° | all hidden values "
               "inside their intervals | estimate of the scenes' CPU s (brackets it) |\n|---|---|---|---|---|---|---|---|")
         for label in ("empty table cache", "tables cached"):
@@ -100,15 +109,46 @@ def walkthrough(quick=False) -> None:
               f"best score {r['best']['score_db']:.2f} dB")
         notes = [n for n in r["notes"] if "interval ends excluded" in n]
         print("".join(f"- {n}\n" for n in notes), end="")
-        if quick:
-            return
-        print("\n| run (12-scene grid, no refinement) | scenes | CPU s (whole process) | length mm | offset H mm | "
-              "skew θ° | all hidden values inside their intervals | estimate of the scenes' CPU s (brackets it) |"
-              "\n|---|---|---|---|---|---|---|---|")
-        env12 = {**os.environ, "BEARING_LAB_CACHE": str(Path(tmp) / "cache-grid12")}
-        cpu, out = _cli(["identify", "rig.toml", "-o", "reports-grid12", "--json", "--no-progress", *GRID12], tmp,
-                        env12)
-        _row("empty table cache", cpu, json.loads(out))
+        if not quick:
+            _grid12(tmp)
+
+
+def _grid12(tmp) -> None:
+    """The 12-scene grid on the walkthrough's case in ``tmp``, with an empty table cache of its own."""
+    print("\n| run (12-scene grid, no refinement) | scenes | CPU s (whole process) | length mm | offset H mm | "
+          "skew θ° | all hidden values inside their intervals | estimate of the scenes' CPU s (brackets it) |"
+          "\n|---|---|---|---|---|---|---|---|")
+    env12 = {**os.environ, "BEARING_LAB_CACHE": str(Path(tmp) / "cache-grid12")}
+    cpu, out = _cli(["identify", "rig.toml", "-o", "reports-grid12", "--json", "--no-progress", *GRID12], tmp, env12)
+    _row("empty table cache", cpu, json.loads(out))
+
+
+def path_fit(repeat) -> None:
+    """CPU time of the structural path's fit on the walkthrough's case and on cwru-130 (see the module docstring)."""
+    with tempfile.TemporaryDirectory(prefix="identify_pathfit_") as tmp:
+        env = {**os.environ, "BEARING_LAB_CACHE": str(Path(tmp) / "cache")}
+        _walkthrough_case(tmp, env)
+        os.environ["BEARING_LAB_CACHE"] = env["BEARING_LAB_CACHE"]
+        from bearing_lab.validation import rig
+        from bearing_lab.validation.load import load_case
+        real, calls = rig.fit_structural_path, []
+
+        def timed(*a, **k):
+            for _ in range(repeat):
+                t = time.process_time()
+                path = real(*a, **k)
+                calls[-1][1].append(time.process_time() - t)
+            return path
+        rig.fit_structural_path = timed
+        print("| case | impacts pooled | CPU s per fit (each repeat) | evaluations (last re-fit) | path | status |"
+              "\n|---|---|---|---|---|---|")
+        for label, ref in (("README walkthrough", str(Path(tmp) / "rig.toml")), ("cwru-130", "cwru-130")):
+            calls.append((label, []))
+            path = rig.identify_path(load_case(ref))
+            cpu = calls[-1][1]
+            modes = "".join(f", {r.frequency_hz:.2f} Hz, ζ {r.damping_ratio:.5f}" for r in path.resonances)
+            print(f"| {label} | {path.fit.get('n_impacts_simulation', 0)} | {', '.join(f'{c:.2f}' for c in cpu)} | "
+                  f"{path.fit.get('evaluations')} | gain {path.gain:.5g}{modes} | {path.status} |", flush=True)
 
 
 #: the small grid: 3 lengths, 2 offsets, 2 skews, no refinement (12 scenes)
@@ -205,9 +245,15 @@ def main() -> None:
                                                         "--phases: the 12-scene grid, no refinement (checks that "
                                                         "they run, not their cost)")
     ap.add_argument("--phases", action="store_true", help="the cold walkthrough's CPU per step of the search")
+    ap.add_argument("--grid12", action="store_true", help="the walkthrough's 12-scene grid alone")
+    ap.add_argument("--path-fit", action="store_true", help="the structural path's fit alone, on the walkthrough's "
+                                                            "case and on cwru-130 (--repeat fits each)")
     args = ap.parse_args()
-    if args.walkthrough:
-        walkthrough(quick=args.quick)
+    if args.walkthrough or args.grid12:
+        walkthrough(quick=args.quick, grid_only=args.grid12)
+        return
+    if args.path_fit:
+        path_fit(args.repeat)
         return
     if args.phases:
         phases(quick=args.quick)

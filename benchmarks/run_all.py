@@ -127,6 +127,8 @@ REGISTRY: tuple[Entry, ...] = (
           quoted_in=("README.md", D + "identification.md")),
     Entry("identify_cost.py", ("--phases",), variant="phases", quick=("--phases", "--quick"),
           cost="~2 min", quick_cost="~30 s", quoted_in=(D + "identification.md",)),
+    Entry("identify_cost.py", ("--path-fit", "--repeat", "3"), variant="pathfit", quick=("--path-fit", "--repeat", "1"),
+          cost="~2 min", quick_cost="~1.5 min", quoted_in=("README.md", D + "identification.md")),
     Entry("identify_selfconsistency.py", (), quick=("--quick",), cost="~1 min", quick_cost="13 s",
           quoted_in=(D + "identification.md",)),
     Entry("sweep_scaling.py", (), quick=("--scenes", "4", "--duration", "0.1", "--rounds", "1"),

@@ -47,7 +47,8 @@ lowered to 0.45 fs, and the fit says so).  A fit that ends at a bound, does not
 converge, or ends no better than the unfitted simulation is *degraded*, and says
 why.  Such a fit is then compared with the path without a resonance (the gain alone,
 fitted on the same residuals): when the gain alone explains the impacts as well, the
-recording shows no housing resonance, and the path is that gain (a note says so).
+recording shows no housing resonance, and the path is that gain (a note says so).  Each
+evaluation filters the simulation's transform (taken once) and reads windows indexed once.
 
 Public API
 ----------
@@ -70,8 +71,9 @@ from scipy.optimize import least_squares
 
 from ..errors import AnalysisError, check_choice
 from ..utils._files import atomic_open
-from ._impact_views import background_power, centred_times, floor_level
-from .impacts import impact_peaks, impact_times, mean_envelope, segment_spectrum
+from ._impact_views import (ImpactWindows, background_power, centred_times, floor_level, frequency_runs,
+                            hilbert_envelope)
+from .impacts import impact_peaks, impact_times, segment_spectrum
 
 __all__ = ["transmissibility", "Resonance", "StructuralPath", "fit_structural_path", "MIN_IMPACTS"]
 
@@ -249,15 +251,16 @@ class _PathProblem:
         self.s = np.asarray(simulation, float) - np.mean(simulation)
         self.pre, self.post = pre, post
         self.band = band
-        self.te, self.ts = self._locate(self.e), self._locate(self.s)
+        env_e, env_s = hilbert_envelope(self.e), hilbert_envelope(self.s)
+        self.te, self.ts = self._locate(self.e, env_e), self._locate(self.s, env_s)
         if self.te.size < MIN_IMPACTS or self.ts.size < MIN_IMPACTS:
             raise AnalysisError(f"structural path: the fit needs at least {MIN_IMPACTS} impacts in each signal; "
                                 f"found {self.te.size} in the recording and {self.ts.size} in the simulation")
-        self.env_e = mean_envelope(self.e, fs, self.te, pre=pre, post=post)
+        self.env_e = ImpactWindows(self.e.size, fs, self.te, period, pre=pre, post=post).mean_of(env_e)
         if self.env_e is None:
             raise AnalysisError("structural path: no impact window fits inside the recording")
         self.pk = int(np.argmax(self.env_e))
-        self.floor = floor_level(self.e, fs, self.te, period)
+        self.floor = floor_level(self.e, fs, self.te, period, env=env_e)
         # the decay is fitted where the recording's envelope stands clear of its floor: below it
         # the pooled envelope is the floor's, which says nothing about the path's damping
         tail = self.env_e[self.pk:]
@@ -270,15 +273,29 @@ class _PathProblem:
         level = np.array([self.p_e[b].mean() for b, _ in bins])
         kept = [b for b, lv in zip(bins, level) if lv >= 0.01 * level.max()]
         self.bins = [b for b, _ in kept]
+        self.runs = frequency_runs(self.bins)
         self.peak_e = self.impact_peak(self.e, self.te)
         self.ranges = [r for _, r in kept]
+        self.p_e_bins = np.array([self.p_e[b].mean() for b in self.bins])
         self.w2 = float(np.sum(np.hanning(int(round(pre * fs)) + int(round(post * fs))) ** 2))
         self.noise_e = background_power(self.e, fs, self.te, period, self.ranges, self.w2)
-        self._hold_background(self.s)
+        # the bare simulation's transform, zero-padded as StructuralPath.apply pads it, taken once
+        n = self.s.size
+        self.nfft = 1 << int(math.ceil(math.log2(2 * n)))
+        omega = 2 * np.pi * np.fft.rfftfreq(self.nfft, 1 / fs)
+        self.j_omega, self.omega2 = 1j * omega, omega * omega
+        self.spec_s_w2 = np.fft.rfft(self.s, self.nfft) * self.omega2
+        self._set_windows()
+        self._hold_background(self.s, env_s)
 
-    def _locate(self, y):
-        """The impacts of ``y``, each at the centroid of its envelope power."""
-        return centred_times(y, self.fs, impact_times(y, self.fs, self.period, band=self.band), self.period)
+    def _set_windows(self):
+        """The simulation's impact windows (at ``self.ts``), and no remembered views (they read them)."""
+        self.win = ImpactWindows(self.s.size, self.fs, self.ts, self.period, pre=self.pre, post=self.post)
+        self._seen = {}
+
+    def _locate(self, y, env):
+        """The impacts of ``y`` (its Hilbert envelope ``env``), each at the centroid of its envelope power."""
+        return centred_times(y, self.fs, impact_times(y, self.fs, self.period, band=self.band), self.period, env=env)
 
     def relocate(self, y) -> bool:
         """Pool the simulation's impacts where ``y`` (the simulation through a path) has them, and hold
@@ -290,24 +307,26 @@ class _PathProblem:
         paper-O2 600 N stand-in (4300 Hz, 5 %; speed jitter, tones, noise) the fit gave 4314 Hz with the
         windows on the bare simulation, 4305 Hz with them moved onto the fitted path's ringing.
         """
-        ts = self._locate(y)
+        env = hilbert_envelope(y)
+        ts = self._locate(y, env)
         if ts.size < MIN_IMPACTS:
             return False
         changed = not np.array_equal(ts, self.ts)
         self.ts = ts
-        self._hold_background(y)
+        self._set_windows()
+        self._hold_background(y, env)
         return changed
 
-    def _hold_background(self, y):
-        """The recording's background that ``y`` (impacts at ``self.ts``) does not hold, in the envelope and
-        the spectrum views."""
+    def _hold_background(self, y, env):
+        """The recording's background that ``y`` (impacts at ``self.ts``; its Hilbert envelope ``env``) does not
+        hold, in the envelope and the spectrum views."""
         ts = self.ts
         # the part of the recording's floor the model does not hold, fixed before each fit: the
         # model's own floor at the gain that matches the impact peaks (a floor that followed the
         # fitted gain would let the gain trade impact level for floor, and bias it)
         peak_s = self.impact_peak(y, ts)
         g0 = self.peak_e / peak_s if peak_s > 0 else 0.0
-        self.floor_add2 = max(self.floor ** 2 - (g0 * floor_level(y, self.fs, ts, self.period)) ** 2, 0.0)
+        self.floor_add2 = max(self.floor ** 2 - (g0 * floor_level(y, self.fs, ts, self.period, env=env)) ** 2, 0.0)
         # the same for the spectrum view: the background's power in each bin (measured between the
         # impacts, scaled to an impact window) that the model's own background does not hold
         noise_s = background_power(y, self.fs, ts, self.period, self.ranges, self.w2)
@@ -324,32 +343,42 @@ class _PathProblem:
         return StructuralPath(tuple(Resonance(float(f), float(z), float(w)) for f, z, w in zip(freqs, zetas, weights)),
                               float(gain), "fit")
 
-    def envelope(self, y):
-        """Mean envelope of ``y`` over the simulation's impacts, its peak at the recording's.
+    def shape_output(self, params):
+        """The simulation through the path of ``params`` at gain 1, as :meth:`StructuralPath.apply` gives it, from
+        the bare simulation's transform ``S`` taken once: with ``T = 1 + W^2 / D``, ``D = w^2 - W^2 + 2j zeta w W``
+        (:func:`transmissibility`), it is the simulation plus the inverse of ``sum_k w_k S W^2 / D_k / sum w``."""
+        p, k = np.exp(params), self.nres
+        weights = np.ones(k) if k == 1 else np.r_[1.0, p[2 * k + 1:]]
+        spec = 0.0
+        for f, z, w in zip(p[:k], p[k:2 * k], weights / weights.sum()):
+            wn = 2 * np.pi * f
+            d = (2 * z * wn) * self.j_omega
+            d.real += wn * wn
+            d.real -= self.omega2
+            term = np.divide(self.spec_s_w2, d, out=d)
+            spec = spec + w * term if k > 1 else term
+        return self.s + np.fft.irfft(spec, self.nfft)[:self.s.size]
 
-        The windows are moved (not the averaged envelope rolled): a roll would wrap the rise
-        before the peak onto the window's end, where the recording is at its noise level, and
-        that wrapped peak pulls the gain down (on a stand-in with a known path, gain 1, 4300 Hz,
-        5 %, and 0.05 g sensor noise, model at rtol 1e-6: gain 0.964 with the roll, 0.990 with the
-        windows moved).
-        """
-        env = mean_envelope(y, self.fs, self.ts, pre=self.pre, post=self.post)
-        shift = int(np.argmax(env)) - self.pk
-        if shift:
-            moved = mean_envelope(y, self.fs, self.ts + shift / self.fs, pre=self.pre, post=self.post)
-            env = moved if moved is not None and moved.size == env.size else np.roll(env, -shift)
-        return np.sqrt(env ** 2 + self.floor_add2)
+    def views_at(self, params):
+        """The views of the path ``params``'s output at gain 1, remembered for the last few shapes: a step
+        in the gain alone (a column of the Jacobian) costs no evaluation."""
+        key = tuple(np.delete(params, 2 * self.nres))
+        if key not in self._seen:
+            if len(self._seen) >= 8:
+                self._seen.pop(next(iter(self._seen)))
+            self._seen[key] = self.win.views(self.shape_output(params), self.pk, self.runs)
+        return self._seen[key]
 
     def residuals(self, params):
-        return self.residuals_of(self.path_of(params).apply(self.s, self.fs))
+        return self.residuals_from(self.views_at(params), math.exp(params[2 * self.nres]))
 
-    def residuals_of(self, y, parts=False):
-        env_m = self.envelope(y)
+    def residuals_from(self, views, gain, parts=False):
+        """The residuals of a signal scaled by ``gain``, from its views (:meth:`ImpactWindows.views`)."""
+        env, bins, peak = views
+        env_m = np.sqrt((gain * env) ** 2 + self.floor_add2)
         r1 = np.log(env_m[self.pk:] / np.maximum(self.env_e[self.pk:], 1e-30))[self.fit_tail]
-        _, p_m = segment_spectrum(y, self.fs, self.ts, pre=self.pre, post=self.post)
-        r2 = np.array([0.5 * np.log((p_m[b].mean() + add + 1e-30) / (self.p_e[b].mean() + 1e-30))
-                       for b, add in zip(self.bins, self.spec_add)])
-        r0 = np.array([PEAK_WEIGHT * np.log(max(self.impact_peak(y, self.ts), 1e-30) / max(self.peak_e, 1e-30))])
+        r2 = 0.5 * np.log((gain * gain * bins + self.spec_add + 1e-30) / (self.p_e_bins + 1e-30))
+        r0 = np.array([PEAK_WEIGHT * np.log(max(gain * peak, 1e-30) / max(self.peak_e, 1e-30))])
         r = np.concatenate([r0, r1 / math.sqrt(r1.size), r2 / math.sqrt(max(r2.size, 1))])
         return (r, (r0, r1, r2)) if parts else r
 
@@ -386,8 +415,7 @@ def _starts(prob, lo, hi, f_lo, f_hi):
     for freqs in combos:
         for z0 in (0.03, 0.1):
             x = np.r_[np.log(freqs), np.log([z0] * k), 0.0, np.zeros(k - 1)]
-            y = prob.path_of(x).apply(prob.s, prob.fs)
-            x[2 * k] = math.log(max(prob.peak_e / max(prob.impact_peak(y, prob.ts), 1e-30), 1e-30))
+            x[2 * k] = math.log(max(prob.peak_e / max(prob.views_at(x)[2], 1e-30), 1e-30))
             yield np.clip(x, lo + 1e-6, hi - 1e-6)
 
 
@@ -425,11 +453,9 @@ def _check_bounds(frequency_bounds, damping_bounds, gain_bounds, fs):
 
 def _finish(prob, best, lo, hi, bounds, notes, source) -> StructuralPath:
     """The fitted path with its report: residuals before and after, bounds, impacts, problems."""
-    fs, k = prob.fs, prob.nres
+    k = prob.nres
     path = prob.path_of(best.x)
-    _, parts = prob.residuals_of(path.apply(prob.s, fs), parts=True)
-    _, parts0 = prob.residuals_of(prob.s, parts=True)
-    fit_db, before_db = _rms_db(np.concatenate(parts)), _rms_db(np.concatenate(parts0))
+    fit_db, before_db = _score(prob, path)
     names = ([f"frequency_hz[{i}]" if k > 1 else "frequency_hz" for i in range(k)]
              + [f"damping_ratio[{i}]" if k > 1 else "damping_ratio" for i in range(k)] + ["gain"])
     given = {n: bounds[n.split("[")[0]] for n in names}
@@ -438,9 +464,16 @@ def _finish(prob, best, lo, hi, bounds, notes, source) -> StructuralPath:
                 "n_impacts_recording": int(prob.te.size), "n_impacts_simulation": int(prob.ts.size),
                 "evaluations": int(best.nfev), "notes": notes,
                 "problems": _fit_problems(best, lo, hi, names, fit_db, before_db, given)}
-    path.curves = {"time_s": (np.arange(prob.env_e.size) - prob.pk) / fs, "recording": prob.env_e,
-                   "before": prob.envelope(prob.s), "after": prob.envelope(path.apply(prob.s, fs))}
     return path
+
+
+def _score(prob, path):
+    """The RMS residuals (dB) of ``path`` and of the unfitted simulation; their pooled envelopes (with the
+    recording's floor that they do not hold) in ``path.curves``, for a figure."""
+    fit, bare = (prob.win.views(y, prob.pk, prob.runs) for y in (path.apply(prob.s, prob.fs), prob.s))
+    path.curves = {"time_s": (np.arange(prob.env_e.size) - prob.pk) / prob.fs, "recording": prob.env_e,
+                   "before": np.sqrt(bare[0] ** 2 + prob.floor_add2), "after": np.sqrt(fit[0] ** 2 + prob.floor_add2)}
+    return tuple(_rms_db(np.concatenate(prob.residuals_from(v, 1.0, parts=True)[1])) for v in (fit, bare))
 
 
 def _samples(obj, fs):
@@ -548,12 +581,11 @@ def _flat_path(prob, bounds, notes, source):
     if not peak_s > 0:
         return None
     g0 = min(max(math.log(prob.peak_e / peak_s), glo + 1e-6), ghi - 1e-6)
-    best = least_squares(lambda p: prob.residuals_of(math.exp(p[0]) * prob.s), [g0], bounds=([glo], [ghi]),
+    views = prob.win.views(prob.s, prob.pk, prob.runs)
+    best = least_squares(lambda p: prob.residuals_from(views, math.exp(p[0])), [g0], bounds=([glo], [ghi]),
                          x_scale=0.3, max_nfev=60)
     path = StructuralPath((), float(math.exp(best.x[0])), source or "fitted on the pooled impulse responses")
-    _, parts = prob.residuals_of(path.apply(prob.s, prob.fs), parts=True)
-    _, parts0 = prob.residuals_of(prob.s, parts=True)
-    fit_db, before_db = _rms_db(np.concatenate(parts)), _rms_db(np.concatenate(parts0))
+    fit_db, before_db = _score(prob, path)
     problems = []
     if abs(best.x[0] - glo) < 1e-3 or abs(best.x[0] - ghi) < 1e-3:
         problems.append(f"the fit ended at a bound: gain at its {'lower' if abs(best.x[0] - glo) < 1e-3 else 'upper'}"
@@ -564,6 +596,4 @@ def _flat_path(prob, bounds, notes, source):
     path.fit = {"residual_db": fit_db, "initial_db": before_db, "bounds": bounds,
                 "n_impacts_recording": int(prob.te.size), "n_impacts_simulation": int(prob.ts.size),
                 "evaluations": int(best.nfev), "notes": list(notes), "problems": problems}
-    path.curves = {"time_s": (np.arange(prob.env_e.size) - prob.pk) / prob.fs, "recording": prob.env_e,
-                   "before": prob.envelope(prob.s), "after": prob.envelope(path.apply(prob.s, prob.fs))}
     return path
