@@ -10,16 +10,18 @@ background_power(x, fs, times, period, ranges, w2) -- background power per frequ
 ImpactWindows(n, fs, times, period, pre=, post=) -- the impact windows' sample indices, cut once:
                                                    .mean_of(env, shift), .power(x), .peaks(x), .views(...)
 frequency_runs(masks)                           -- the runs of frequencies of a spectrum's bins, for .views
+signal_of(obj, fs, what)                        -- (samples, fs) of an array or a Dataset, checked
 """
 from __future__ import annotations
 
 import numpy as np
 from scipy import fft as sfft
 
+from ..errors import AnalysisError
 from .impacts import between_impacts
 
 __all__ = ["CENTROID_HALF_S", "hilbert_envelope", "centred_times", "floor_level", "background_power",
-           "ImpactWindows", "frequency_runs"]
+           "ImpactWindows", "frequency_runs", "signal_of"]
 
 
 def hilbert_envelope(x):
@@ -188,3 +190,32 @@ def frequency_runs(masks):
     if edges and edges[-1][1] >= np.size(masks[-1]):
         starts = starts[:-1]
     return np.array(starts, int), np.array([b - a for a, b in edges], float)
+
+
+def signal_of(obj, fs, what):
+    """(x, fs) of an array, or of a Dataset's default channel; ``what`` names it in errors.
+
+    Raises AnalysisError for what the fit cannot read: not 1-D, empty, not finite, all zero, or
+    no positive sampling rate.
+    """
+    if hasattr(obj, "data_vars"):
+        ch = obj.attrs.get("default_channel") or next(iter(obj.data_vars), None)
+        if ch is None or "sampling_rate_hz" not in obj.attrs:
+            raise AnalysisError(f"structural path: the {what} Dataset has no channel or no sampling_rate_hz")
+        x, fs = obj[ch].values, obj.attrs["sampling_rate_hz"]
+    elif fs is None:
+        raise AnalysisError(f"structural path: give fs (Hz) with the {what} as a plain array")
+    else:
+        x = obj
+    x, fs = np.asarray(x, float), float(fs)
+    if not (np.isfinite(fs) and fs > 0):
+        raise AnalysisError(f"structural path: the {what}'s sampling rate must be positive; got {fs!r} Hz")
+    if x.ndim != 1 or x.size == 0:
+        raise AnalysisError(f"structural path: the {what} must be one non-empty signal; got shape {x.shape}")
+    bad = np.flatnonzero(~np.isfinite(x))
+    if bad.size:
+        raise AnalysisError(f"structural path: the {what} holds {bad.size} non-finite samples (the first at "
+                            f"{bad[0] / fs:.6g} s)")
+    if not np.any(x):
+        raise AnalysisError(f"structural path: the {what} is zero throughout; it has no impacts to fit on")
+    return x, fs

@@ -72,7 +72,7 @@ from scipy.optimize import least_squares
 from ..errors import AnalysisError, check_choice
 from ..utils._files import atomic_open
 from ._impact_views import (ImpactWindows, background_power, centred_times, floor_level, frequency_runs,
-                            hilbert_envelope)
+                            hilbert_envelope, signal_of)
 from .impacts import impact_peaks, impact_times, segment_spectrum
 
 __all__ = ["transmissibility", "Resonance", "StructuralPath", "fit_structural_path", "MIN_IMPACTS"]
@@ -476,16 +476,6 @@ def _score(prob, path):
     return tuple(_rms_db(np.concatenate(prob.residuals_from(v, 1.0, parts=True)[1])) for v in (fit, bare))
 
 
-def _samples(obj, fs):
-    """(x, fs) of an array, or of a Dataset's default channel (recording or simulation)."""
-    if hasattr(obj, "data_vars"):
-        ch = obj.attrs.get("default_channel") or next(iter(obj.data_vars))
-        return np.asarray(obj[ch].values, float), float(obj.attrs["sampling_rate_hz"])
-    if fs is None:
-        raise AnalysisError("structural path: give fs (Hz) with a plain array")
-    return np.asarray(obj, float), float(fs)
-
-
 def fit_structural_path(recording, simulation, fs, period, *, band=None, n_resonances=1,
                         frequency_bounds=(500.0, None), damping_bounds=(0.005, 0.5), gain_bounds=(1e-3, 1e3),
                         pre=0.5e-3, post=None, source="") -> StructuralPath:
@@ -525,10 +515,11 @@ def fit_structural_path(recording, simulation, fs, period, *, band=None, n_reson
     Raises
     ------
     AnalysisError
-        Fewer than :data:`MIN_IMPACTS` impacts in either signal, or invalid bounds.
+        Fewer than :data:`MIN_IMPACTS` impacts in either signal, invalid bounds, a signal that is
+        empty, not 1-D, not finite or zero throughout, or a period not shorter than the recording.
     """
-    recording, fs_r = _samples(recording, fs)
-    simulation, fs_s = _samples(simulation, fs)
+    recording, fs_r = signal_of(recording, fs, "recording")
+    simulation, fs_s = signal_of(simulation, fs, "simulation")
     if abs(fs_r - fs_s) > 1e-9 * fs_r:
         raise AnalysisError(f"structural path: recording at {fs_r:g} Hz and simulation at {fs_s:g} Hz; "
                             "simulate at the recording's rate")
@@ -536,6 +527,9 @@ def fit_structural_path(recording, simulation, fs, period, *, band=None, n_reson
     check_choice(n_resonances, (1, 2), "structural path: n_resonances", AnalysisError)
     bounds, notes = _check_bounds(frequency_bounds, damping_bounds, gain_bounds, fs)
     f_hi = bounds["frequency_hz"][1]
+    if not (np.isfinite(period) and 0 < period < recording.size / fs):
+        raise AnalysisError(f"structural path: the impact period must be positive and shorter than the "
+                            f"recording ({recording.size / fs:.6g} s); got {period!r} s")
     post = 0.6 * period if post is None else post
     prob = _PathProblem(recording, simulation, fs, period, band=band, pre=pre, post=post, n_resonances=n_resonances)
     k = n_resonances

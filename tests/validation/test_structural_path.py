@@ -88,6 +88,23 @@ def test_a_fit_needs_impacts():
         fit_structural_path(_impacts(), _impacts(), FS, PERIOD, n_resonances=3)
 
 
+@pytest.mark.parametrize("recording, simulation, fs, period, match", [
+    (np.array([]), _impacts(), FS, PERIOD, "recording must be one non-empty signal"),
+    (np.stack([_impacts(), _impacts()]), _impacts(), FS, PERIOD, r"shape \(2, 12000\)"),
+    (np.zeros(12000), _impacts(), FS, PERIOD, "recording is zero throughout"),
+    (_impacts(), np.zeros(12000), FS, PERIOD, "simulation is zero throughout"),
+    (np.where(np.arange(12000) == 600, np.nan, _impacts()), _impacts(), FS, PERIOD, "1 non-finite samples .* 0.05 s"),
+    (_impacts(), np.where(np.arange(12000) == 6, np.inf, _impacts()), FS, PERIOD, "simulation holds 1 non-finite"),
+    (_impacts(), _impacts(), -FS, PERIOD, "sampling rate must be positive"),
+    (_impacts(), _impacts(), FS, 0.0, "impact period must be positive"),
+    (_impacts(), _impacts(), FS, 2.0, "shorter than the recording"),
+])
+def test_unreadable_signals_are_refused_by_name(recording, simulation, fs, period, match):
+    """What the fit cannot read is named (signal, problem, where), not a scipy error from inside the search."""
+    with pytest.raises(AnalysisError, match=match):
+        fit_structural_path(recording, simulation, fs, period)
+
+
 def test_two_resonances():
     raw = _impacts()
     true = StructuralPath((Resonance(2500.0, 0.03), Resonance(4500.0, 0.03, 0.7)), 10.0)
