@@ -1,6 +1,7 @@
 """numba kernels of the half-space solver: the element-wise steps of one conjugate-gradient
-iteration (Polonsky & Keer, Wear 231, 1999) for a batch of problems, and the groove's gap over
-a skewed table's windows (:func:`torus_gap`).
+iteration (Polonsky & Keer, Wear 231, 1999) for a batch of problems, the groove's gap over
+a skewed table's windows (:func:`torus_gap`) and the outline points that hold a rigid ball
+(:func:`outline_candidates`).
 
 Why numba: on the tables' small grids (about 34 x 26 cells) the two FFT convolutions of
 an iteration cost ~25 µs per problem in single precision, while the dozen numpy
@@ -197,6 +198,45 @@ def torus_gap(S, Z, depth, R, rb, rg, centre, sign, rho0, outer, out):
     return out
 
 
+@njit(cache=True)
+def outline_candidates(sa, ca, zz, r, sp, cp, rb2, rho0, outer, margin, cand_j, cand_k):
+    """The outline points that may hold a rigid ball (:func:`.geometry.drop_profile_2d`): for each ball
+    position j and outline point k the gap of ``approach`` computed cheaply, the angle ``a_k - b_j``
+    between them taken from the sines and cosines of both (``sa, ca`` of the points' angles,
+    ``sp, cp`` of the balls'), no transcendental per pair; ``zz`` the points' z^2, ``r`` their surface
+    radius.  Every pair whose cheap gap is within ``margin`` of its position's lowest goes to
+    ``cand_j, cand_k`` (and a few more, within twice the margin: the list of a position is kept in one
+    pass, emptied when a gap lower by more than the margin comes).  Returns the number of pairs, or -1
+    if they would not fit (the arrays' size).  The cheap gap differs from ``approach`` by rounding
+    only (~1e-16 m near the ball), so the point ``approach`` puts lowest is among those within a
+    margin of 1e-12 m."""
+    n = 0
+    cap = cand_j.size
+    for j in range(sp.size):
+        start = n
+        best = math.inf
+        for k in range(sa.size):
+            sn = sa[k] * cp[j] - ca[k] * sp[j]
+            cs = ca[k] * cp[j] + sa[k] * sp[j]
+            arg = rb2 - zz[k] - (r[k] * sn) ** 2
+            if cs <= 0.0 or arg < 0.0:
+                continue
+            rc = r[k] * cs
+            h = (rc - rho0 if outer else rho0 - rc) - math.sqrt(arg)
+            if h < best - margin:
+                n = start
+            elif h > best + margin:
+                continue
+            if h < best:
+                best = h
+            if n >= cap:
+                return -1
+            cand_j[n] = j
+            cand_k[n] = k
+            n += 1
+    return n
+
+
 def warm_up():
     """Compile (or load from numba's cache) the kernels on a tiny problem."""
     p = np.ones((1, 2, 2))
@@ -213,3 +253,5 @@ def warm_up():
     update_displacement(g, g.copy(), f.copy(), g.copy(), n, np.ones((2, 2)), flags.copy(), 32,
                         False, flags.copy(), 0)
     torus_gap(f.copy(), f.copy(), 0.0, 1.0, 1.0, 1.1, 0.0, 1.0, 0.0, True, f.copy())
+    outline_candidates(f.copy(), f + 1.0, f.copy(), f + 1.0, f.copy(), f + 1.0, 1.0, 0.0, True, 1e-12,
+                       n.copy(), n.copy())

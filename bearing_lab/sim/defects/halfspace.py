@@ -60,6 +60,7 @@ import math
 import lazy_loader as lazy
 import numpy as np
 
+from ._transforms import convolve, kernel_spectrum
 from .geometry import RaceGeometry, hertz_semi_axes
 from .model import Defect
 
@@ -185,10 +186,8 @@ class HalfSpace:
         self.k00 = float(k[0, 0])          # a cell's displacement under its own pressure
         self.kern = k                      # for direct sums over a few cells (m/Pa)
         # single precision in the transforms (~1e-7 relative error in the displacement, far
-        # below the solver's tolerance) at a third of the cost; the kernel is scaled to
-        # order one so that no product falls into float32's subnormal range (~1e-38),
-        # where the arithmetic is a hundred times slower
-        self.kf = (sfft.rfft2(full, workers=1) / self.k00).astype(np.complex64)
+        # below the solver's tolerance) at a third of the cost; the kernel scaled to order one
+        self.kf = kernel_spectrum(full, self.k00)
         self.stencil = preconditioner_stencil(k[:nx, :ny]) if stencil is None else stencil
 
     def displacement(self, p: np.ndarray) -> np.ndarray:
@@ -196,15 +195,10 @@ class HalfSpace:
         shape (..., nx, ny) (leading axes: independent problems).
 
         Only the nx x ny corner of the padded array is non-zero and only that corner of
-        the result is needed, so the first and last 1-D passes run on nx rows only.
+        the result is needed, so the first and last 1-D passes run on nx rows only
+        (:func:`._transforms.convolve`).
         """
-        a = sfft.rfft(p.astype(np.float32), n=self.my, axis=-1, workers=1)
-        a = sfft.fft(a, n=self.mx, axis=-2, workers=1, overwrite_x=True)
-        a *= self.kf
-        a = sfft.ifft(a, axis=-2, workers=1, overwrite_x=True)[..., :self.nx, :]
-        u = sfft.irfft(a, n=self.my, axis=-1, workers=1)[..., :self.ny].astype(np.float64)
-        u *= self.k00
-        return u
+        return convolve(p, self.kf, self.mx, self.my, self.k00)
 
     def solve(self, gap: np.ndarray, approach: float, *, tol: float = 1e-8,
               maxiter: int = 3000, p0: np.ndarray | None = None,
