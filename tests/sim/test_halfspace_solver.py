@@ -151,6 +151,29 @@ def test_compiled_window_gap_is_the_geometry_gap(race, depth):
     np.testing.assert_allclose(got, np.where(np.isfinite(ref), ref, 1.0), rtol=1e-13, atol=1e-18)
 
 
+@pytest.mark.parametrize("race", ["outer", "inner"])
+@pytest.mark.parametrize("delta", [0.5e-6, 4.04e-6, 15e-6])
+def test_compiled_windows_are_the_numpy_windows(race, delta):
+    """A skewed ratio curve's windows from the one compiled pass (the floor's gap only where it is
+    read) against the numpy windows they stand for (intact gap everywhere, the floor's inside the
+    outline, combined where the intact gap is below the approach): the same gaps, cells and sub-cell
+    offsets to the last bit, for ball positions across and beyond a pit deep and a pit shallower
+    than the approach."""
+    geom = RaceGeometry.from_bearing(B6308, race)
+    for depth in (0.5e-3, 2e-6):
+        d = Defect(length=3e-3, width=1e-3, depth=depth, offset=0.3e-3, skew=math.radians(-45.0), race=race)
+        g = hsk.skewed_grid(d, geom, delta, TABLE_CELLS)
+        s = np.linspace(-3e-3, 3e-3, 23)
+        gi, gf, ins, (fu, fv) = hsk.windows(d, geom, g, s)
+        ins &= gi < delta
+        gap, ins_c, (fu_c, fv_c) = hsk.window_gaps(d, geom, g, s, delta)
+        assert 0 < ins.sum() < ins.size and np.any(gap < delta)
+        np.testing.assert_array_equal(ins_c, ins)
+        np.testing.assert_array_equal(gap, np.where(ins, gf, gi))
+        np.testing.assert_array_equal(fu_c, fu)
+        np.testing.assert_array_equal(fv_c, fv)
+
+
 def test_skewed_window_is_solved_in_a_sheared_layout_with_the_same_solution():
     """The contact over a skewed window lies along a diagonal of its cells: the batch is solved on
     the box of a sheared layout (cell (i, j) of the array is the grid's (i, j + m i)), whose

@@ -335,10 +335,12 @@ class HalfSpace:
                 act, p, t, hd, floor = act[keep], p[keep], t[keep], hd[keep], floor[keep]
                 allowed, g_old, restart = allowed[keep], g_old[keep], restart[keep]
                 stalled, exact, done = stalled[keep], exact[keep], done[keep]
-                u, fresh, tau, extra, n_extra = u[keep], fresh[keep], tau[keep], extra[keep], n_extra[keep]
+                u, fresh, tau, n_extra = u[keep], fresh[keep], tau[keep], n_extra[keep]
                 if act.size == 0:
                     break
-                g, z, gc = np.empty_like(p), np.empty_like(p), gc[keep]
+                # written whole at every iteration before they are read (gc's border stays zero)
+                g, z, extra = np.empty_like(p), np.empty_like(p), np.empty_like(p)
+                gc = np.zeros((p.shape[0],) + gc.shape[1:])
                 any_fresh = any_fresh and bool(np.any(fresh))
             if any_fresh:
                 u[fresh] = self.displacement(p[fresh])
