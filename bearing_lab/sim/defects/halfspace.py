@@ -104,15 +104,13 @@ def _stable_sum(t, s):
 def love_influence(nx: int, ny: int, dx: float, dy: float, e_star: float) -> np.ndarray:
     """Normal surface displacement (m per Pa) at cell centres (i dx, j dy), i < nx, j < ny,
     due to unit pressure on the dx x dy cell centred at the origin (both bodies, 1/E*)."""
-    x = np.arange(nx)[:, None] * dx
-    y = np.arange(ny)[None, :] * dy
-    a, b = dx / 2, dy / 2
-
-    def term(xx, yy):
-        # xx * ln(yy + r) + yy * ln(xx + r), r = hypot(xx, yy), stable for any sign
-        return xx * np.log(_stable_sum(yy, xx)) + yy * np.log(_stable_sum(xx, yy))
-
-    u = (term(x + a, y + b) - term(x + a, y - b) - term(x - a, y + b) + term(x - a, y - b))
+    # the closed form at the cells' corners (x_i - dx/2, y_j - dy/2), i <= nx, j <= ny: each corner
+    # serves the four cells around it, so it is evaluated once
+    x = (np.arange(nx + 1)[:, None] - 0.5) * dx
+    y = (np.arange(ny + 1)[None, :] - 0.5) * dy
+    # x ln(y + r) + y ln(x + r), r = hypot(x, y), stable for any sign
+    t = x * np.log(_stable_sum(y, x)) + y * np.log(_stable_sum(x, y))
+    u = (t[1:, 1:] - t[1:, :-1]) - (t[:-1, 1:] - t[:-1, :-1])
     return u / (math.pi * e_star)
 
 
@@ -514,8 +512,9 @@ def ratio_curve(defect: Defect, geom: RaceGeometry, delta: float, *, cells=TABLE
 
     def solve_round(ks, starts):
         todo, gaps, p0 = [], [], []
-        for k, start in zip(ks, starts):
-            ins = defect.contains(S + k * dy, Z) & touch
+        # the cells inside the outline for every position of the round at once
+        inside = defect.contains(S[None] + (np.asarray(ks) * dy)[:, None, None], Z[None]) & touch
+        for k, start, ins in zip(ks, starts, inside):
             if not np.any(ins):
                 solved[k] = (1.0, p_int)
                 continue
