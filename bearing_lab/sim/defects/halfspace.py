@@ -174,6 +174,7 @@ class HalfSpace:
             k = np.zeros(need)
             k[:min(need[0], kern.shape[0]), :min(need[1], kern.shape[1])] = kern[:need[0], :need[1]]
         self._crops: dict[tuple[int, int, int], HalfSpace] = {}
+        self._sheared: dict[tuple, tuple[np.ndarray, np.ndarray]] = {}
         # the kernel spans offsets -(n-1)..(n-1): a period of 2n - 1 avoids wrap-around
         self.mx = sfft.next_fast_len(2 * nx - 1, real=True)
         self.my = sfft.next_fast_len(2 * ny - 1, real=True)
@@ -275,20 +276,28 @@ class HalfSpace:
         """:meth:`solve_batch` on the box of ``rows`` x ``cols`` cells in the layout sheared by
         ``m``: array cell (i, j) is this grid's (r0 + i, c0 + j + m (r0 + i)); cells of the box
         outside the grid cannot touch."""
-        ri = r0 + np.arange(rows)
-        cj = c0 + np.arange(cols)[None, :] + m * ri[:, None]
-        inside = (cj >= 0) & (cj < self.ny)
-        src = (np.broadcast_to(ri[:, None], inside.shape)[inside], cj[inside])
-        hs = np.full((h.shape[0], rows, cols), 1.0)        # 1 m: never touches
-        hs[:, inside] = h[:, src[0], src[1]]
+        key = (m, r0, rows, c0, cols)
+        if key not in self._sheared:
+            # flat indices: the box's cells inside the grid, and those cells in the grid
+            ri = r0 + np.arange(rows)
+            cj = c0 + np.arange(cols)[None, :] + m * ri[:, None]
+            inside = (cj >= 0) & (cj < self.ny)
+            self._sheared[key] = (np.flatnonzero(inside),
+                                  np.broadcast_to(ri[:, None], inside.shape)[inside] * self.ny + cj[inside])
+        box, src = self._sheared[key]
+        k = h.shape[0]
+        hs = np.full((k, rows * cols), 1.0)        # 1 m: never touches
+        hs[:, box] = h.reshape(k, -1)[:, src]
         ps = None
         if p0 is not None:
             ps = np.zeros_like(hs)
-            ps[:, inside] = np.broadcast_to(p0, h.shape)[:, src[0], src[1]]
-        p, its = self._crop(rows, cols, m)._iterate(hs, approach, tol, maxiter, ps, precondition)
-        out = np.zeros_like(h)
-        out[:, src[0], src[1]] = p[:, inside]
-        return out, its
+            ps[:, box] = np.broadcast_to(p0, h.shape).reshape(k, -1)[:, src]
+            ps = ps.reshape(k, rows, cols)
+        p, its = self._crop(rows, cols, m)._iterate(hs.reshape(k, rows, cols), approach, tol, maxiter, ps,
+                                                    precondition)
+        out = np.zeros((k, self.nx * self.ny))
+        out[:, src] = p.reshape(k, -1)[:, box]
+        return out.reshape(h.shape), its
 
     def _iterate(self, h, approach, tol, maxiter, p0, precondition):
         """:meth:`solve_batch` on this grid's every cell."""
