@@ -15,7 +15,7 @@ Method
 Piecewise-constant pressure on a rectangular grid of cells; the surface displacement of
 a uniformly loaded rectangle from Love's (1929) closed form; the convolution over the
 grid by FFT with zero padding (DC-FFT: Liu, Wang & Liu, Wear 243, 2000), pruned so that
-only the non-zero quarter of the padded array is transformed; the complementarity
+only the non-zero quarter of the padded array is transformed (:mod:`._transforms`); the complementarity
 problem (pressure >= 0, gap >= 0, one of them zero) by the conjugate-gradient method of
 Polonsky & Keer (Wear 231, 1999), displacement-controlled (the approach is fixed, so
 their load-balance step is omitted), preconditioned on the contact set by a 3 x 3 stencil
@@ -42,7 +42,7 @@ semi-axes from the pressure's second moments within 0.7 % up to 8.4 µm (800 N);
 share of the intact force carried over a centred 1 x 1 mm defect converges to first
 order in the cell size (the pressure is singular at the pit's edge), which the
 two-grid extrapolation of :mod:`.contact` removes.  One approach node (both grids) costs
-about 11 ms of CPU for a rectangle along the track and 40 ms for a skewed one (70 ms off the
+about 9 ms of CPU for a rectangle along the track and 30 ms for a skewed one (50 ms off the
 track's centre line, where no mirror symmetry halves the ball positions); figures in
 ``docs/contact-model.md``.
 
@@ -286,15 +286,12 @@ class HalfSpace:
                                   np.broadcast_to(ri[:, None], inside.shape)[inside] * self.ny + cj[inside])
         box, src = self._sheared[key]
         k = h.shape[0]
-        hs = np.full((k, rows * cols), 1.0)        # 1 m: never touches
-        hs[:, box] = h.reshape(k, -1)[:, src]
-        ps = None
+        hs, ps = np.full((k, rows, cols), 1.0), None        # 1 m: never touches
+        hs.reshape(k, -1)[:, box] = h.reshape(k, -1)[:, src]
         if p0 is not None:
             ps = np.zeros_like(hs)
-            ps[:, box] = np.broadcast_to(p0, h.shape).reshape(k, -1)[:, src]
-            ps = ps.reshape(k, rows, cols)
-        p, its = self._crop(rows, cols, m)._iterate(hs.reshape(k, rows, cols), approach, tol, maxiter, ps,
-                                                    precondition)
+            ps.reshape(k, -1)[:, box] = np.broadcast_to(p0, h.shape).reshape(k, -1)[:, src]
+        p, its = self._crop(rows, cols, m)._iterate(hs, approach, tol, maxiter, ps, precondition)
         out = np.zeros((k, self.nx * self.ny))
         out[:, src] = p.reshape(k, -1)[:, box]
         return out.reshape(h.shape), its
