@@ -97,6 +97,8 @@ REGISTRY: tuple[Entry, ...] = (
           quoted_in=(B, D + "contact-model.md")),
     Entry("defect_tables.py", ("--before", "c083eaa"), variant="before-c083eaa", cost="40 s",
           quoted_in=(B, D + "contact-model.md")),
+    Entry("defect_tables.py", ("--before", "531c103"), variant="before-531c103", cost="40 s",
+          quoted_in=(B, D + "contact-model.md", "README.md")),
     Entry("defect_tables.py", ("--offcentre",), variant="offcentre", cost="25 s",
           quoted_in=(D + "contact-model.md",)),
     Entry("cwru_or021_amplitude.py", (), cost="8 s", quoted_in=(D + "validation.md",)),

@@ -96,6 +96,34 @@ def test_drop_profiles_symmetric_and_zero_off_defect():
     assert np.all(h1 >= h - 1e-12)  # the 1-D reduction ignores the flanks
 
 
+@pytest.mark.parametrize("race,defect,psi_radius", [
+    ("outer", Defect(length=6e-3, width=1e-3), None),
+    ("outer", Defect(length=1e-3, width=1e-3, offset=0.5e-3), None),          # drop exactly 0 over it
+    ("outer", Defect(length=3e-3, width=1e-3, offset=0.3e-3, skew=math.radians(30)), None),
+    ("inner", Defect(length=1e-3, width=1e-3, race="inner"), None),
+    ("outer", Defect(shape="ellipse", length=2e-3, width=1e-3, offset=0.2e-3), None),
+    ("outer", Defect(length=1e-3, width=1e-3, offset=0.2e-3, race="ball"), B6308.ball_diameter / 2),
+])
+def test_compiled_drop_pass_is_the_numpy_pass(race, defect, psi_radius, monkeypatch):
+    """A table's drop profile (hundreds of ball positions x thousands of outline points) takes the
+    compiled pass that keeps the outline points near the lowest and evaluates ``approach`` on those
+    only; the numpy pass over every pair gives the same drops to the last bit, zeros included, and
+    so does the numpy pass the compiled one falls back to when its candidates would not fit."""
+    from bearing_lab.sim.defects import _halfspace_kernels, geometry
+    g = RaceGeometry.from_bearing(B6308, race)
+    R = g.track_radius if psi_radius is None else psi_radius
+    s0, s1, _, _ = defect.track_extent()
+    psi = np.linspace(s0 - 1e-3, s1 + 1e-3, 401) / R
+    monkeypatch.setattr(geometry, "_COMPILED_PAIRS", 10 ** 12)
+    numpy_pass = drop_profile_2d(defect, g, psi, psi_radius=psi_radius)
+    monkeypatch.setattr(geometry, "_COMPILED_PAIRS", 0)
+    compiled = drop_profile_2d(defect, g, psi, psi_radius=psi_radius)
+    assert np.count_nonzero(numpy_pass) > 50 or defect.offset == 0.5e-3
+    np.testing.assert_array_equal(compiled, numpy_pass)
+    monkeypatch.setattr(_halfspace_kernels, "outline_candidates", lambda *a: -1)
+    np.testing.assert_array_equal(drop_profile_2d(defect, g, psi, psi_radius=psi_radius), numpy_pass)
+
+
 def test_from_mapping_units_and_defaults():
     d = Defect.from_mapping({"length_mm": 3, "width_mm": 1, "offset_mm": 0.2, "skew_deg": 30,
                              "angle_deg": 90})

@@ -237,8 +237,8 @@ def test_concurrent_processes_share_one_valid_entry(tmp_path, monkeypatch):
     np.testing.assert_array_equal(T.G, g0)
 
 
-@pytest.mark.parametrize("module", ["halfspace.py", "halfspace_skewed.py", "_halfspace_kernels.py", "geometry.py",
-                                    "contact.py"])
+@pytest.mark.parametrize("module", ["halfspace.py", "halfspace_skewed.py", "_halfspace_kernels.py", "_transforms.py",
+                                    "geometry.py", "contact.py"])
 def test_cache_key_follows_the_table_code(module, monkeypatch):
     """An edit of any module the tables are built by (the solver, its compiled kernels, the contact's
     geometry, the table's assembly) gives new cache keys, so no table of the old code is served."""

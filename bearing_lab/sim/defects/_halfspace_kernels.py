@@ -1,6 +1,7 @@
 """numba kernels of the half-space solver: the element-wise steps of one conjugate-gradient
-iteration (Polonsky & Keer, Wear 231, 1999) for a batch of problems, and the groove's gap over
-a skewed table's windows (:func:`torus_gap`).
+iteration (Polonsky & Keer, Wear 231, 1999) for a batch of problems, the groove's gap over
+a skewed table's windows (:func:`torus_gap`) and the outline points that hold a rigid ball
+(:func:`outline_candidates`).
 
 Why numba: on the tables' small grids (about 34 x 26 cells) the two FFT convolutions of
 an iteration cost ~25 µs per problem in single precision, while the dozen numpy
@@ -180,21 +181,95 @@ def torus_gap(S, Z, depth, R, rb, rg, centre, sign, rho0, outer, out):
     """:meth:`.geometry.RaceGeometry.approach` in one compiled pass over flat arrays of track
     positions ``S`` (m along the track from the ball) and ``Z`` (m across), the surface moved
     ``depth`` into the ring; 1.0 (m: never touches) where the ball cannot reach, written to
-    ``out``.  The windows of a skewed table ask for this gap at about 10^5 cells per round,
-    where numpy's two dozen passes cost about 13 % of the table.  Tested against ``approach``."""
+    ``out``.  Tested against ``approach``."""
     for n in range(S.size):
-        z = Z[n]
-        dphi = S[n] / R
-        r = centre + sign * (math.sqrt(max(rg * rg - z * z, 0.0)) + depth)
-        sn = math.sin(dphi)
-        cs = math.cos(dphi)
-        arg = rb * rb - z * z - (r * sn) ** 2
-        if arg >= 0.0 and abs(z) < rg and cs > 0.0:
-            rc = r * cs
-            out[n] = (rc - rho0 if outer else rho0 - rc) - math.sqrt(arg)
-        else:
-            out[n] = 1.0
+        out[n] = _gap1(S[n], Z[n], depth, R, rb, rg, centre, sign, rho0, outer)
     return out
+
+
+@njit(cache=True, inline="always")
+def _gap1(s, z, depth, R, rb, rg, centre, sign, rho0, outer):
+    dphi = s / R
+    r = centre + sign * (math.sqrt(max(rg * rg - z * z, 0.0)) + depth)
+    sn = math.sin(dphi)
+    cs = math.cos(dphi)
+    arg = rb * rb - z * z - (r * sn) ** 2
+    if arg >= 0.0 and abs(z) < rg and cs > 0.0:
+        rc = r * cs
+        return (rc - rho0 if outer else rho0 - rc) - math.sqrt(arg)
+    return 1.0
+
+
+@njit(cache=True)
+def window_gaps(xu, xv, du, dv, c, sn, n_u, n_v, delta, depth, R, rb, rg, centre, sign, rho0, outer,
+                gap, ins, fu, fv):
+    """The gaps of a skewed table's windows (:func:`.halfspace_skewed.windows`, as its ratio curve uses
+    them) in one pass: for ball k, ``xu[k], xv[k]`` its position in cells on the defect-anchored grid
+    (cells ``du x dv``, the outline ``n_u x n_v`` of them, the window ``gap.shape[1:]``), the window's
+    cells at track positions relative to the ball turned by the skew (``c, sn``); ``gap`` the intact
+    gap, the floor's (``depth`` into the ring) on cells inside the outline whose intact gap is below
+    ``delta``, which are marked in ``ins``; ``fu, fv`` the ball's offsets within a cell.  The
+    arithmetic is numpy's in :func:`.halfspace_skewed.windows`, operation for operation (tested), and
+    the floor's gap is computed only where it is read.  The windows of a skewed table ask for about
+    10^5 gaps per round of ball positions, where numpy's passes cost a tenth of the table."""
+    K, nu, nv = gap.shape
+    for k in range(K):
+        i0 = math.floor(xu[k])
+        j0 = math.floor(xv[k])
+        fu[k] = xu[k] - i0
+        fv[k] = xv[k] - j0
+        for a in range(nu):
+            dU = (a + 0.5 - nu / 2 - fu[k]) * du
+            in_u = 0 <= i0 + a < n_u
+            for b in range(nv):
+                dV = (b + 0.5 - nv / 2 - fv[k]) * dv
+                s = dU * c - dV * sn
+                z = dU * sn + dV * c
+                g = _gap1(s, z, 0.0, R, rb, rg, centre, sign, rho0, outer)
+                inside = in_u and 0 <= j0 + b < n_v and g < delta
+                if inside:
+                    g = _gap1(s, z, depth, R, rb, rg, centre, sign, rho0, outer)
+                gap[k, a, b] = g
+                ins[k, a, b] = inside
+
+
+@njit(cache=True)
+def outline_candidates(sa, ca, zz, r, sp, cp, rb2, rho0, outer, margin, cand_j, cand_k):
+    """The outline points that may hold a rigid ball (:func:`.geometry.drop_profile_2d`): for each ball
+    position j and outline point k the gap of ``approach`` computed cheaply, the angle ``a_k - b_j``
+    between them taken from the sines and cosines of both (``sa, ca`` of the points' angles,
+    ``sp, cp`` of the balls'), no transcendental per pair; ``zz`` the points' z^2, ``r`` their surface
+    radius.  Every pair whose cheap gap is within ``margin`` of its position's lowest goes to
+    ``cand_j, cand_k`` (and a few more, within twice the margin: the list of a position is kept in one
+    pass, emptied when a gap lower by more than the margin comes).  Returns the number of pairs, or -1
+    if they would not fit (the arrays' size).  The cheap gap differs from ``approach`` by rounding
+    only (~1e-16 m near the ball), so the point ``approach`` puts lowest is among those within a
+    margin of 1e-12 m."""
+    n = 0
+    cap = cand_j.size
+    for j in range(sp.size):
+        start = n
+        best = math.inf
+        for k in range(sa.size):
+            sn = sa[k] * cp[j] - ca[k] * sp[j]
+            cs = ca[k] * cp[j] + sa[k] * sp[j]
+            arg = rb2 - zz[k] - (r[k] * sn) ** 2
+            if cs <= 0.0 or arg < 0.0:
+                continue
+            rc = r[k] * cs
+            h = (rc - rho0 if outer else rho0 - rc) - math.sqrt(arg)
+            if h < best - margin:
+                n = start
+            elif h > best + margin:
+                continue
+            if h < best:
+                best = h
+            if n >= cap:
+                return -1
+            cand_j[n] = j
+            cand_k[n] = k
+            n += 1
+    return n
 
 
 def warm_up():
@@ -213,3 +288,7 @@ def warm_up():
     update_displacement(g, g.copy(), f.copy(), g.copy(), n, np.ones((2, 2)), flags.copy(), 32,
                         False, flags.copy(), 0)
     torus_gap(f.copy(), f.copy(), 0.0, 1.0, 1.0, 1.1, 0.0, 1.0, 0.0, True, f.copy())
+    window_gaps(f.copy(), f.copy(), 1.0, 1.0, 1.0, 0.0, 1, 1, 0.1, 0.0, 1.0, 1.0, 1.1, 0.0, 1.0, 0.0, True,
+                g.copy(), b.copy(), f.copy(), f.copy())
+    outline_candidates(f.copy(), f + 1.0, f.copy(), f + 1.0, f.copy(), f + 1.0, 1.0, 0.0, True, 1e-12,
+                       n.copy(), n.copy())

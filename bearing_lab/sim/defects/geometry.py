@@ -201,6 +201,11 @@ def _boundary_points(defect: Defect, geom: RaceGeometry, spacing: float | None =
     return s[keep], z[keep]
 
 
+#: ball positions x outline points above which :func:`drop_profile_2d` takes its compiled pass (below,
+#: loading the kernel costs more than numpy's pass: e.g. :func:`rigid_drop`'s one position)
+_COMPILED_PAIRS = 200_000
+
+
 def drop_profile_2d(defect: Defect, geom: RaceGeometry, psi, *, chunk: int = 64,
                     psi_radius: float | None = None) -> np.ndarray:
     """Rigid-ball drop (m) at ball positions ``psi`` (rad from the defect centre), 3-D.
@@ -222,6 +227,21 @@ def drop_profile_2d(defect: Defect, geom: RaceGeometry, psi, *, chunk: int = 64,
         out[inside] = defect.depth
         return out
     idx = np.flatnonzero(inside)
+    if idx.size * sb.size > _COMPILED_PAIRS:
+        # the outline points within a rounding margin of the lowest, found by a compiled pass
+        # (:func:`._halfspace_kernels.outline_candidates`), and ``approach`` on those only
+        from ._halfspace_kernels import outline_candidates
+        a, b = sb / R, Rp * psi[idx] / R
+        cap = max(4096, 16 * idx.size)
+        cj, ck = np.empty(cap, dtype=np.int64), np.empty(cap, dtype=np.int64)
+        n = outline_candidates(np.sin(a), np.cos(a), zb * zb, geom.surface_radius(zb), np.sin(b), np.cos(b),
+                               geom.ball_radius ** 2, geom.rho0, geom.race == "outer", 1e-12, cj, ck)
+        if n >= 0:
+            lowest = np.full(idx.size, np.inf)
+            j, k = cj[:n], ck[:n]
+            np.minimum.at(lowest, j, geom.approach((sb[k] - Rp * psi[idx[j]]) / R, zb[k]))
+            out[idx] = np.clip(lowest, 0.0, defect.depth)
+            return out
     for i in range(0, idx.size, chunk):
         j = idx[i:i + chunk]
         h = geom.approach((sb[None, :] - Rp * psi[j, None]) / R, zb[None, :])

@@ -15,7 +15,7 @@ Method
 Piecewise-constant pressure on a rectangular grid of cells; the surface displacement of
 a uniformly loaded rectangle from Love's (1929) closed form; the convolution over the
 grid by FFT with zero padding (DC-FFT: Liu, Wang & Liu, Wear 243, 2000), pruned so that
-only the non-zero quarter of the padded array is transformed; the complementarity
+only the non-zero quarter of the padded array is transformed (:mod:`._transforms`); the complementarity
 problem (pressure >= 0, gap >= 0, one of them zero) by the conjugate-gradient method of
 Polonsky & Keer (Wear 231, 1999), displacement-controlled (the approach is fixed, so
 their load-balance step is omitted), preconditioned on the contact set by a 3 x 3 stencil
@@ -42,7 +42,7 @@ semi-axes from the pressure's second moments within 0.7 % up to 8.4 µm (800 N);
 share of the intact force carried over a centred 1 x 1 mm defect converges to first
 order in the cell size (the pressure is singular at the pit's edge), which the
 two-grid extrapolation of :mod:`.contact` removes.  One approach node (both grids) costs
-about 11 ms of CPU for a rectangle along the track and 40 ms for a skewed one (70 ms off the
+about 9 ms of CPU for a rectangle along the track and 30 ms for a skewed one (50 ms off the
 track's centre line, where no mirror symmetry halves the ball positions); figures in
 ``docs/contact-model.md``.
 
@@ -60,6 +60,7 @@ import math
 import lazy_loader as lazy
 import numpy as np
 
+from ._transforms import convolve, kernel_spectrum
 from .geometry import RaceGeometry, hertz_semi_axes
 from .model import Defect
 
@@ -103,15 +104,13 @@ def _stable_sum(t, s):
 def love_influence(nx: int, ny: int, dx: float, dy: float, e_star: float) -> np.ndarray:
     """Normal surface displacement (m per Pa) at cell centres (i dx, j dy), i < nx, j < ny,
     due to unit pressure on the dx x dy cell centred at the origin (both bodies, 1/E*)."""
-    x = np.arange(nx)[:, None] * dx
-    y = np.arange(ny)[None, :] * dy
-    a, b = dx / 2, dy / 2
-
-    def term(xx, yy):
-        # xx * ln(yy + r) + yy * ln(xx + r), r = hypot(xx, yy), stable for any sign
-        return xx * np.log(_stable_sum(yy, xx)) + yy * np.log(_stable_sum(xx, yy))
-
-    u = (term(x + a, y + b) - term(x + a, y - b) - term(x - a, y + b) + term(x - a, y - b))
+    # the closed form at the cells' corners (x_i - dx/2, y_j - dy/2), i <= nx, j <= ny: each corner
+    # serves the four cells around it, so it is evaluated once
+    x = (np.arange(nx + 1)[:, None] - 0.5) * dx
+    y = (np.arange(ny + 1)[None, :] - 0.5) * dy
+    # x ln(y + r) + y ln(x + r), r = hypot(x, y), stable for any sign
+    t = x * np.log(_stable_sum(y, x)) + y * np.log(_stable_sum(x, y))
+    u = (t[1:, 1:] - t[1:, :-1]) - (t[:-1, 1:] - t[:-1, :-1])
     return u / (math.pi * e_star)
 
 
@@ -175,6 +174,7 @@ class HalfSpace:
             k = np.zeros(need)
             k[:min(need[0], kern.shape[0]), :min(need[1], kern.shape[1])] = kern[:need[0], :need[1]]
         self._crops: dict[tuple[int, int, int], HalfSpace] = {}
+        self._sheared: dict[tuple, tuple[np.ndarray, np.ndarray]] = {}
         # the kernel spans offsets -(n-1)..(n-1): a period of 2n - 1 avoids wrap-around
         self.mx = sfft.next_fast_len(2 * nx - 1, real=True)
         self.my = sfft.next_fast_len(2 * ny - 1, real=True)
@@ -185,10 +185,8 @@ class HalfSpace:
         self.k00 = float(k[0, 0])          # a cell's displacement under its own pressure
         self.kern = k                      # for direct sums over a few cells (m/Pa)
         # single precision in the transforms (~1e-7 relative error in the displacement, far
-        # below the solver's tolerance) at a third of the cost; the kernel is scaled to
-        # order one so that no product falls into float32's subnormal range (~1e-38),
-        # where the arithmetic is a hundred times slower
-        self.kf = (sfft.rfft2(full, workers=1) / self.k00).astype(np.complex64)
+        # below the solver's tolerance) at a third of the cost; the kernel scaled to order one
+        self.kf = kernel_spectrum(full, self.k00)
         self.stencil = preconditioner_stencil(k[:nx, :ny]) if stencil is None else stencil
 
     def displacement(self, p: np.ndarray) -> np.ndarray:
@@ -196,15 +194,10 @@ class HalfSpace:
         shape (..., nx, ny) (leading axes: independent problems).
 
         Only the nx x ny corner of the padded array is non-zero and only that corner of
-        the result is needed, so the first and last 1-D passes run on nx rows only.
+        the result is needed, so the first and last 1-D passes run on nx rows only
+        (:func:`._transforms.convolve`).
         """
-        a = sfft.rfft(p.astype(np.float32), n=self.my, axis=-1, workers=1)
-        a = sfft.fft(a, n=self.mx, axis=-2, workers=1, overwrite_x=True)
-        a *= self.kf
-        a = sfft.ifft(a, axis=-2, workers=1, overwrite_x=True)[..., :self.nx, :]
-        u = sfft.irfft(a, n=self.my, axis=-1, workers=1)[..., :self.ny].astype(np.float64)
-        u *= self.k00
-        return u
+        return convolve(p, self.kf, self.mx, self.my, self.k00)
 
     def solve(self, gap: np.ndarray, approach: float, *, tol: float = 1e-8,
               maxiter: int = 3000, p0: np.ndarray | None = None,
@@ -283,20 +276,25 @@ class HalfSpace:
         """:meth:`solve_batch` on the box of ``rows`` x ``cols`` cells in the layout sheared by
         ``m``: array cell (i, j) is this grid's (r0 + i, c0 + j + m (r0 + i)); cells of the box
         outside the grid cannot touch."""
-        ri = r0 + np.arange(rows)
-        cj = c0 + np.arange(cols)[None, :] + m * ri[:, None]
-        inside = (cj >= 0) & (cj < self.ny)
-        src = (np.broadcast_to(ri[:, None], inside.shape)[inside], cj[inside])
-        hs = np.full((h.shape[0], rows, cols), 1.0)        # 1 m: never touches
-        hs[:, inside] = h[:, src[0], src[1]]
-        ps = None
+        key = (m, r0, rows, c0, cols)
+        if key not in self._sheared:
+            # flat indices: the box's cells inside the grid, and those cells in the grid
+            ri = r0 + np.arange(rows)
+            cj = c0 + np.arange(cols)[None, :] + m * ri[:, None]
+            inside = (cj >= 0) & (cj < self.ny)
+            self._sheared[key] = (np.flatnonzero(inside),
+                                  np.broadcast_to(ri[:, None], inside.shape)[inside] * self.ny + cj[inside])
+        box, src = self._sheared[key]
+        k = h.shape[0]
+        hs, ps = np.full((k, rows, cols), 1.0), None        # 1 m: never touches
+        hs.reshape(k, -1)[:, box] = h.reshape(k, -1)[:, src]
         if p0 is not None:
             ps = np.zeros_like(hs)
-            ps[:, inside] = np.broadcast_to(p0, h.shape)[:, src[0], src[1]]
+            ps.reshape(k, -1)[:, box] = np.broadcast_to(p0, h.shape).reshape(k, -1)[:, src]
         p, its = self._crop(rows, cols, m)._iterate(hs, approach, tol, maxiter, ps, precondition)
-        out = np.zeros_like(h)
-        out[:, src[0], src[1]] = p[:, inside]
-        return out, its
+        out = np.zeros((k, self.nx * self.ny))
+        out[:, src] = p.reshape(k, -1)[:, box]
+        return out.reshape(h.shape), its
 
     def _iterate(self, h, approach, tol, maxiter, p0, precondition):
         """:meth:`solve_batch` on this grid's every cell."""
@@ -341,10 +339,12 @@ class HalfSpace:
                 act, p, t, hd, floor = act[keep], p[keep], t[keep], hd[keep], floor[keep]
                 allowed, g_old, restart = allowed[keep], g_old[keep], restart[keep]
                 stalled, exact, done = stalled[keep], exact[keep], done[keep]
-                u, fresh, tau, extra, n_extra = u[keep], fresh[keep], tau[keep], extra[keep], n_extra[keep]
+                u, fresh, tau, n_extra = u[keep], fresh[keep], tau[keep], n_extra[keep]
                 if act.size == 0:
                     break
-                g, z, gc = np.empty_like(p), np.empty_like(p), gc[keep]
+                # written whole at every iteration before they are read (gc's border stays zero)
+                g, z, extra = np.empty_like(p), np.empty_like(p), np.empty_like(p)
+                gc = np.zeros((p.shape[0],) + gc.shape[1:])
                 any_fresh = any_fresh and bool(np.any(fresh))
             if any_fresh:
                 u[fresh] = self.displacement(p[fresh])
@@ -518,8 +518,9 @@ def ratio_curve(defect: Defect, geom: RaceGeometry, delta: float, *, cells=TABLE
 
     def solve_round(ks, starts):
         todo, gaps, p0 = [], [], []
-        for k, start in zip(ks, starts):
-            ins = defect.contains(S + k * dy, Z) & touch
+        # the cells inside the outline for every position of the round at once
+        inside = defect.contains(S[None] + (np.asarray(ks) * dy)[:, None, None], Z[None]) & touch
+        for k, start, ins in zip(ks, starts, inside):
             if not np.any(ins):
                 solved[k] = (1.0, p_int)
                 continue

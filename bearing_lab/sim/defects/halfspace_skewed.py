@@ -108,15 +108,25 @@ def _track_coords(skew: float, g: SkewedGrid, fu: float, fv: float):
     return UU * c - VV * sn, UU * sn + VV * c
 
 
+def _kernels():
+    """The compiled kernels (:mod:`._halfspace_kernels`), loaded at the first solve (7 ms)."""
+    from . import _halfspace_kernels
+    return _halfspace_kernels
+
+
+def _groove(geom: RaceGeometry):
+    """The groove's numbers the compiled gap takes (``torus_gap``'s arguments after ``depth``)."""
+    return (geom.track_radius, geom.ball_radius, geom.groove_radius, geom.centre_radius, geom.sign,
+            geom.rho0, geom.race == "outer")
+
+
 def _gap(geom: RaceGeometry, S, Z, depth=0.0):
     """The intact (or, ``depth`` into the ring, the floor's) gap (m) at track positions S, Z
     relative to the ball; 1.0 where the ball cannot reach (compiled ``geom.approach``)."""
-    from ._halfspace_kernels import torus_gap  # kernels (7 ms) at the first solve
     S, Z = np.broadcast_arrays(np.asarray(S, dtype=float), np.asarray(Z, dtype=float))
     out = np.empty(S.shape)
-    torus_gap(np.ascontiguousarray(S).ravel(), np.ascontiguousarray(Z).ravel(), float(depth),
-              geom.track_radius, geom.ball_radius, geom.groove_radius, geom.centre_radius, geom.sign,
-              geom.rho0, geom.race == "outer", out.reshape(-1))
+    _kernels().torus_gap(np.ascontiguousarray(S).ravel(), np.ascontiguousarray(Z).ravel(), float(depth),
+                         *_groove(geom), out.reshape(-1))
     return out
 
 
@@ -150,6 +160,23 @@ def windows(defect: Defect, geom: RaceGeometry, g: SkewedGrid, s_balls: np.ndarr
     gf = gi.copy()          # the floor's gap is read inside the outline only
     gf[ins] = _gap(geom, S[ins], Z[ins], defect.depth)
     return gi, gf, ins, (fu, fv)
+
+
+def window_gaps(defect: Defect, geom: RaceGeometry, g: SkewedGrid, s_balls: np.ndarray, delta: float):
+    """The windows of :func:`windows` as a ratio curve reads them at approach ``delta``, in one compiled
+    pass (:func:`._halfspace_kernels.window_gaps`): the gap (the floor's on the cells inside the
+    outline whose intact gap is below ``delta``, the intact one elsewhere), those cells, (K, nu, nv),
+    and the ball's sub-cell offsets (fu, fv)."""
+    c, sn = math.cos(defect.skew), math.sin(defect.skew)
+    s_balls = np.asarray(s_balls, dtype=float)
+    xu = ((s_balls * c - defect.offset * sn) + defect.length / 2) / g.du - g.nu / 2
+    xv = ((-s_balls * sn - defect.offset * c) + defect.width / 2) / g.dv - g.nv / 2
+    gap = np.empty((s_balls.size, g.nu, g.nv))
+    ins = np.empty(gap.shape, dtype=bool)
+    fu, fv = np.empty(s_balls.size), np.empty(s_balls.size)
+    _kernels().window_gaps(xu, xv, g.du, g.dv, c, sn, g.n_u, g.n_v, float(delta), float(defect.depth),
+                           *_groove(geom), gap, ins, fu, fv)
+    return gap, ins, (fu, fv)
 
 
 class IntactForce:
@@ -233,9 +260,7 @@ def ratio_curve_skewed(defect: Defect, geom: RaceGeometry, delta: float, *, cell
     stats = {"solves": intact.solves, "iterations": intact.iterations}
 
     def solve_round(ks, starts):
-        gi, gf, ins, (fu, fv) = windows(defect, geom, g, np.asarray(ks) * step)
-        ins &= gi < delta
-        gap = np.where(ins, gf, gi)
+        gap, ins, (fu, fv) = window_gaps(defect, geom, g, np.asarray(ks) * step, delta)
         meets = ins.any(axis=(1, 2))
         touches = (gap < delta).any(axis=(1, 2))
         todo = np.flatnonzero(meets & touches)
