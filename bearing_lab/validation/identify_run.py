@@ -30,18 +30,19 @@ from ..utils._json import clean
 
 #: CPU s of one contact table built cold, as the simulation builds it (half-space; 6308 stand-in rig):
 #: an outline with sides along and across the track, and a skewed one (rotated cells).  Measured with
-#: benchmarks/identify_cost.py: 0.17 s and 0.47-1.14 s on the shared 2-core machine; bracketed with its spread
-TABLE_CPU_S = {"aligned": (0.08, 1.0), "skewed": (0.3, 3.0)}
+#: benchmarks/defect_tables.py on the shared 2-core machine: 0.07-0.10 s aligned (the slot 0.28 s),
+#: 0.30-0.53 s skewed; bracketed with a wide margin for slower machines
+TABLE_CPU_S = {"aligned": (0.05, 1.0), "skewed": (0.2, 3.0)}
 #: CPU s per second of record of one scene with its table cached, its signature and score included
 #: (0.08-0.10 s for the time loop at rtol 1e-6, 20 kHz; the sweep, the Dataset and the scoring add to it)
 SCENE_CPU_S_PER_S = (0.08, 0.8)
 #: fewer scenes than the refinement added in any run measured (53-57 on the stand-ins, docs/identification.md);
 #: its most is its budget
 REFINE_FEWEST = 30
-#: the likely figures inside those brackets: the middle of the measured tables (0.17 s aligned, 0.47-1.14 s
-#: skewed), a scene with its scoring (0.065 s for the README walkthrough's 0.65 s scenes), and the
+#: the likely figures inside those brackets: the middle of the measured tables (0.07-0.10 s aligned,
+#: 0.30-0.53 s skewed), a scene with its scoring (0.065 s for the README walkthrough's 0.65 s scenes), and the
 #: refinement's scenes in the runs measured
-TABLE_CPU_LIKELY_S = {"aligned": 0.17, "skewed": 0.9}
+TABLE_CPU_LIKELY_S = {"aligned": 0.09, "skewed": 0.45}
 SCENE_CPU_LIKELY_S_PER_S = 0.12
 REFINE_LIKELY = 55
 #: the search's budgets (identify.py runs the search; the estimate bounds it from these):
