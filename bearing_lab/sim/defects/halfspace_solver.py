@@ -256,8 +256,9 @@ class HalfSpace:
         first solved on the box of the cells the start presses, widened by :data:`NEAR_CELLS`
         (:data:`NEAR_CELLS_LOST` for a problem whose start loses more than :data:`NEAR_LOST` of its
         load on cells that cannot touch here, over a pit: its load moves outward), when this grid has
-        :data:`NEAR_MIN_CELLS` cells or more and that box's transform is smaller by a tenth or more.  Each result is then checked on every cell of this
-        grid that can touch (one transform at this grid's size): a problem where such a cell
+        :data:`NEAR_MIN_CELLS` cells or more and that box's transform is smaller by a tenth or more.
+        Each result is then checked on every cell of this grid that can touch (one transform at this
+        grid's size): a problem where such a cell
         outside the box would penetrate is solved again from that pressure, those cells added, on
         the box around them, and if that fails too, on this whole grid.  So the solution is this
         grid's problem's, to the solver's tolerance; only the transforms are smaller."""
