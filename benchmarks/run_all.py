@@ -99,6 +99,8 @@ REGISTRY: tuple[Entry, ...] = (
           quoted_in=(B, D + "contact-model.md")),
     Entry("defect_tables.py", ("--before", "531c103"), variant="before-531c103", cost="40 s",
           quoted_in=(B, D + "contact-model.md", "README.md")),
+    Entry("defect_tables.py", ("--before", "f8262c3"), variant="before-f8262c3", cost="40 s",
+          quoted_in=(B, D + "contact-model.md", "README.md")),
     Entry("defect_tables.py", ("--offcentre",), variant="offcentre", cost="25 s",
           quoted_in=(D + "contact-model.md",)),
     Entry("cwru_or021_amplitude.py", (), cost="8 s", quoted_in=(D + "validation.md",)),

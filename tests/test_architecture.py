@@ -256,7 +256,7 @@ FUNCTION_LEVEL_IMPORTS = {
     "io/__init__.py": 1, "io/_base.py": 2, "io/_fuzz.py": 2, "io/_fuzz_struct.py": 1, "io/_guard.py": 2,
     "io/_matlab.py": 8, "io/cwru.py": 2, "io/export.py": 1, "io/mdf.py": 1, "io/netcdf.py": 3, "io/tdms.py": 1,
     "io/wav.py": 1,
-    "sim/defects/geometry.py": 1, "sim/defects/halfspace.py": 1, "sim/defects/halfspace_skewed.py": 1,
+    "sim/defects/geometry.py": 1, "sim/defects/halfspace_skewed.py": 1, "sim/defects/halfspace_solver.py": 1,
     "sim/integrate.py": 1,
     "studies/bench.py": 2, "studies/paper.py": 1, "sweep/__init__.py": 5, "sweep/store.py": 1,
     "utils/figures.py": 2, "validation/identify.py": 1,

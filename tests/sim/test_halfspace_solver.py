@@ -191,3 +191,34 @@ def test_skewed_window_is_solved_in_a_sheared_layout_with_the_same_solution():
     p_all, it_all = hs._iterate(gaps, 4.04e-6, 1e-8, 3000, None, True)
     assert np.abs(p_shear - p_all).max() < 1e-5 * p_all.max()
     assert np.all(p_shear[gaps >= 4.04e-6] == 0)
+
+
+@pytest.mark.parametrize("shrink", [False, True])
+def test_solve_near_the_start_gives_the_whole_window_solution(shrink, monkeypatch):
+    """A batch with a start is solved first on the box around the cells the start presses (a
+    smaller transform) and then checked on every cell that can touch.  From the intact pressure
+    (over the pit most of it lies on cells that cannot touch) and from a start pressing only the
+    middle of the contact (so that the box misses the contact's edge and the check must send
+    problems on), the pressures equal the whole window's solve from no start within the solver's
+    tolerance, cell by cell, and none falls outside the cells that can touch."""
+    delta = 4.04e-6
+    hs, gaps, gi = _skewed_windows(delta, n=7)
+    p_int, _ = hs.solve(gi, delta, tol=1e-8)
+    start = np.where(p_int > 0.8 * p_int.max(), p_int, 0.0) if shrink else p_int
+    calls = []
+    on_box = HalfSpace._on_box
+
+    def record(self, *a):
+        out = on_box(self, *a)
+        calls.append((self, int(out[2].sum())))
+        return out
+    monkeypatch.setattr(HalfSpace, "_on_box", record)
+    p_near, _ = hs.solve_batch(gaps, delta, tol=1e-8, p0=np.broadcast_to(start, gaps.shape))
+    p_all, _ = hs._iterate(gaps, delta, 1e-8, 3000, None, True)
+    assert np.abs(p_near - p_all).max() < 1e-5 * p_all.max()
+    assert np.all(p_near[gaps >= delta] == 0)
+    # a smaller box was solved, and the start that under-reaches sent problems to the next stage
+    box = calls[0][0]
+    assert any(c.mx * c.my <= 0.9 * box.mx * box.my for c in box._crops.values())
+    if shrink:
+        assert calls[0][1] > 0

@@ -30,7 +30,7 @@ from numba import njit
 def cg_direction(p, u, g, hd, t, allowed, restart, g_old, floor, k00, stalled, exact, stencil, gc, z, shear):
     """The gap ``g = u + hd`` (``u`` the displacement), the new search direction ``t`` in place.
 
-    Preconditioned (:func:`.halfspace.preconditioner_stencil`): ``z = M^-1 g`` with
+    Preconditioned (:func:`.halfspace_solver.preconditioner_stencil`): ``z = M^-1 g`` with
     ``M^-1`` the symmetric 3 x 3 ``stencil`` (divided by ``k00``: Pa per m of gap), applied
     to ``g`` on the contact set and read there only, so that it acts as its restriction to
     the contact set; ``t = z + beta t``, ``beta = (g.z) / (g.z)_previous``.  A stencil with
@@ -38,7 +38,7 @@ def cg_direction(p, u, g, hd, t, allowed, restart, g_old, floor, k00, stalled, e
     with a zero border, ``z`` of ``g``'s shape.
 
     ``shear`` m: the arrays hold the cells in a sheared layout, index (i, j) being the grid's
-    cell (i, j + m i) (:class:`.halfspace.HalfSpace`); the stencil's weights stay those of the
+    cell (i, j + m i) (:class:`.halfspace_solver.HalfSpace`); the stencil's weights stay those of the
     cells' physical neighbours (offset (di, dj) sits at (di, dj - m di) in the arrays).
 
     A problem whose contact set is in equilibrium (or empty; ``sum g^2 <= floor``) is

@@ -1,4 +1,4 @@
-"""The half-space solver's convolution by FFT (:meth:`.halfspace.HalfSpace.displacement`), pruned and
+"""The half-space solver's convolution by FFT (:meth:`.halfspace_solver.HalfSpace.displacement`), pruned and
 in single precision, with scipy's pocketfft called directly.
 
 Why apart, and why not through ``scipy.fft``'s functions: on the tables' grids (boxes of about
