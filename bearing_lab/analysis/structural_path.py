@@ -104,6 +104,11 @@ def transmissibility(f, frequency_hz, damping_ratio):
     return num / (w * w - W * W + 2j * damping_ratio * w * W)
 
 
+def padded_length(n):
+    """The transform length the path filters ``n`` samples at: a power of two, at least 2 n (no wrap-around)."""
+    return 1 << int(math.ceil(math.log2(2 * n)))
+
+
 @dataclass(frozen=True)
 class Resonance:
     """One mode of the path: frequency (Hz), damping ratio, relative weight."""
@@ -147,7 +152,7 @@ class StructuralPath:
         if not self.resonances:
             return self.gain * x
         n = x.size
-        nfft = 1 << int(math.ceil(math.log2(2 * n)))
+        nfft = padded_length(n)
         spec = np.fft.rfft(x, nfft) * self.response(np.fft.rfftfreq(nfft, 1 / fs))
         return np.fft.irfft(spec, nfft)[:n]
 
@@ -281,7 +286,7 @@ class _PathProblem:
         self.noise_e = background_power(self.e, fs, self.te, period, self.ranges, self.w2)
         # the bare simulation's transform, zero-padded as StructuralPath.apply pads it, taken once
         n = self.s.size
-        self.nfft = 1 << int(math.ceil(math.log2(2 * n)))
+        self.nfft = padded_length(n)
         omega = 2 * np.pi * np.fft.rfftfreq(self.nfft, 1 / fs)
         self.j_omega, self.omega2 = 1j * omega, omega * omega
         self.spec_s_w2 = np.fft.rfft(self.s, self.nfft) * self.omega2
